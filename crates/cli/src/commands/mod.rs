@@ -1,0 +1,13 @@
+//! One module per subcommand: its clap arguments (`Args`) and its `run`.
+
+pub mod convert;
+pub mod evaluate;
+pub mod info;
+pub mod labels;
+pub mod online;
+pub mod predict;
+pub mod represent;
+pub mod reproduce;
+pub mod simulate;
+pub mod train;
+pub mod tune;

@@ -1,0 +1,67 @@
+//! `evtac`: contact-angle estimation for event-based tactile sensors, from the command line.
+//!
+//! The binary only parses arguments and shows progress; the work is done by the library crates
+//! (`evtac-events`, `evtac-repr`, `evtac-sim`, `evtac-labels`, `evtac-learn`,
+//! `evtac-experiments`, `evtac-online`). Run `evtac --help` for the subcommands.
+
+mod commands;
+mod progress;
+
+use clap::{Parser, Subcommand};
+
+/// Contact-angle estimation for event-based tactile sensors (NeuroTac-style domes imaged by an
+/// event camera): read and convert recordings, simulate trials, build representations, label,
+/// train, evaluate, reproduce the paper, and estimate online.
+#[derive(Debug, Parser)]
+#[command(name = "evtac", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Summarise an event recording (format, resolution, event and IMU counts, time span).
+    Info(commands::info::Args),
+    /// Convert an event recording to AEDAT4, CSV or NPY (chosen by the output's extension).
+    Convert(commands::convert::Args),
+    /// Simulate NeuroTac trials of one of the paper's protocols into a dataset folder.
+    Simulate(commands::simulate::Args),
+    /// Derive contact-angle labels from each trial's IMU stream.
+    Labels(commands::labels::Args),
+    /// Build static, dynamic or combined frames, potentials or pooled features at sample times.
+    Represent(commands::represent::Args),
+    /// Train the MLP regressor on a dataset's training split.
+    Train(commands::train::Args),
+    /// Evaluate a trained model on a dataset split (MAE overall, pitch, roll; per phase).
+    Evaluate(commands::evaluate::Args),
+    /// Predict (pitch, roll) from a features NPY with a trained model.
+    Predict(commands::predict::Args),
+    /// Grid-search a representation's hyperparameters on a dataset (Experiment 1's tuning).
+    Tune(commands::tune::Args),
+    /// Reproduce the paper end to end: simulate, label, tune, Experiments 1-3, latency, report.
+    Reproduce(commands::reproduce::Args),
+    /// Estimate contact angles online from a live or replayed event stream.
+    Online(commands::online::Args),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(args) => commands::info::run(args),
+        Command::Convert(args) => commands::convert::run(args),
+        Command::Simulate(args) => commands::simulate::run(args),
+        Command::Labels(args) => commands::labels::run(args),
+        Command::Represent(args) => commands::represent::run(args),
+        Command::Train(args) => commands::train::run(args),
+        Command::Evaluate(args) => commands::evaluate::run(args),
+        Command::Predict(args) => commands::predict::run(args),
+        Command::Tune(args) => commands::tune::run(args),
+        Command::Reproduce(args) => commands::reproduce::run(args),
+        Command::Online(args) => commands::online::run(args),
+    };
+    if let Err(err) = result {
+        eprintln!("error: {err:#}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,14 @@
+//! Integration tests of the `evtac` binary: one test binary, one module per subcommand.
+
+mod common;
+mod convert;
+mod evaluate;
+mod info;
+mod labels;
+mod online;
+mod predict;
+mod represent;
+mod reproduce;
+mod simulate;
+mod train;
+mod tune;

@@ -1,0 +1,1 @@
+//! Datasets, splits, sampling, feature caches, the paper's experiments and the report.

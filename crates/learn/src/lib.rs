@@ -1,0 +1,1 @@
+//! The MLP contact-angle regressor: model, training loop, checkpoints, prediction and metrics.

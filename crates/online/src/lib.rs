@@ -1,0 +1,1 @@
+//! Online contact-angle estimation from live or replayed event streams.

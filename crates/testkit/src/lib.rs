@@ -1,0 +1,86 @@
+//! Test support shared by evtac's crates: where the shared fixtures are, and how to reach the
+//! Python reference tools (dv-processing, numpy, safetensors) that interop tests compare against.
+//!
+//! Fixtures live in `../shared` beside the checkout, or wherever `$EVTAC_SHARED` points. The
+//! Python interpreter is `$EVTAC_PYTHON`, else `.venv/bin/python` at the workspace root (made by
+//! `bash .ci/python-env`). Under CI (`CI` set) a missing fixture or interpreter fails the test;
+//! elsewhere the test says it was skipped and passes, so `cargo test` works on a bare machine.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The workspace root (two levels above this crate).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .expect("testkit lives at crates/testkit")
+        .to_path_buf()
+}
+
+fn in_ci() -> bool {
+    std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false")
+}
+
+fn missing(what: &str) -> Option<PathBuf> {
+    if in_ci() {
+        panic!("{what} is required under CI but was not found");
+    }
+    eprintln!("skipped: {what} not found");
+    None
+}
+
+/// The shared folder (`$EVTAC_SHARED` or `../shared` beside the checkout), or `None` (test
+/// skipped) when absent outside CI.
+pub fn shared_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("EVTAC_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join("..").join("shared"));
+    if dir.join("fixtures").is_dir() {
+        Some(dir)
+    } else {
+        missing(&format!("the shared fixtures folder {}", dir.display()))
+    }
+}
+
+/// A file under `shared/fixtures/real/`, or `None` (test skipped) outside CI when absent.
+pub fn real_fixture(name: &str) -> Option<PathBuf> {
+    let path = shared_dir()?.join("fixtures").join("real").join(name);
+    if path.is_file() {
+        Some(path)
+    } else {
+        missing(&format!("the fixture {}", path.display()))
+    }
+}
+
+/// The Python interpreter with the reference tools installed, or `None` (test skipped) outside CI.
+pub fn python() -> Option<PathBuf> {
+    let candidate = std::env::var_os("EVTAC_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join(".venv").join("bin").join("python"));
+    if candidate.is_file() {
+        Some(candidate)
+    } else {
+        missing("the Python reference environment (run `bash .ci/python-env`)")
+    }
+}
+
+/// Runs `script` with the reference Python and `args`; returns its stdout. Panics with the
+/// script's stderr when it fails. `None` when Python is unavailable outside CI.
+pub fn run_python(script: &str, args: &[&str]) -> Option<String> {
+    let python = python()?;
+    let out = Command::new(&python)
+        .arg("-c")
+        .arg(script)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("could not start {}: {e}", python.display()));
+    if !out.status.success() {
+        panic!(
+            "python script failed ({}):\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+}
