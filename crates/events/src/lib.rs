@@ -11,6 +11,11 @@
 //! assert_eq!(roi.map(e).map(|e| (e.x, e.y)), Some((120, 120)));
 //! ```
 
+pub mod aedat;
+pub mod csv;
+pub mod evt;
+pub mod manifest;
+pub mod npy;
 mod types;
 
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

@@ -1,0 +1,2 @@
+//! Decoding throughput benchmark (being built).
+fn main() {}

@@ -1,0 +1,1 @@
+//! CSV event files (`t,x,y,p`) and IMU CSV files.

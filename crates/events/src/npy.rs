@@ -1,0 +1,1 @@
+//! NPY event files (structured `t,x,y,p`).
