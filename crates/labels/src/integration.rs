@@ -1,0 +1,151 @@
+//! Trapezoidal integration of a rate sampled at irregular times, readable at any instant.
+//!
+//! The rate is taken as piecewise linear between samples, so the running integral at a sample is
+//! exactly the cumulative trapezoid rule (`scipy.integrate.cumulative_trapezoid`) and between
+//! samples it is the exact integral of the linear interpolant. That lets integration start at the
+//! motion onset and stop at its end even when those fall between IMU samples.
+
+/// What makes a series unintegrable.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntegrationError {
+    /// Times and values differ in number.
+    #[error("{times} times but {values} values")]
+    LengthMismatch {
+        /// Number of times.
+        times: usize,
+        /// Number of values.
+        values: usize,
+    },
+    /// Nothing to integrate.
+    #[error("no samples to integrate")]
+    Empty,
+    /// Times must strictly increase.
+    #[error("time {t_us} us at index {index} is not after the previous time {previous_us} us")]
+    NotIncreasing {
+        /// Index of the offending time.
+        index: usize,
+        /// The offending time.
+        t_us: i64,
+        /// The time before it.
+        previous_us: i64,
+    },
+}
+
+/// The running integral `I(t) = integral from t[0] to t of y`, with `t` in microseconds and `y`
+/// per second (deg/s in, deg out).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CumulativeTrapezoid {
+    t_us: Vec<i64>,
+    y: Vec<f64>,
+    cumulative: Vec<f64>,
+}
+
+impl CumulativeTrapezoid {
+    /// Integrates `y` sampled at the strictly increasing times `t_us`.
+    pub fn new(t_us: &[i64], y: &[f64]) -> Result<Self, IntegrationError> {
+        if t_us.len() != y.len() {
+            return Err(IntegrationError::LengthMismatch {
+                times: t_us.len(),
+                values: y.len(),
+            });
+        }
+        if t_us.is_empty() {
+            return Err(IntegrationError::Empty);
+        }
+        let mut cumulative = Vec::with_capacity(y.len());
+        let mut sum = 0.0;
+        cumulative.push(sum);
+        for i in 1..t_us.len() {
+            if t_us[i] <= t_us[i - 1] {
+                return Err(IntegrationError::NotIncreasing {
+                    index: i,
+                    t_us: t_us[i],
+                    previous_us: t_us[i - 1],
+                });
+            }
+            let dt = (t_us[i] - t_us[i - 1]) as f64 * 1e-6;
+            sum += 0.5 * (y[i] + y[i - 1]) * dt;
+            cumulative.push(sum);
+        }
+        Ok(Self {
+            t_us: t_us.to_vec(),
+            y: y.to_vec(),
+            cumulative,
+        })
+    }
+
+    /// The running integral at each sample time (the cumulative trapezoid rule, starting at 0).
+    pub fn at_samples(&self) -> &[f64] {
+        &self.cumulative
+    }
+
+    /// The integral from the first sample to `t_us`. Outside the sampled span the rate counts as
+    /// zero, so the integral holds its end values there.
+    pub fn at(&self, t_us: i64) -> f64 {
+        let n = self.t_us.len();
+        if t_us <= self.t_us[0] {
+            return 0.0;
+        }
+        if t_us >= self.t_us[n - 1] {
+            return self.cumulative[n - 1];
+        }
+        // The sample at or before t_us: t[i] <= t_us < t[i + 1].
+        let i = self.t_us.partition_point(|&s| s <= t_us) - 1;
+        let span = (self.t_us[i + 1] - self.t_us[i]) as f64;
+        let frac = (t_us - self.t_us[i]) as f64 / span;
+        let y_t = self.y[i] + frac * (self.y[i + 1] - self.y[i]);
+        let dt = (t_us - self.t_us[i]) as f64 * 1e-6;
+        self.cumulative[i] + 0.5 * (self.y[i] + y_t) * dt
+    }
+
+    /// The integral from `from_us` to `to_us`.
+    pub fn between(&self, from_us: i64, to_us: i64) -> f64 {
+        self.at(to_us) - self.at(from_us)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_trapezoid_rule_and_linear_rates_exactly() {
+        // y = 2 + 3 t (t in s) integrates to 2 t + 1.5 t^2, which the rule gets exactly.
+        let t_us: Vec<i64> = vec![0, 1_000, 2_500, 3_000, 7_000];
+        let y: Vec<f64> = t_us.iter().map(|&t| 2.0 + 3.0 * t as f64 * 1e-6).collect();
+        let integral = CumulativeTrapezoid::new(&t_us, &y).unwrap();
+        let exact = |t_us: i64| {
+            let t = t_us as f64 * 1e-6;
+            2.0 * t + 1.5 * t * t
+        };
+        for (&t, &c) in t_us.iter().zip(integral.at_samples()) {
+            assert!((c - exact(t)).abs() < 1e-15);
+        }
+        for t in [1, 999, 1_000, 1_700, 4_321, 6_999] {
+            assert!((integral.at(t) - exact(t)).abs() < 1e-15, "t = {t}");
+        }
+        assert_eq!(integral.at(-5), 0.0);
+        assert_eq!(integral.at(9_000), integral.at(7_000));
+        assert!((integral.between(1_700, 4_321) - (exact(4_321) - exact(1_700))).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rejects_bad_series() {
+        assert_eq!(
+            CumulativeTrapezoid::new(&[0, 1], &[1.0]),
+            Err(IntegrationError::LengthMismatch {
+                times: 2,
+                values: 1
+            })
+        );
+        assert_eq!(
+            CumulativeTrapezoid::new(&[], &[]),
+            Err(IntegrationError::Empty)
+        );
+        assert!(matches!(
+            CumulativeTrapezoid::new(&[0, 5, 5], &[1.0; 3]),
+            Err(IntegrationError::NotIncreasing { index: 2, .. })
+        ));
+    }
+}

@@ -1,0 +1,5 @@
+//! Integration tests of `evtac-labels`: one test binary, one module per concern.
+
+mod degenerate;
+mod pipeline;
+mod synthetic;
