@@ -2,4 +2,5 @@
 
 mod degenerate;
 mod pipeline;
+mod simulated;
 mod synthetic;
