@@ -149,3 +149,36 @@ mod tests {
         ));
     }
 }
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Strictly increasing times with values beside them.
+    fn series() -> impl Strategy<Value = (Vec<i64>, Vec<f64>)> {
+        prop::collection::vec((1i64..5_000, -50.0f64..50.0), 2..60).prop_map(|steps| {
+            let mut t = -1_000;
+            steps
+                .into_iter()
+                .map(|(dt, y)| {
+                    t += dt;
+                    (t, y)
+                })
+                .unzip()
+        })
+    }
+
+    proptest! {
+        #[test]
+        fn integrals_add_up((t, y) in series(), a in -2_000i64..300_000, b in -2_000i64..300_000, c in -2_000i64..300_000) {
+            let integral = CumulativeTrapezoid::new(&t, &y).unwrap();
+            let whole = integral.between(a, c);
+            let parts = integral.between(a, b) + integral.between(b, c);
+            prop_assert!((whole - parts).abs() < 1e-9);
+            for (k, &tk) in t.iter().enumerate() {
+                prop_assert!((integral.at(tk) - integral.at_samples()[k]).abs() < 1e-12);
+            }
+        }
+    }
+}

@@ -308,3 +308,27 @@ mod tests {
         assert!(matches!(err, SeriesError::Empty { .. }));
     }
 }
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn csv_round_trips(rows in prop::collection::vec((1i64..1_000_000, any::<f64>(), any::<f64>(), any::<f64>()), 1..40)) {
+            let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+            let mut t = i64::MIN / 2;
+            let mut s = LabelSeries::default();
+            for (dt, a, b, c) in rows {
+                t += dt;
+                s.t_us.push(t);
+                s.theta_deg.push(finite(a));
+                s.pitch_deg.push(finite(b));
+                s.roll_deg.push(finite(c));
+            }
+            let back = LabelSeries::parse(&s.to_csv(), Path::new("p.csv")).unwrap();
+            prop_assert_eq!(back, s);
+        }
+    }
+}
