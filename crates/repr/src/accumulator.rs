@@ -1,0 +1,327 @@
+//! [`StaticAccumulator`]: dv-processing's `dv::Accumulator`, reproduced bit for bit.
+//!
+//! Per pixel a float32 potential `V` (starting at the neutral potential) and the int64 time `T`
+//! of its last event (starting at **0**, as in dv-processing). Per event, in float32:
+//!
+//! ```text
+//! dt = t - T;  T = t
+//! V  = (V - neutral) * expf(-(dt as f32) / tau_us) + neutral     (exponential)
+//! V  = V >= neutral ? max(V - dt * rate, neutral) : min(V + dt * rate, neutral)   (linear)
+//! V  = min(max(V + (ON or ignore ? eta : -eta), min), max)
+//! ```
+//!
+//! Decay is lazy (a pixel decays only when it receives an event) unless synchronous decay is on,
+//! in which case [`StaticAccumulator::synchronize`] (dv's `generateFrame`) decays every pixel to the
+//! latest event's time. `f32::exp` is glibc's `expf` on linux-gnu, which is what dv-processing
+//! calls: the differential tests in `tests/dv_differential.rs` check the potentials bit for bit.
+
+use crate::ReprError;
+use crate::config::{AccumulatorParams, Decay, StaticConfig};
+use evtac_events::{Event, Resolution};
+
+/// The exponential-decay (or linear / no-decay) potential accumulator of the static
+/// representation, bit-for-bit equal to dv-processing 2.0.4's `dv::Accumulator`.
+///
+/// ```
+/// use evtac_events::{Event, Resolution};
+/// use evtac_repr::{StaticAccumulator, StaticConfig};
+///
+/// let mut acc = StaticAccumulator::new(Resolution::new(4, 4), &StaticConfig::default()).unwrap();
+/// let e = |t| Event { t, x: 1, y: 2, polarity: true };
+/// acc.accumulate(&[e(1_000), e(1_000)]).unwrap();
+/// assert_eq!(acc.potential(1, 2), 0.3);
+/// assert_eq!(acc.frame_value(acc.potential(1, 2)), 76); // rint(0.3 * 255) = 76
+/// ```
+#[derive(Debug, Clone)]
+pub struct StaticAccumulator {
+    resolution: Resolution,
+    params: AccumulatorParams,
+    potentials: Vec<f32>,
+    times: Vec<i64>,
+    highest_time: i64,
+    map: FrameMap,
+}
+
+/// dv-processing's float-to-8-bit mapping of `generateFrame` (OpenCV `convertTo(CV_8U, s, b)`):
+/// `saturate(rint(v * s + b))` in float32 with ties to even, `s = 255 / (max - min)`,
+/// `b = -min * s`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameMap {
+    scale: f32,
+    offset: f32,
+}
+
+impl FrameMap {
+    /// The mapping for potentials clamped to `[min, max]`.
+    pub fn new(min: f32, max: f32) -> Self {
+        // As dv calls OpenCV: range in float32, scale and offset in double, then handed to the
+        // float32 conversion kernel.
+        let scale = 255.0 / f64::from(max - min);
+        let offset = -f64::from(min) * scale;
+        Self {
+            scale: scale as f32,
+            offset: offset as f32,
+        }
+    }
+
+    /// The 8-bit value of potential `v`.
+    #[inline]
+    pub fn value(&self, v: f32) -> u8 {
+        // `as u8` saturates (and maps NaN to 0, which a finite potential never is).
+        self.scaled(v).round_ties_even() as u8
+    }
+
+    /// `v * s + b` before rounding.
+    #[inline]
+    pub fn scaled(&self, v: f32) -> f32 {
+        v * self.scale + self.offset
+    }
+}
+
+impl StaticAccumulator {
+    /// An accumulator over a `resolution` frame with the accumulation settings of `config`
+    /// (its threshold fields are not used here).
+    pub fn new(resolution: Resolution, config: &StaticConfig) -> Result<Self, ReprError> {
+        config.validate()?;
+        Ok(Self::with_params(resolution, config.accumulator_params()))
+    }
+
+    /// An accumulator with raw (already converted) parameters.
+    pub fn with_params(resolution: Resolution, params: AccumulatorParams) -> Self {
+        let n = resolution.pixels();
+        Self {
+            resolution,
+            params,
+            potentials: vec![params.neutral_potential; n],
+            times: vec![0; n],
+            highest_time: 0,
+            map: FrameMap::new(params.min_potential, params.max_potential),
+        }
+    }
+
+    /// The frame size.
+    pub fn resolution(&self) -> Resolution {
+        self.resolution
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &AccumulatorParams {
+        &self.params
+    }
+
+    /// Adds events (coordinates inside the frame, times non-decreasing and not before earlier
+    /// events). On error nothing of the slice is applied.
+    pub fn accumulate(&mut self, events: &[Event]) -> Result<(), ReprError> {
+        let mut previous = self.highest_time;
+        for (index, e) in events.iter().enumerate() {
+            if !self.resolution.contains(e.x, e.y) {
+                return Err(ReprError::EventOutOfFrame {
+                    index,
+                    t: e.t,
+                    x: e.x,
+                    y: e.y,
+                    width: self.resolution.width,
+                    height: self.resolution.height,
+                });
+            }
+            if e.t < previous {
+                return Err(ReprError::EventOutOfOrder {
+                    index,
+                    t: e.t,
+                    previous,
+                });
+            }
+            previous = e.t;
+        }
+        let width = usize::from(self.resolution.width);
+        for e in events {
+            self.update(usize::from(e.y) * width + usize::from(e.x), e.t, e.polarity);
+        }
+        Ok(())
+    }
+
+    /// Applies one event at pixel index `pixel` (`y * width + x`) and returns the pixel's new
+    /// potential. The caller guarantees time order; `pixel` must be inside the frame.
+    ///
+    /// # Panics
+    /// When `pixel` is outside the frame.
+    #[inline]
+    pub fn update(&mut self, pixel: usize, t: i64, polarity: bool) -> f32 {
+        let p = &self.params;
+        let v = &mut self.potentials[pixel];
+        let last = &mut self.times[pixel];
+        *v = decay(p, *v, t - *last);
+        *last = t;
+        let c = if p.ignore_polarity || polarity {
+            p.eta
+        } else {
+            -p.eta
+        };
+        *v = (*v + c).max(p.min_potential).min(p.max_potential);
+        self.highest_time = t;
+        *v
+    }
+
+    /// Synchronous decay (what dv-processing's `generateFrame` does first): when synchronous
+    /// decay is on, decays every pixel to the latest event's time and moves its `T` there; a
+    /// no-op for lazy decay or [`Decay::None`].
+    pub fn synchronize(&mut self) {
+        if !self.params.synchronous_decay || self.params.decay == Decay::None {
+            return;
+        }
+        let t = self.highest_time;
+        let p = &self.params;
+        for (v, last) in self.potentials.iter_mut().zip(self.times.iter_mut()) {
+            *v = decay(p, *v, t - *last);
+            *last = t;
+        }
+    }
+
+    /// The time of the latest event applied (0 before any).
+    pub fn highest_time(&self) -> i64 {
+        self.highest_time
+    }
+
+    /// All potentials, row-major.
+    pub fn potentials(&self) -> &[f32] {
+        &self.potentials
+    }
+
+    /// The potential at `(x, y)`.
+    ///
+    /// # Panics
+    /// When `(x, y)` is outside the frame.
+    pub fn potential(&self, x: u16, y: u16) -> f32 {
+        self.potentials[usize::from(y) * usize::from(self.resolution.width) + usize::from(x)]
+    }
+
+    /// The 8-bit value `generateFrame` gives a potential (see [`FrameMap`]).
+    #[inline]
+    pub fn frame_value(&self, v: f32) -> u8 {
+        self.map.value(v)
+    }
+
+    /// The 8-bit mapping of this accumulator.
+    pub fn frame_map(&self) -> FrameMap {
+        self.map
+    }
+
+    /// Writes the 8-bit frame of the current potentials into `out` (row-major), without the
+    /// synchronous decay step (call [`Self::synchronize`] first to mirror `generateFrame`).
+    ///
+    /// # Panics
+    /// When `out` is not exactly one frame long.
+    pub fn frame_into(&self, out: &mut [u8]) {
+        assert_eq!(out.len(), self.potentials.len(), "frame buffer length");
+        for (o, &v) in out.iter_mut().zip(&self.potentials) {
+            *o = self.frame_value(v);
+        }
+    }
+
+    /// dv-processing's `generateFrame()`: synchronous decay (if on), then the 8-bit frame.
+    pub fn generate_frame(&mut self) -> Vec<u8> {
+        self.synchronize();
+        let mut out = vec![0; self.potentials.len()];
+        self.frame_into(&mut out);
+        out
+    }
+
+    /// Back to the initial state (neutral potentials, `T = 0`).
+    pub fn reset(&mut self) {
+        self.potentials.fill(self.params.neutral_potential);
+        self.times.fill(0);
+        self.highest_time = 0;
+    }
+}
+
+/// One decay step of `dt` microseconds, exactly as dv-processing computes it.
+#[inline]
+fn decay(p: &AccumulatorParams, v: f32, dt: i64) -> f32 {
+    match p.decay {
+        Decay::Exponential => {
+            let n = p.neutral_potential;
+            (v - n) * (-(dt as f32) / p.decay_param).exp() + n
+        }
+        Decay::Linear => {
+            let n = p.neutral_potential;
+            let step = dt as f32 * p.decay_param;
+            if v >= n {
+                (v - step).max(n)
+            } else {
+                (v + step).min(n)
+            }
+        }
+        Decay::None => v,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(t: i64, x: u16, y: u16, polarity: bool) -> Event {
+        Event { t, x, y, polarity }
+    }
+
+    #[test]
+    fn first_event_decays_from_time_zero_and_off_clamps_at_min() {
+        let mut acc =
+            StaticAccumulator::new(Resolution::new(2, 2), &StaticConfig::default()).unwrap();
+        acc.accumulate(&[ev(5, 0, 0, false), ev(7, 1, 0, true)])
+            .unwrap();
+        assert_eq!(acc.potential(0, 0), 0.0);
+        assert_eq!(acc.potential(1, 0), 0.15);
+        acc.accumulate(&[ev(500_007, 1, 0, true)]).unwrap();
+        let expected = 0.15f32 * (-0.5f32).exp() + 0.15;
+        assert_eq!(acc.potential(1, 0), expected);
+    }
+
+    #[test]
+    fn u8_rounding_is_ties_to_even() {
+        let acc = StaticAccumulator::new(Resolution::new(1, 1), &StaticConfig::default()).unwrap();
+        // 0.3 * 255 in f32 is 76.5 exactly after rounding of the product.
+        assert_eq!(acc.frame_value(0.3), 76);
+        assert_eq!(acc.frame_value(2.0), 255);
+        assert_eq!(acc.frame_value(-1.0), 0);
+        assert_eq!(acc.frame_map().scaled(0.3), 76.5);
+    }
+
+    #[test]
+    fn bad_events_are_rejected_whole() {
+        let mut acc =
+            StaticAccumulator::new(Resolution::new(2, 2), &StaticConfig::default()).unwrap();
+        let err = acc
+            .accumulate(&[ev(1, 0, 0, true), ev(2, 2, 0, true)])
+            .unwrap_err();
+        assert!(matches!(
+            err,
+            ReprError::EventOutOfFrame { index: 1, x: 2, .. }
+        ));
+        assert_eq!(acc.potential(0, 0), 0.0);
+        let err = acc
+            .accumulate(&[ev(3, 0, 0, true), ev(2, 1, 0, true)])
+            .unwrap_err();
+        assert!(matches!(
+            err,
+            ReprError::EventOutOfOrder {
+                index: 1,
+                t: 2,
+                previous: 3
+            }
+        ));
+    }
+
+    #[test]
+    fn synchronous_decay_moves_every_pixel() {
+        let cfg = StaticConfig {
+            synchronous_decay: true,
+            ..StaticConfig::default()
+        };
+        let mut acc = StaticAccumulator::new(Resolution::new(2, 1), &cfg).unwrap();
+        acc.accumulate(&[ev(0, 0, 0, true), ev(1_000_000, 1, 0, true)])
+            .unwrap();
+        assert_eq!(acc.potential(0, 0), 0.15);
+        acc.synchronize();
+        assert_eq!(acc.potential(0, 0), 0.15 * (-1.0f32).exp());
+    }
+}

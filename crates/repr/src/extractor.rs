@@ -1,0 +1,621 @@
+//! [`FeatureExtractor`]: the streaming engine that turns events into binary frames and pooled
+//! features at sample times, for several representation configs in one pass.
+//!
+//! # How it works
+//! Events are pushed in time order (any chunking) and wait in a queue; `advance_to(t_k)` applies
+//! those with `t <= t_k`. Each applied event updates, once each:
+//! - every distinct accumulator (configs with equal accumulation settings share one), whose new
+//!   potential is thresholded by every static *plane* on it (one per distinct threshold rule and
+//!   mask);
+//! - every distinct sliding window (one per window length), whose new count is thresholded by
+//!   every dynamic plane on it (one per count threshold).
+//!
+//! Then each window drops the events that left `(t_k - window, t_k]`. A plane pixel that flips
+//! updates the outputs built on it (static, dynamic, or the OR of a static and a dynamic plane)
+//! and their [`Pool8`] features. A sample therefore costs the events since the previous sample
+//! (entering and leaving), never a full frame, and allocates nothing once buffers have grown.
+//! Synchronous-decay accumulators are the exception: dv-processing decays every pixel when a
+//! frame is read, so their planes are recomputed in full (`O(width x height)`) per sample.
+//!
+//! # Edge cases, documented
+//! - Before the first event, or for an empty stream, every output is the initial state:
+//!   potentials at the neutral potential, counts 0, thresholded as usual (all zero with the
+//!   defaults). Sample times before the first event are therefore valid.
+//! - Sample times must be non-decreasing ([`ReprError::SampleTimeBackwards`]); equal times are
+//!   allowed and give the same output.
+//! - Events must be inside the frame ([`ReprError::EventOutOfFrame`]) and in non-decreasing time
+//!   order across all pushes ([`ReprError::EventOutOfOrder`]); a rejected chunk is not applied
+//!   at all.
+//! - An event pushed after a sample time it precedes (`t <= t_k` already sampled) cannot change
+//!   that sample: it is applied at the next `advance_to`. Push every event up to `t_k` before
+//!   calling `advance_to(t_k)` for exact results; output is then the same for any chunking.
+
+use crate::ReprError;
+use crate::accumulator::StaticAccumulator;
+use crate::combine::StaticThreshold;
+use crate::config::{AccumulatorParams, ReprConfig};
+use crate::mask::Mask;
+use crate::pool::Pool8;
+use crate::window::SlidingWindow;
+use evtac_events::{Event, Resolution, Roi};
+use std::collections::VecDeque;
+
+struct AccSlot {
+    params: AccumulatorParams,
+    acc: StaticAccumulator,
+    planes: Vec<usize>,
+}
+
+struct WindowSlot {
+    window: SlidingWindow,
+    planes: Vec<usize>,
+}
+
+struct StaticPlane {
+    acc: usize,
+    rule: StaticThreshold,
+    mask: Option<usize>,
+    bits: Vec<u8>,
+    outputs: Vec<usize>,
+}
+
+struct DynamicPlane {
+    window: usize,
+    count_threshold: u32,
+    bits: Vec<u8>,
+    outputs: Vec<usize>,
+}
+
+#[derive(Clone, Copy)]
+enum Kind {
+    Static(usize),
+    Dynamic(usize),
+    Combined(usize, usize),
+}
+
+struct Output {
+    kind: Kind,
+    pool: Pool8,
+}
+
+/// Streaming representations at sample times, for one or more [`ReprConfig`]s at once.
+///
+/// ```
+/// use evtac_events::{Event, Resolution};
+/// use evtac_repr::{FeatureExtractor, ReprConfig};
+///
+/// let mut fx = FeatureExtractor::new(&[ReprConfig::default()], Resolution::new(240, 240), None)?;
+/// let events: Vec<Event> = (0..100)
+///     .map(|i| Event { t: i * 10, x: 5, y: 7, polarity: true })
+///     .collect();
+/// fx.push(&events)?;
+/// fx.advance_to(500)?; // applies the events with t <= 500
+/// assert_eq!(fx.features(0).len(), 900);
+/// assert_eq!(fx.frame(0)[7 * 240 + 5], 1);
+/// assert_eq!(fx.features(0)[0], 1.0 / 64.0);
+/// # Ok::<(), evtac_repr::ReprError>(())
+/// ```
+pub struct FeatureExtractor {
+    configs: Vec<ReprConfig>,
+    resolution: Resolution,
+    accs: Vec<AccSlot>,
+    windows: Vec<WindowSlot>,
+    splanes: Vec<StaticPlane>,
+    dplanes: Vec<DynamicPlane>,
+    outputs: Vec<Output>,
+    masks: Vec<Mask>,
+    pending: VecDeque<Event>,
+    last_pushed: Option<i64>,
+    sample_time: Option<i64>,
+}
+
+impl std::fmt::Debug for FeatureExtractor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FeatureExtractor")
+            .field("configs", &self.configs)
+            .field("resolution", &self.resolution)
+            .field("accumulators", &self.accs.len())
+            .field("windows", &self.windows.len())
+            .field("pending", &self.pending.len())
+            .field("sample_time", &self.sample_time)
+            .finish()
+    }
+}
+
+fn index_or_push<T>(
+    items: &mut Vec<T>,
+    same: impl Fn(&T) -> bool,
+    make: impl FnOnce() -> T,
+) -> usize {
+    if let Some(i) = items.iter().position(same) {
+        i
+    } else {
+        items.push(make());
+        items.len() - 1
+    }
+}
+
+impl FeatureExtractor {
+    /// An extractor for `configs` over a `frame`-sized crop (sides multiples of 8), with an
+    /// optional no-contact `mask` applied to the static part of every config.
+    pub fn new(
+        configs: &[ReprConfig],
+        frame: Resolution,
+        mask: Option<&Mask>,
+    ) -> Result<Self, ReprError> {
+        let masks = vec![mask; configs.len()];
+        Self::new_with_masks(configs, frame, &masks)
+    }
+
+    /// As [`Self::new`] with one mask per config (e.g. a mask built with each config's own
+    /// accumulator settings, as the paper's rule implies for a tau grid).
+    pub fn new_with_masks(
+        configs: &[ReprConfig],
+        frame: Resolution,
+        masks: &[Option<&Mask>],
+    ) -> Result<Self, ReprError> {
+        if configs.is_empty() {
+            return Err(ReprError::NoConfig);
+        }
+        if masks.len() != configs.len() {
+            return Err(ReprError::MaskCount {
+                masks: masks.len(),
+                configs: configs.len(),
+            });
+        }
+        // Validates the frame size for every output.
+        Pool8::new(frame)?;
+        let mut fx = Self {
+            configs: configs.to_vec(),
+            resolution: frame,
+            accs: Vec::new(),
+            windows: Vec::new(),
+            splanes: Vec::new(),
+            dplanes: Vec::new(),
+            outputs: Vec::new(),
+            masks: Vec::new(),
+            pending: VecDeque::new(),
+            last_pushed: None,
+            sample_time: None,
+        };
+        let n = frame.pixels();
+        for (i, (config, mask)) in configs.iter().zip(masks).enumerate() {
+            config.validate()?;
+            let mask = match mask {
+                Some(m) => {
+                    if m.resolution() != frame {
+                        return Err(ReprError::MaskSize {
+                            mask_width: m.resolution().width,
+                            mask_height: m.resolution().height,
+                            width: frame.width,
+                            height: frame.height,
+                        });
+                    }
+                    Some(index_or_push(&mut fx.masks, |x| x == *m, || (*m).clone()))
+                }
+                None => None,
+            };
+            let splane = config.static_part().map(|s| {
+                let params = s.accumulator_params();
+                let acc = index_or_push(
+                    &mut fx.accs,
+                    |a| a.params == params,
+                    || AccSlot {
+                        params,
+                        acc: StaticAccumulator::with_params(frame, params),
+                        planes: Vec::new(),
+                    },
+                );
+                let rule = StaticThreshold::new(s);
+                let plane = index_or_push(
+                    &mut fx.splanes,
+                    |p| p.acc == acc && p.rule == rule && p.mask == mask,
+                    || StaticPlane {
+                        acc,
+                        rule,
+                        mask,
+                        bits: vec![0; n],
+                        outputs: Vec::new(),
+                    },
+                );
+                if !fx.accs[acc].planes.contains(&plane) {
+                    fx.accs[acc].planes.push(plane);
+                }
+                fx.splanes[plane].outputs.push(i);
+                plane
+            });
+            let dplane = config.dynamic_part().map(|d| {
+                let window_us = d.window_us();
+                let window = index_or_push(
+                    &mut fx.windows,
+                    |w| w.window.window_us() == window_us,
+                    || WindowSlot {
+                        window: SlidingWindow::new(frame, window_us),
+                        planes: Vec::new(),
+                    },
+                );
+                let plane = index_or_push(
+                    &mut fx.dplanes,
+                    |p| p.window == window && p.count_threshold == d.count_threshold,
+                    || DynamicPlane {
+                        window,
+                        count_threshold: d.count_threshold,
+                        bits: vec![0; n],
+                        outputs: Vec::new(),
+                    },
+                );
+                if !fx.windows[window].planes.contains(&plane) {
+                    fx.windows[window].planes.push(plane);
+                }
+                fx.dplanes[plane].outputs.push(i);
+                plane
+            });
+            let kind = match (splane, dplane) {
+                (Some(s), Some(d)) => Kind::Combined(s, d),
+                (Some(s), None) => Kind::Static(s),
+                (None, Some(d)) => Kind::Dynamic(d),
+                (None, None) => unreachable!("a ReprConfig has a static or a dynamic part"),
+            };
+            fx.outputs.push(Output {
+                kind,
+                pool: Pool8::new(frame)?,
+            });
+        }
+        fx.refresh_static_planes(false);
+        Ok(fx)
+    }
+
+    /// The configs, in the order outputs are indexed.
+    pub fn configs(&self) -> &[ReprConfig] {
+        &self.configs
+    }
+
+    /// Number of configs (outputs).
+    pub fn len(&self) -> usize {
+        self.configs.len()
+    }
+
+    /// Always `false`: an extractor has at least one config.
+    pub fn is_empty(&self) -> bool {
+        self.configs.is_empty()
+    }
+
+    /// The frame size.
+    pub fn resolution(&self) -> Resolution {
+        self.resolution
+    }
+
+    /// Number of features per output: `(width / 8) * (height / 8)` (900 for 240x240).
+    pub fn feature_len(&self) -> usize {
+        self.outputs[0].pool.features().len()
+    }
+
+    /// The latest sample time given to [`Self::advance_to`], if any.
+    pub fn sample_time(&self) -> Option<i64> {
+        self.sample_time
+    }
+
+    /// Number of pushed events not yet applied (later than the latest sample time).
+    pub fn pending(&self) -> usize {
+        self.pending.len()
+    }
+
+    /// Queues events in crop coordinates, in time order (also after earlier pushes). The whole
+    /// chunk is checked first: on error nothing is queued.
+    pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
+        let mut previous = self.last_pushed;
+        for (index, e) in events.iter().enumerate() {
+            if !self.resolution.contains(e.x, e.y) {
+                return Err(ReprError::EventOutOfFrame {
+                    index,
+                    t: e.t,
+                    x: e.x,
+                    y: e.y,
+                    width: self.resolution.width,
+                    height: self.resolution.height,
+                });
+            }
+            if let Some(p) = previous
+                && e.t < p
+            {
+                return Err(ReprError::EventOutOfOrder {
+                    index,
+                    t: e.t,
+                    previous: p,
+                });
+            }
+            previous = Some(e.t);
+        }
+        self.last_pushed = previous;
+        self.pending.extend(events);
+        Ok(())
+    }
+
+    /// Queues events in full-sensor coordinates, cropping them with `roi` on the way (events
+    /// outside it are dropped). `roi.size` must be the frame size.
+    pub fn push_with_roi(&mut self, events: &[Event], roi: &Roi) -> Result<(), ReprError> {
+        if roi.size != self.resolution {
+            return Err(ReprError::MaskSize {
+                mask_width: roi.size.width,
+                mask_height: roi.size.height,
+                width: self.resolution.width,
+                height: self.resolution.height,
+            });
+        }
+        let mut previous = self.last_pushed;
+        for (index, e) in events.iter().enumerate() {
+            if let Some(p) = previous
+                && e.t < p
+            {
+                return Err(ReprError::EventOutOfOrder {
+                    index,
+                    t: e.t,
+                    previous: p,
+                });
+            }
+            previous = Some(e.t);
+        }
+        self.last_pushed = previous;
+        self.pending
+            .extend(events.iter().filter_map(|&e| roi.map(e)));
+        Ok(())
+    }
+
+    /// Applies every queued event with `t <= t_k`, moves the windows to end at `t_k`, and
+    /// updates every output. `t_k` must not be before the previous sample time.
+    pub fn advance_to(&mut self, t_k: i64) -> Result<(), ReprError> {
+        if let Some(previous) = self.sample_time
+            && t_k < previous
+        {
+            return Err(ReprError::SampleTimeBackwards { t: t_k, previous });
+        }
+        let n = self.pending.partition_point(|e| e.t <= t_k);
+        let width = usize::from(self.resolution.width);
+        let Self {
+            accs,
+            windows,
+            splanes,
+            dplanes,
+            outputs,
+            masks,
+            pending,
+            ..
+        } = self;
+        for e in pending.range(..n) {
+            let p = usize::from(e.y) * width + usize::from(e.x);
+            for slot in accs.iter_mut() {
+                let v = slot.acc.update(p, e.t, e.polarity);
+                if slot.params.synchronous_decay {
+                    // Recomputed in full after the synchronous decay below.
+                    continue;
+                }
+                for &sp in &slot.planes {
+                    let plane = &mut splanes[sp];
+                    let on =
+                        plane.rule.is_set(v) && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
+                    if (plane.bits[p] != 0) != on {
+                        plane.bits[p] = u8::from(on);
+                        propagate(outputs, &splanes[sp].outputs, splanes, dplanes, p);
+                    }
+                }
+            }
+            for slot in windows.iter_mut() {
+                let count = slot.window.add(e.t, p as u32);
+                for &dp in &slot.planes {
+                    let plane = &mut dplanes[dp];
+                    let on = count > plane.count_threshold;
+                    if (plane.bits[p] != 0) != on {
+                        plane.bits[p] = u8::from(on);
+                        propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
+                    }
+                }
+            }
+        }
+        pending.drain(..n);
+        for slot in windows.iter_mut() {
+            let planes = &slot.planes;
+            slot.window.expire_through(t_k, |pixel, count| {
+                let p = pixel as usize;
+                for &dp in planes {
+                    let plane = &mut dplanes[dp];
+                    let on = count > plane.count_threshold;
+                    if (plane.bits[p] != 0) != on {
+                        plane.bits[p] = u8::from(on);
+                        propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
+                    }
+                }
+            });
+        }
+        self.refresh_static_planes(true);
+        self.sample_time = Some(t_k);
+        Ok(())
+    }
+
+    /// Recomputes static planes in full from their accumulators: all of them (`sync_only`
+    /// false, at construction and reset) or those on synchronous-decay accumulators, after
+    /// their synchronous decay.
+    fn refresh_static_planes(&mut self, sync_only: bool) {
+        let Self {
+            accs,
+            splanes,
+            dplanes,
+            outputs,
+            masks,
+            ..
+        } = self;
+        for slot in accs.iter_mut() {
+            if sync_only && !slot.params.synchronous_decay {
+                continue;
+            }
+            slot.acc.synchronize();
+            for &sp in &slot.planes {
+                for (p, &v) in slot.acc.potentials().iter().enumerate() {
+                    let plane = &mut splanes[sp];
+                    let on =
+                        plane.rule.is_set(v) && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
+                    if (plane.bits[p] != 0) != on {
+                        plane.bits[p] = u8::from(on);
+                        propagate(outputs, &splanes[sp].outputs, splanes, dplanes, p);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The pooled features of output `i` at the latest sample time: `(width / 8) * (height / 8)`
+    /// values, row-major over 8x8 cells, each the fraction of set pixels in its cell.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn features(&self, i: usize) -> &[f32] {
+        self.outputs[i].pool.features()
+    }
+
+    /// The binary frame (0/1 per pixel, row-major) of output `i` at the latest sample time.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn frame(&self, i: usize) -> &[u8] {
+        self.outputs[i].pool.frame()
+    }
+
+    /// The potential surface behind output `i` (static and combined configs), row-major.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn potentials(&self, i: usize) -> Option<&[f32]> {
+        match self.outputs[i].kind {
+            Kind::Static(s) | Kind::Combined(s, _) => {
+                Some(self.accs[self.splanes[s].acc].acc.potentials())
+            }
+            Kind::Dynamic(_) => None,
+        }
+    }
+
+    /// The window counts behind output `i` (dynamic and combined configs), row-major.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn counts(&self, i: usize) -> Option<&[u32]> {
+        match self.outputs[i].kind {
+            Kind::Dynamic(d) | Kind::Combined(_, d) => {
+                Some(self.windows[self.dplanes[d].window].window.counts())
+            }
+            Kind::Static(_) => None,
+        }
+    }
+
+    /// Back to the initial state (as just constructed), keeping every buffer's capacity: for
+    /// reusing one extractor across trials.
+    pub fn reset(&mut self) {
+        for slot in &mut self.accs {
+            slot.acc.reset();
+        }
+        for slot in &mut self.windows {
+            slot.window.clear();
+        }
+        for plane in &mut self.splanes {
+            plane.bits.fill(0);
+        }
+        for plane in &mut self.dplanes {
+            plane.bits.fill(0);
+        }
+        for out in &mut self.outputs {
+            out.pool.clear();
+        }
+        self.pending.clear();
+        self.last_pushed = None;
+        self.sample_time = None;
+        self.refresh_static_planes(false);
+    }
+
+    /// Feeds `events` (crop coordinates, time order) and visits the extractor at each of the
+    /// non-decreasing `samples`, after `advance_to(t_k)`: `visit(k, &self)`. Events are pushed
+    /// per sample, so nothing is copied in bulk.
+    pub fn run(
+        &mut self,
+        events: &[Event],
+        samples: &[i64],
+        mut visit: impl FnMut(usize, &Self),
+    ) -> Result<(), ReprError> {
+        let mut cursor = 0;
+        for (k, &t_k) in samples.iter().enumerate() {
+            let end = cursor + events[cursor..].partition_point(|e| e.t <= t_k);
+            self.push(&events[cursor..end])
+                .map_err(|err| shift_index(err, cursor))?;
+            cursor = end;
+            self.advance_to(t_k)?;
+            visit(k, self);
+        }
+        // Out-of-order events after the last sample are still an error.
+        self.push(&events[cursor..])
+            .map_err(|err| shift_index(err, cursor))
+    }
+}
+
+/// Features of every config at every sample time: one `samples.len() x feature_len` row-major
+/// buffer per config. A convenience over [`FeatureExtractor::run`].
+pub fn extract_features(
+    configs: &[ReprConfig],
+    frame: Resolution,
+    mask: Option<&Mask>,
+    events: &[Event],
+    samples: &[i64],
+) -> Result<Vec<Vec<f32>>, ReprError> {
+    let mut fx = FeatureExtractor::new(configs, frame, mask)?;
+    let mut out: Vec<Vec<f32>> = (0..configs.len())
+        .map(|_| Vec::with_capacity(samples.len() * fx.feature_len()))
+        .collect();
+    fx.run(events, samples, |_, fx| {
+        for (i, o) in out.iter_mut().enumerate() {
+            o.extend_from_slice(fx.features(i));
+        }
+    })?;
+    Ok(out)
+}
+
+fn shift_index(err: ReprError, offset: usize) -> ReprError {
+    match err {
+        ReprError::EventOutOfFrame {
+            index,
+            t,
+            x,
+            y,
+            width,
+            height,
+        } => ReprError::EventOutOfFrame {
+            index: index + offset,
+            t,
+            x,
+            y,
+            width,
+            height,
+        },
+        ReprError::EventOutOfOrder { index, t, previous } => ReprError::EventOutOfOrder {
+            index: index + offset,
+            t,
+            previous,
+        },
+        other => other,
+    }
+}
+
+/// Recomputes pixel `p` of every output in `targets` from its planes after a plane flip.
+#[inline]
+fn propagate(
+    outputs: &mut [Output],
+    targets: &[usize],
+    splanes: &[StaticPlane],
+    dplanes: &[DynamicPlane],
+    p: usize,
+) {
+    for &o in targets {
+        let out = &mut outputs[o];
+        let on = match out.kind {
+            Kind::Static(s) => splanes[s].bits[p] != 0,
+            Kind::Dynamic(d) => dplanes[d].bits[p] != 0,
+            Kind::Combined(s, d) => splanes[s].bits[p] != 0 || dplanes[d].bits[p] != 0,
+        };
+        out.pool.set(p, on);
+    }
+}

@@ -1,0 +1,115 @@
+//! [`SlidingWindow`]: per-pixel event counts over `(t_k - window, t_k]`, kept incrementally.
+//!
+//! Every event enters once (count + 1) and expires once (count - 1) when the window's start passes
+//! it, from a FIFO of `(t, pixel)`: the window is never recounted, so a sample costs only the
+//! events that entered or left since the previous one.
+
+use evtac_events::Resolution;
+use std::collections::VecDeque;
+
+/// Sliding-window event counter over one frame (both polarities).
+///
+/// ```
+/// use evtac_events::Resolution;
+/// use evtac_repr::SlidingWindow;
+///
+/// let mut w = SlidingWindow::new(Resolution::new(2, 2), 10);
+/// w.add(0, 3);
+/// w.add(5, 3);
+/// w.expire_through(10, |_, _| {}); // window (0, 10]: the event at t = 0 leaves
+/// assert_eq!(w.counts()[3], 1);
+/// ```
+#[derive(Debug, Clone)]
+pub struct SlidingWindow {
+    window_us: i64,
+    counts: Vec<u32>,
+    queue: VecDeque<(i64, u32)>,
+}
+
+impl SlidingWindow {
+    /// An empty window of `window_us` microseconds over a `resolution` frame.
+    pub fn new(resolution: Resolution, window_us: i64) -> Self {
+        Self {
+            window_us,
+            counts: vec![0; resolution.pixels()],
+            queue: VecDeque::new(),
+        }
+    }
+
+    /// The window length in microseconds.
+    pub fn window_us(&self) -> i64 {
+        self.window_us
+    }
+
+    /// Adds an event at time `t` on pixel `pixel` (`y * width + x`); returns the pixel's new
+    /// count. Times must be non-decreasing (the caller checks).
+    ///
+    /// # Panics
+    /// When `pixel` is outside the frame.
+    #[inline]
+    pub fn add(&mut self, t: i64, pixel: u32) -> u32 {
+        let c = &mut self.counts[pixel as usize];
+        *c += 1;
+        self.queue.push_back((t, pixel));
+        *c
+    }
+
+    /// Moves the window's end to `t_k`: removes every event with `t <= t_k - window`, calling
+    /// `on_expire(pixel, new_count)` for each.
+    #[inline]
+    pub fn expire_through(&mut self, t_k: i64, mut on_expire: impl FnMut(u32, u32)) {
+        let start = t_k.saturating_sub(self.window_us);
+        while let Some(&(t, pixel)) = self.queue.front() {
+            if t > start {
+                break;
+            }
+            self.queue.pop_front();
+            let c = &mut self.counts[pixel as usize];
+            *c -= 1;
+            on_expire(pixel, *c);
+        }
+    }
+
+    /// The per-pixel counts, row-major.
+    pub fn counts(&self) -> &[u32] {
+        &self.counts
+    }
+
+    /// Number of events in the window.
+    pub fn len(&self) -> usize {
+        self.queue.len()
+    }
+
+    /// Whether the window holds no event.
+    pub fn is_empty(&self) -> bool {
+        self.queue.is_empty()
+    }
+
+    /// Empties the window.
+    pub fn clear(&mut self) {
+        self.counts.fill(0);
+        self.queue.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn window_is_half_open_on_the_left() {
+        let mut w = SlidingWindow::new(Resolution::new(1, 1), 100);
+        w.add(0, 0);
+        w.add(100, 0);
+        w.expire_through(99, |_, _| {
+            panic!("nothing leaves before t_k - window reaches 0")
+        });
+        assert_eq!(w.counts()[0], 2);
+        let mut left = Vec::new();
+        w.expire_through(100, |p, c| left.push((p, c)));
+        assert_eq!(left, [(0, 1)]);
+        w.expire_through(200, |_, _| {});
+        assert!(w.is_empty());
+        assert_eq!(w.counts()[0], 0);
+    }
+}
