@@ -12,6 +12,7 @@
 //! ```
 
 pub mod aedat;
+pub mod check;
 pub mod csv;
 pub mod evt;
 pub mod manifest;

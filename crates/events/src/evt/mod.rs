@@ -1,1 +1,362 @@
 //! Prophesee EVT 2.0 and EVT 3.0 raw files (with their `%` text header).
+//!
+//! [`EvtReader`] streams any [`Read`]: it parses the header, then decodes fixed-size reads into
+//! reused event and trigger buffers, carrying a word that straddles two reads over to the next.
+//! Timestamps and vector decoding follow Prophesee's own decoders (openeb), without time shifting,
+//! so the times are the camera's. Events outside the sensor and timestamps that go backwards
+//! are errors, as is a file that ends inside a word.
+//!
+//! ```no_run
+//! use evtac_events::evt::EvtReader;
+//!
+//! let mut reader = EvtReader::from_path("recording.raw")?;
+//! let mut count = 0;
+//! while let Some(chunk) = reader.next_chunk()? {
+//!     count += chunk.events.len();
+//! }
+//! println!("{count} events, {:?}", reader.header().resolution);
+//! # Ok::<(), evtac_events::evt::EvtError>(())
+//! ```
+
+mod evt2;
+mod evt3;
+mod header;
+
+use std::fs::File;
+use std::io::{ErrorKind, Read};
+use std::path::Path;
+
+pub use header::{EvtVersion, Header, HeaderError};
+
+use crate::check::{CheckError, EventCheck};
+use crate::{Event, Resolution, Trigger};
+
+/// Bytes asked of the source per read.
+const READ_SIZE: usize = 1 << 16;
+/// A header longer than this is not an EVT header.
+const MAX_HEADER: usize = 1 << 20;
+
+/// What can go wrong reading an EVT file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EvtError {
+    /// Reading the source failed.
+    #[error("read failed: {0}")]
+    Io(#[from] std::io::Error),
+    /// The source holds no bytes at all.
+    #[error("the file is empty")]
+    Empty,
+    /// The source does not start with a `%` header line.
+    #[error("no `%` text header at the start: not a Prophesee EVT file")]
+    NoHeader,
+    /// The header ended without a line break, or never ended.
+    #[error("the text header is cut off at byte {offset}")]
+    TruncatedHeader {
+        /// Offset where the header stops.
+        offset: u64,
+    },
+    /// A header field is missing or malformed.
+    #[error("bad header: {0}")]
+    Header(#[from] HeaderError),
+    /// The data ends inside a word.
+    #[error(
+        "truncated: the file ends {got} byte(s) into a {word}-byte word at byte offset {offset}"
+    )]
+    Truncated {
+        /// Offset of the incomplete word.
+        offset: u64,
+        /// Bytes of it present.
+        got: usize,
+        /// Size of a word.
+        word: usize,
+    },
+    /// A decoded event is invalid (outside the sensor, or earlier than its predecessor).
+    #[error("{source} (in the data chunk ending at byte offset {offset})")]
+    Event {
+        /// What is wrong with it.
+        source: CheckError,
+        /// Offset of the end of the data decoded when the problem was found.
+        offset: u64,
+    },
+}
+
+/// One decoded chunk: views into the reader's reused buffers.
+#[derive(Debug, Clone, Copy)]
+pub struct EvtChunk<'a> {
+    /// CD events, in file order.
+    pub events: &'a [Event],
+    /// External triggers (rising edge = AEDAT4 code 1, falling = 2).
+    pub triggers: &'a [Trigger],
+}
+
+#[derive(Debug, Clone)]
+enum Decoder {
+    Evt2(evt2::Evt2Decoder),
+    Evt3(evt3::Evt3Decoder),
+}
+
+/// A streaming EVT 2.0 / 3.0 reader over any [`Read`].
+#[derive(Debug)]
+pub struct EvtReader<R> {
+    source: R,
+    header: Header,
+    decoder: Decoder,
+    buf: Vec<u8>,
+    /// Unconsumed bytes are `buf[start..end]`.
+    start: usize,
+    end: usize,
+    /// File offset of `buf[start]`.
+    offset: u64,
+    events: Vec<Event>,
+    triggers: Vec<Trigger>,
+    check: EventCheck,
+}
+
+impl EvtReader<File> {
+    /// Opens the file at `path`.
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Self, EvtError> {
+        Self::new(File::open(path)?)
+    }
+}
+
+impl<'a> EvtReader<&'a [u8]> {
+    /// Reads from bytes in memory.
+    pub fn from_slice(bytes: &'a [u8]) -> Result<Self, EvtError> {
+        Self::new(bytes)
+    }
+}
+
+/// Reads into `buf`, retrying when interrupted; `Ok(0)` only at the end of the source.
+fn read_some(source: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    loop {
+        match source.read(buf) {
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            other => return other,
+        }
+    }
+}
+
+impl<R: Read> EvtReader<R> {
+    /// Reads and parses the header from `source`, leaving it at the first data byte.
+    pub fn new(mut source: R) -> Result<Self, EvtError> {
+        let mut buf = vec![0u8; READ_SIZE];
+        let mut end = 0;
+        let mut pos = 0;
+        let mut fields = Vec::new();
+        loop {
+            // Make sure at least one byte past `pos` is buffered to see whether a line follows.
+            if pos == end {
+                if end == buf.len() {
+                    buf.resize(buf.len() * 2, 0);
+                }
+                let n = read_some(&mut source, &mut buf[end..])?;
+                if n == 0 {
+                    if end == 0 {
+                        return Err(EvtError::Empty);
+                    }
+                    break;
+                }
+                end += n;
+            }
+            if buf[pos] != b'%' {
+                break;
+            }
+            let Some(newline) = buf[pos..end].iter().position(|&b| b == b'\n') else {
+                // The line continues past what is buffered: read more (bounded).
+                if end >= MAX_HEADER {
+                    return Err(EvtError::TruncatedHeader { offset: end as u64 });
+                }
+                if end == buf.len() {
+                    buf.resize(buf.len() * 2, 0);
+                }
+                let n = read_some(&mut source, &mut buf[end..])?;
+                if n == 0 {
+                    return Err(EvtError::TruncatedHeader { offset: end as u64 });
+                }
+                end += n;
+                continue;
+            };
+            let line = &buf[pos + 1..pos + newline];
+            let line = line.strip_suffix(b"\r").unwrap_or(line);
+            let (key, value) = header::split_line(line);
+            pos += newline + 1;
+            if key == "end" {
+                break;
+            }
+            fields.push((key, value));
+        }
+        if pos == 0 {
+            return Err(EvtError::NoHeader);
+        }
+        let header = header::parse_fields(fields, pos as u64)?;
+        let decoder = match header.version {
+            EvtVersion::Evt2 => Decoder::Evt2(evt2::Evt2Decoder::default()),
+            EvtVersion::Evt3 => Decoder::Evt3(evt3::Evt3Decoder::default()),
+        };
+        let check = EventCheck::new(header.resolution);
+        Ok(Self {
+            source,
+            decoder,
+            buf,
+            start: pos,
+            end,
+            offset: header.len,
+            events: Vec::new(),
+            triggers: Vec::new(),
+            check,
+            header,
+        })
+    }
+
+    /// The parsed header.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// The sensor size the events are checked against (from the header, or set by
+    /// [`set_resolution`](Self::set_resolution)).
+    pub fn resolution(&self) -> Option<Resolution> {
+        self.check.resolution()
+    }
+
+    /// Declares the sensor size for a file whose header does not state it (or overrides it):
+    /// events from now on are checked against it.
+    pub fn set_resolution(&mut self, resolution: Resolution) {
+        self.check.set_resolution(Some(resolution));
+    }
+
+    /// Bytes of the source consumed so far (header included).
+    pub fn position(&self) -> u64 {
+        self.offset + (self.end - self.start) as u64
+    }
+
+    /// Decodes the next chunk; `Ok(None)` at the end of the data. Chunks hold at least one event
+    /// or trigger.
+    pub fn next_chunk(&mut self) -> Result<Option<EvtChunk<'_>>, EvtError> {
+        let word = self.header.version.word_size();
+        self.events.clear();
+        self.triggers.clear();
+        loop {
+            let available = self.end - self.start;
+            let whole = available - available % word;
+            if whole > 0 {
+                let bytes = &self.buf[self.start..self.start + whole];
+                match &mut self.decoder {
+                    Decoder::Evt2(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
+                    Decoder::Evt3(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
+                }
+                self.start += whole;
+                self.offset += whole as u64;
+                let offset = self.offset;
+                self.check
+                    .check(&self.events)
+                    .map_err(|source| EvtError::Event { source, offset })?;
+                if !self.events.is_empty() || !self.triggers.is_empty() {
+                    return Ok(Some(EvtChunk {
+                        events: &self.events,
+                        triggers: &self.triggers,
+                    }));
+                }
+                continue;
+            }
+            // Carry the partial word (if any) to the front and read more behind it.
+            self.buf.copy_within(self.start..self.end, 0);
+            self.end = available;
+            self.start = 0;
+            let n = read_some(&mut self.source, &mut self.buf[self.end..])?;
+            if n == 0 {
+                if available > 0 {
+                    return Err(EvtError::Truncated {
+                        offset: self.offset,
+                        got: available,
+                        word,
+                    });
+                }
+                return Ok(None);
+            }
+            self.end += n;
+        }
+    }
+}
+
+/// Decodes a whole EVT file held in memory, for fuzzing and tests: every event and trigger, or
+/// the first error.
+pub fn decode_all(bytes: &[u8]) -> Result<(Header, Vec<Event>, Vec<Trigger>), EvtError> {
+    let mut reader = EvtReader::from_slice(bytes)?;
+    let (mut events, mut triggers) = (Vec::new(), Vec::new());
+    while let Some(chunk) = reader.next_chunk()? {
+        events.extend_from_slice(chunk.events);
+        triggers.extend_from_slice(chunk.triggers);
+    }
+    Ok((reader.header, events, triggers))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(header: &str, words: &[u16]) -> Vec<u8> {
+        let mut bytes = header.as_bytes().to_vec();
+        bytes.extend(words.iter().flat_map(|w| w.to_le_bytes()));
+        bytes
+    }
+
+    #[test]
+    fn reads_header_and_events() {
+        let bytes = file(
+            "% evt 3.0\r\n% geometry 16x8\n% end\n",
+            &[0x8001, 0x0003, 0x2805],
+        );
+        let (header, events, _) = decode_all(&bytes).unwrap();
+        assert_eq!(header.resolution, Some(Resolution::new(16, 8)));
+        assert_eq!(header.len, 33);
+        assert_eq!(
+            events,
+            vec![Event {
+                t: 4096,
+                x: 5,
+                y: 3,
+                polarity: true
+            }]
+        );
+    }
+
+    #[test]
+    fn data_may_start_with_a_percent_sign_after_end() {
+        // 0x2025 is an EVT_ADDR_X word whose first byte is `%`.
+        let bytes = file(
+            "% evt 3.0\n% geometry 64x8\n% end\n",
+            &[0x8001, 0x0003, 0x2025],
+        );
+        let (_, events, _) = decode_all(&bytes).unwrap();
+        assert_eq!(events.len(), 1);
+        assert_eq!(events[0].x, 0x25);
+    }
+
+    #[test]
+    fn errors_name_what_is_wrong() {
+        assert!(matches!(decode_all(b""), Err(EvtError::Empty)));
+        assert!(matches!(decode_all(b"\x00\x01"), Err(EvtError::NoHeader)));
+        assert!(matches!(
+            decode_all(b"% evt 3.0"),
+            Err(EvtError::TruncatedHeader { offset: 9 })
+        ));
+        let mut bytes = file("% evt 3.0\n% geometry 16x8\n", &[0x8001, 0x0003]);
+        bytes.push(0x05);
+        let err = decode_all(&bytes).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                EvtError::Truncated {
+                    offset: 30,
+                    got: 1,
+                    word: 2
+                }
+            ),
+            "{err}"
+        );
+        let bytes = file("% evt 3.0\n% geometry 16x8\n", &[0x8001, 0x0009, 0x2805]);
+        let err = decode_all(&bytes).unwrap_err();
+        assert!(err.to_string().contains("y=9"), "{err}");
+    }
+}
