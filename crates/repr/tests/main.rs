@@ -1,0 +1,6 @@
+//! Integration tests of `evtac-repr`: one test binary, one module per concern.
+
+mod bad_input;
+mod common;
+mod dv_differential;
+mod reference;

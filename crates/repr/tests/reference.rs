@@ -1,0 +1,230 @@
+//! The streaming extractor against straightforward references on random streams: the dynamic
+//! frame recounted from scratch per sample, the static frame binarized from a plain accumulator,
+//! their OR, and pooling recomputed from the full frame; and equal output for any chunking.
+
+use crate::common::{random_batches, random_stream};
+use evtac_events::{Event, Resolution};
+use evtac_repr::{
+    Comparison, DynamicConfig, FeatureExtractor, Mask, Polarity, ReprConfig, StaticAccumulator,
+    StaticConfig, ThresholdSpace, dynamic_frame, or_frames, pool8, static_frame,
+};
+use proptest::prelude::*;
+
+const RES: Resolution = Resolution::new(24, 16);
+
+fn configs() -> Vec<ReprConfig> {
+    let s = StaticConfig {
+        tau_ms: 0.2,
+        ..StaticConfig::default()
+    };
+    let d = DynamicConfig {
+        window_ms: 0.15,
+        count_threshold: 0,
+    };
+    vec![
+        ReprConfig::Static(s),
+        ReprConfig::Static(StaticConfig {
+            threshold: 0.0,
+            ..s
+        }),
+        ReprConfig::Static(StaticConfig {
+            polarity: Polarity::Ignore,
+            threshold_space: ThresholdSpace::U8,
+            comparison: Comparison::Ge,
+            threshold: 1.0,
+            ..s
+        }),
+        ReprConfig::Static(StaticConfig {
+            synchronous_decay: true,
+            threshold: 0.5,
+            ..s
+        }),
+        ReprConfig::Dynamic(d),
+        ReprConfig::Dynamic(DynamicConfig {
+            count_threshold: 1,
+            ..d
+        }),
+        ReprConfig::Dynamic(DynamicConfig {
+            window_ms: 0.04,
+            count_threshold: 0,
+        }),
+        ReprConfig::Combined {
+            static_part: s,
+            dynamic_part: d,
+        },
+        ReprConfig::Combined {
+            static_part: StaticConfig {
+                synchronous_decay: true,
+                threshold: 0.5,
+                ..s
+            },
+            dynamic_part: DynamicConfig {
+                count_threshold: 2,
+                ..d
+            },
+        },
+    ]
+}
+
+fn sample_times(events: &[Event], n: usize) -> Vec<i64> {
+    let end = events.last().map_or(0, |e| e.t) + 200;
+    let mut t: Vec<i64> = (0..n)
+        .map(|k| -50 + (end + 50) * k as i64 / n.max(1) as i64)
+        .collect();
+    // A repeated sample time and one exactly on an event are valid too.
+    if let Some(&first) = t.first() {
+        t.insert(0, first);
+    }
+    if let Some(e) = events.get(events.len() / 2) {
+        t.push(e.t);
+        t.sort_unstable();
+    }
+    t
+}
+
+/// Frames and features per config per sample, computed the plain way.
+fn reference(
+    configs: &[ReprConfig],
+    mask: &Mask,
+    events: &[Event],
+    samples: &[i64],
+) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
+    let mut accs: Vec<Option<StaticAccumulator>> = configs
+        .iter()
+        .map(|c| {
+            c.static_part()
+                .map(|s| StaticAccumulator::new(RES, s).unwrap())
+        })
+        .collect();
+    let mut out = vec![Vec::new(); configs.len()];
+    let mut applied = 0;
+    for &t_k in samples {
+        let end = events.partition_point(|e| e.t <= t_k);
+        for (i, config) in configs.iter().enumerate() {
+            let static_bits = accs[i].as_mut().map(|acc| {
+                acc.accumulate(&events[applied..end]).unwrap();
+                acc.synchronize();
+                static_frame(config.static_part().unwrap(), acc.potentials(), Some(mask))
+            });
+            let dynamic_bits = config.dynamic_part().map(|d| {
+                let mut counts = vec![0u32; RES.pixels()];
+                for e in &events[..end] {
+                    if e.t > t_k - d.window_us() {
+                        counts[usize::from(e.y) * usize::from(RES.width) + usize::from(e.x)] += 1;
+                    }
+                }
+                dynamic_frame(d, &counts)
+            });
+            let frame = match (static_bits, dynamic_bits) {
+                (Some(s), Some(d)) => or_frames(&s, &d),
+                (Some(s), None) => s,
+                (None, Some(d)) => d,
+                (None, None) => unreachable!(),
+            };
+            let features = pool8(RES, &frame).unwrap();
+            out[i].push((frame, features));
+        }
+        applied = end;
+    }
+    out
+}
+
+fn streamed(
+    configs: &[ReprConfig],
+    mask: &Mask,
+    events: &[Event],
+    samples: &[i64],
+    cuts: &[usize],
+) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
+    let mut fx = FeatureExtractor::new(configs, RES, Some(mask)).unwrap();
+    let mut out = vec![Vec::new(); configs.len()];
+    let mut pushed = 0;
+    let mut next_cut = cuts.iter().copied().peekable();
+    for &t_k in samples {
+        // Push chunks (of the given random sizes) until every event <= t_k is queued.
+        while pushed < events.len() && events[pushed].t <= t_k {
+            let end = next_cut
+                .by_ref()
+                .find(|&c| c > pushed)
+                .unwrap_or(events.len());
+            fx.push(&events[pushed..end]).unwrap();
+            pushed = end;
+        }
+        fx.advance_to(t_k).unwrap();
+        for (i, o) in out.iter_mut().enumerate() {
+            o.push((fx.frame(i).to_vec(), fx.features(i).to_vec()));
+        }
+    }
+    out
+}
+
+fn random_mask(seed: u64) -> Mask {
+    let pixels: Vec<u8> = (0..RES.pixels())
+        .map(|p| u8::from((p as u64).wrapping_mul(seed | 1) % 13 == 0))
+        .collect();
+    Mask::from_pixels(RES, &pixels).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn extractor_matches_reference_for_any_chunking(
+        seed in any::<u64>(),
+        n in 0usize..600,
+        max_gap in 0i64..40,
+        samples in 1usize..40,
+        chunks in 1usize..30,
+    ) {
+        let events = random_stream(seed, RES, n, 3, max_gap);
+        let samples = sample_times(&events, samples);
+        let mask = random_mask(seed);
+        let configs = configs();
+        let expected = reference(&configs, &mask, &events, &samples);
+        let cuts = random_batches(seed, events.len(), chunks);
+        let got = streamed(&configs, &mask, &events, &samples, &cuts);
+        for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+            for (k, (g, e)) in g.iter().zip(e).enumerate() {
+                prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
+                prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
+            }
+        }
+        // One push of everything gives the same.
+        let whole = streamed(&configs, &mask, &events, &samples, &[]);
+        prop_assert_eq!(whole, got);
+    }
+}
+
+#[test]
+fn configs_share_work_but_not_results() {
+    // A grid in one extractor equals each config in its own extractor.
+    let events = random_stream(99, RES, 2000, 0, 5);
+    let samples = sample_times(&events, 25);
+    let configs = configs();
+    let together = evtac_repr::extract_features(&configs, RES, None, &events, &samples).unwrap();
+    for (i, c) in configs.iter().enumerate() {
+        let alone =
+            evtac_repr::extract_features(std::slice::from_ref(c), RES, None, &events, &samples)
+                .unwrap();
+        assert_eq!(alone[0], together[i], "config {i}");
+    }
+}
+
+#[test]
+fn reset_returns_to_the_initial_state() {
+    let events = random_stream(5, RES, 500, 0, 5);
+    let samples = sample_times(&events, 10);
+    let mut fx = FeatureExtractor::new(&configs(), RES, None).unwrap();
+    let mut first = Vec::new();
+    fx.run(&events, &samples, |_, fx| {
+        first.push(fx.features(7).to_vec())
+    })
+    .unwrap();
+    fx.reset();
+    let mut second = Vec::new();
+    fx.run(&events, &samples, |_, fx| {
+        second.push(fx.features(7).to_vec())
+    })
+    .unwrap();
+    assert_eq!(first, second);
+}
