@@ -160,7 +160,7 @@ fn streamed(
 
 fn random_mask(seed: u64) -> Mask {
     let pixels: Vec<u8> = (0..RES.pixels())
-        .map(|p| u8::from((p as u64).wrapping_mul(seed | 1) % 13 == 0))
+        .map(|p| u8::from((p as u64).wrapping_mul(seed | 1).is_multiple_of(13)))
         .collect();
     Mask::from_pixels(RES, &pixels).unwrap()
 }

@@ -1,0 +1,266 @@
+//! Throughput and per-sample latency of the static, dynamic and combined representations at a
+//! 1 ms sampling interval on a realistic synthetic stream (~300k events/s over 240x240, seeded),
+//! and the same measured in the same run for the paper's implementation style
+//! (`benches/baseline.py`: dv-processing's Accumulator, a numpy sliding window).
+//!
+//! `nice cargo bench -p evtac-repr --bench represent -- --warm-up-time 1 --measurement-time 3`
+//! prints criterion's throughput, then a table of latency (median, P99, max) and throughput for
+//! evtac and the Python baseline, with ratios.
+
+use criterion::{BenchmarkId, Criterion, Throughput};
+use evtac_events::{Event, Resolution};
+use evtac_repr::{FeatureExtractor, ReprConfig};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+use std::time::Instant;
+
+const FRAME: Resolution = Resolution::new(240, 240);
+const RATE_HZ: f64 = 300_000.0;
+const DURATION_US: i64 = 3_000_000;
+const STEP_US: i64 = 1_000;
+const T0: i64 = 1_000_000;
+
+/// A NeuroTac-like stream: a 14 x 14 grid of pins, those under a slowly moving contact region
+/// emit events around their edges (85 % of events), plus uniform background noise; Poisson
+/// arrivals at `RATE_HZ`, integer-microsecond timestamps (so many share a timestamp).
+fn synthetic_stream(seed: u64) -> Vec<Event> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let pins: Vec<(f64, f64)> = (0..14)
+        .flat_map(|i| {
+            (0..14).map(move |j| (10.0 + 17.0 * f64::from(i), 10.0 + 17.0 * f64::from(j)))
+        })
+        .collect();
+    let mut events = Vec::with_capacity((RATE_HZ * DURATION_US as f64 / 1e6 * 1.05) as usize);
+    let mut t = T0 as f64;
+    let end = (T0 + DURATION_US) as f64;
+    let mut active = Vec::with_capacity(pins.len());
+    let mut active_at = i64::MIN;
+    loop {
+        t += -(1.0 - rng.random::<f64>()).ln() * 1e6 / RATE_HZ;
+        if t >= end {
+            break;
+        }
+        let ti = t as i64;
+        // The contact region circles around the centre once per 2 s.
+        if ti - active_at >= 1_000 {
+            active_at = ti;
+            let phase = (ti - T0) as f64 / 2e6 * std::f64::consts::TAU;
+            let (cx, cy) = (120.0 + 40.0 * phase.cos(), 120.0 + 40.0 * phase.sin());
+            active.clear();
+            active.extend(
+                pins.iter()
+                    .filter(|(px, py)| (px - cx).hypot(py - cy) < 70.0)
+                    .copied(),
+            );
+        }
+        let (x, y) = if rng.random_bool(0.85) && !active.is_empty() {
+            let (px, py) = active[rng.random_range(0..active.len())];
+            let angle = rng.random::<f64>() * std::f64::consts::TAU;
+            let r = 3.0 + rng.random::<f64>() * 1.5;
+            (px + r * angle.cos(), py + r * angle.sin())
+        } else {
+            (rng.random::<f64>() * 240.0, rng.random::<f64>() * 240.0)
+        };
+        events.push(Event {
+            t: ti,
+            x: (x.clamp(0.0, 239.0)) as u16,
+            y: (y.clamp(0.0, 239.0)) as u16,
+            polarity: rng.random_bool(0.5),
+        });
+    }
+    events
+}
+
+fn configs() -> [(&'static str, ReprConfig); 3] {
+    let ReprConfig::Combined {
+        static_part,
+        dynamic_part,
+    } = ReprConfig::default()
+    else {
+        unreachable!("the default is combined")
+    };
+    [
+        ("static", ReprConfig::Static(static_part)),
+        ("dynamic", ReprConfig::Dynamic(dynamic_part)),
+        ("combined", ReprConfig::default()),
+    ]
+}
+
+fn samples() -> Vec<i64> {
+    (1..=DURATION_US / STEP_US)
+        .map(|k| T0 + k * STEP_US)
+        .collect()
+}
+
+/// One pass at 1 ms sampling: per sample, push that millisecond's events, advance, and copy the
+/// features out (what an online estimator hands to the model). Returns per-sample nanoseconds.
+fn pass(config: &ReprConfig, events: &[Event], samples: &[i64], lat: &mut Vec<u64>) -> f32 {
+    let mut fx =
+        FeatureExtractor::new(std::slice::from_ref(config), FRAME, None).expect("valid config");
+    let mut features = vec![0.0f32; fx.feature_len()];
+    let mut start = 0;
+    let mut sum = 0.0;
+    lat.clear();
+    for &t_k in samples {
+        let end = start + events[start..].partition_point(|e| e.t <= t_k);
+        let t0 = Instant::now();
+        fx.push(&events[start..end]).expect("events in order");
+        fx.advance_to(t_k).expect("samples in order");
+        features.copy_from_slice(fx.features(0));
+        lat.push(t0.elapsed().as_nanos() as u64);
+        sum += features[465];
+        start = end;
+    }
+    sum
+}
+
+fn throughput(c: &mut Criterion, events: &[Event], samples: &[i64]) {
+    let mut group = c.benchmark_group("represent_1ms");
+    group.throughput(Throughput::Elements(events.len() as u64));
+    group.sample_size(10);
+    let mut lat = Vec::with_capacity(samples.len());
+    for (name, config) in configs() {
+        group.bench_with_input(BenchmarkId::from_parameter(name), &config, |b, config| {
+            b.iter(|| black_box(pass(config, events, samples, &mut lat)))
+        });
+    }
+    group.finish();
+}
+
+struct Row {
+    median_us: f64,
+    p99_us: f64,
+    max_us: f64,
+    events_per_s: f64,
+}
+
+fn stats(lat_ns: &mut [u64], events: usize) -> Row {
+    lat_ns.sort_unstable();
+    let us = |ns: u64| ns as f64 / 1e3;
+    let n = lat_ns.len();
+    let total_s = lat_ns.iter().sum::<u64>() as f64 / 1e9;
+    Row {
+        median_us: us(lat_ns[n / 2]),
+        p99_us: us(lat_ns[(n * 99).div_ceil(100) - 1]),
+        max_us: us(lat_ns[n - 1]),
+        events_per_s: events as f64 / total_s,
+    }
+}
+
+fn python_baseline(events: &[Event], samples: &[i64]) -> Option<Vec<(String, Row)>> {
+    let python = evtac_testkit::python()?;
+    let dir = tempfile::tempdir().ok()?;
+    let path = dir.path().join("events.bin");
+    let mut bytes = Vec::with_capacity(events.len() * 13);
+    bytes.extend(events.iter().flat_map(|e| e.t.to_le_bytes()));
+    bytes.extend(events.iter().flat_map(|e| e.x.to_le_bytes()));
+    bytes.extend(events.iter().flat_map(|e| e.y.to_le_bytes()));
+    bytes.extend(events.iter().map(|e| u8::from(e.polarity)));
+    std::fs::write(&path, bytes).ok()?;
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/baseline.py");
+    let out = std::process::Command::new(python)
+        .arg(script)
+        .arg(&path)
+        .args(
+            [
+                events.len() as i64,
+                i64::from(FRAME.width),
+                i64::from(FRAME.height),
+                T0,
+                STEP_US,
+                samples.len() as i64,
+            ]
+            .map(|v| v.to_string()),
+        )
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        eprintln!(
+            "baseline.py failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        return None;
+    }
+    let rows = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
+        .filter_map(|v| {
+            let f = |k: &str| v[k].as_f64();
+            Some((
+                v["repr"].as_str()?.to_string(),
+                Row {
+                    median_us: f("median_us")?,
+                    p99_us: f("p99_us")?,
+                    max_us: f("max_us")?,
+                    events_per_s: f("events_per_s")?,
+                },
+            ))
+        })
+        .collect();
+    Some(rows)
+}
+
+fn latency_table(events: &[Event], samples: &[i64]) {
+    let mut lat = Vec::with_capacity(samples.len() * 3);
+    let mut rows = Vec::new();
+    for (name, config) in configs() {
+        // Three fresh passes (window filling up included), latencies pooled.
+        let mut all = Vec::with_capacity(samples.len() * 3);
+        for _ in 0..3 {
+            black_box(pass(&config, events, samples, &mut lat));
+            all.extend_from_slice(&lat);
+        }
+        rows.push((name, stats(&mut all, events.len() * 3)));
+    }
+    let baseline = python_baseline(events, samples).unwrap_or_default();
+    let secs = DURATION_US as f64 / 1e6;
+    println!(
+        "\n{} events over {secs} s ({:.0} events/s), 240x240, sampled every {} ms ({} samples)\n",
+        events.len(),
+        events.len() as f64 / secs,
+        STEP_US / 1000,
+        samples.len()
+    );
+    println!(
+        "| repr | impl | median (us) | P99 (us) | max (us) | throughput (Mevents/s) | speed-up |"
+    );
+    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    for (name, row) in &rows {
+        let base = baseline.iter().find(|(n, _)| n == name).map(|(_, r)| r);
+        let ratio = base.map_or("-".into(), |b| {
+            format!("{:.0}x", row.events_per_s / b.events_per_s)
+        });
+        println!(
+            "| {name} | evtac | {:.1} | {:.1} | {:.1} | {:.1} | {ratio} |",
+            row.median_us,
+            row.p99_us,
+            row.max_us,
+            row.events_per_s / 1e6
+        );
+        if let Some(b) = base {
+            println!(
+                "| {name} | Python (dv-processing / numpy) | {:.1} | {:.1} | {:.1} | {:.2} | 1x |",
+                b.median_us,
+                b.p99_us,
+                b.max_us,
+                b.events_per_s / 1e6
+            );
+        }
+    }
+    if baseline.is_empty() {
+        println!("(Python baseline skipped: no reference Python environment)");
+    }
+}
+
+fn main() {
+    let events = synthetic_stream(42);
+    let samples = samples();
+    let mut c = Criterion::default().configure_from_args();
+    throughput(&mut c, &events, &samples);
+    c.final_summary();
+    // Only under `cargo bench` (which passes `--bench`), not when `cargo test` smoke-runs benches.
+    if std::env::args().any(|a| a == "--bench") {
+        latency_table(&events, &samples);
+    }
+}
