@@ -1,7 +1,14 @@
-//! Event and IMU types for evtac, and readers and writers for the files event-camera users have.
+//! Event and IMU types for evtac, and readers and writers for the files event-camera users have:
+//! AEDAT 4.0 ([`aedat`]), Prophesee EVT 2.0 / 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]).
 //!
 //! Time is `i64` microseconds everywhere; coordinates are on the full sensor with `x` to the right
 //! and `y` downwards; a [`Roi`] crops them (the paper uses the centered 240x240 region).
+//!
+//! [`open`] recognises a file's format and streams it in chunks that borrow reused buffers;
+//! [`read_recording`] reads it whole; [`EventWriter`] writes AEDAT4, CSV or NPY. Readers never
+//! panic on bad input: a truncated or corrupt file, a bad header, an event outside the declared
+//! resolution or a timestamp going backwards is an [`Error`] naming the file, the byte offset or
+//! event index, and the broken limit.
 //!
 //! ```
 //! use evtac_events::{Event, Resolution, Roi};
@@ -10,13 +17,23 @@
 //! let e = Event { t: 10, x: 320, y: 240, polarity: true };
 //! assert_eq!(roi.map(e).map(|e| (e.x, e.y)), Some((120, 120)));
 //! ```
+//!
+//! ```no_run
+//! let recording = evtac_events::read_recording("trial.aedat4")?;
+//! println!("{} events on a {:?} sensor", recording.events.len(), recording.resolution);
+//! # Ok::<(), evtac_events::Error>(())
+//! ```
 
 pub mod aedat;
 pub mod check;
 pub mod csv;
+mod error;
 pub mod evt;
 pub mod manifest;
 pub mod npy;
+mod recording;
 mod types;
 
+pub use error::Error;
+pub use recording::{Chunk, EventReader, EventWriter, Format, Recording, open, read_recording};
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

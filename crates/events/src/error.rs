@@ -1,0 +1,99 @@
+//! The crate-level error of the whole-file API ([`open`](crate::open),
+//! [`read_recording`](crate::read_recording), [`EventWriter`](crate::EventWriter)): each
+//! format's error, with the path of the file it concerns.
+
+use std::path::PathBuf;
+
+use crate::aedat::AedatError;
+use crate::check::CheckError;
+use crate::csv::CsvError;
+use crate::evt::EvtError;
+use crate::npy::NpyError;
+use crate::{Format, Resolution};
+
+/// What can go wrong opening, reading or writing an event file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The file could not be opened, created or inspected.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// Neither the first bytes nor the extension identify a format evtac reads.
+    #[error("{}: unknown event file format ({reason})", path.display())]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+        /// What was looked at.
+        reason: String,
+    },
+    /// evtac cannot write this format.
+    #[error("{}: cannot write {format} files (write .aedat4, .csv or .npy)", path.display())]
+    NotWritable {
+        /// The file.
+        path: PathBuf,
+        /// The format its extension names.
+        format: Format,
+    },
+    /// Writing AEDAT4 needs the sensor size, and none was given.
+    #[error("{}: writing AEDAT4 needs the sensor resolution, and the input has none", path.display())]
+    MissingResolution {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A declared resolution contradicts the one the file states.
+    #[error("{}: the file states a {found} sensor, not {declared}", path.display())]
+    ResolutionMismatch {
+        /// The file.
+        path: PathBuf,
+        /// The resolution the caller declared.
+        declared: Resolution,
+        /// The resolution in the file.
+        found: Resolution,
+    },
+    /// An AEDAT4 file is broken.
+    #[error("{}: {source}", path.display())]
+    Aedat {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: AedatError,
+    },
+    /// An EVT file is broken.
+    #[error("{}: {source}", path.display())]
+    Evt {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: EvtError,
+    },
+    /// A CSV file is broken.
+    #[error("{}: {source}", path.display())]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: CsvError,
+    },
+    /// An NPY file is broken.
+    #[error("{}: {source}", path.display())]
+    Npy {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: NpyError,
+    },
+    /// An event read from the file is invalid (outside the sensor, or earlier than its
+    /// predecessor).
+    #[error("{}: {source}", path.display())]
+    Event {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: CheckError,
+    },
+}

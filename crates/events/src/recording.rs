@@ -1,0 +1,530 @@
+//! The whole-file API: open any supported event file by its path, stream it in chunks
+//! ([`EventReader`]) or read it whole ([`read_recording`]), and write events to any writable
+//! format ([`EventWriter`]).
+//!
+//! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, EVT `%` header)
+//! and otherwise by its extension (`.csv`). Every reader validates what it decodes: events
+//! inside the declared resolution and timestamps that never go backwards.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read};
+use std::path::{Path, PathBuf};
+
+use crate::aedat::{AedatReader, AedatWriter, WriterConfig};
+use crate::check::EventCheck;
+use crate::csv::{CsvReader, CsvWriter};
+use crate::evt::{EvtReader, EvtVersion};
+use crate::npy::{NpyReader, NpyWriter};
+use crate::{Error, Event, ImuSample, Resolution, Trigger};
+
+/// The event file formats evtac knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Format {
+    /// iniVation AEDAT 4.0 (`.aedat4`): events, IMU and triggers.
+    Aedat4,
+    /// Prophesee EVT 2.0 raw (`.raw`), read only.
+    Evt2,
+    /// Prophesee EVT 3.0 raw (`.raw`), read only.
+    Evt3,
+    /// `t,x,y,p` CSV (`.csv`).
+    Csv,
+    /// NPY with the record dtype `t <i8, x <i2, y <i2, p u1` (`.npy`).
+    Npy,
+}
+
+impl Format {
+    /// The short name shown to users (`AEDAT4`, `EVT2`, `EVT3`, `CSV`, `NPY`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Aedat4 => "AEDAT4",
+            Self::Evt2 => "EVT2",
+            Self::Evt3 => "EVT3",
+            Self::Csv => "CSV",
+            Self::Npy => "NPY",
+        }
+    }
+
+    /// Whether the format carries the sensor resolution itself (CSV and NPY do not).
+    pub const fn has_resolution(self) -> bool {
+        !matches!(self, Self::Csv | Self::Npy)
+    }
+
+    /// The format an output path's extension asks for: `.aedat4`, `.csv` or `.npy`.
+    pub fn for_writing(path: &Path) -> Result<Self, Error> {
+        let extension = extension(path);
+        match extension.as_str() {
+            "aedat4" | "aedat" => Ok(Self::Aedat4),
+            "csv" => Ok(Self::Csv),
+            "npy" => Ok(Self::Npy),
+            "raw" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::Evt3,
+            }),
+            _ => Err(Error::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: format!("the extension `{extension}` is not .aedat4, .csv or .npy"),
+            }),
+        }
+    }
+
+    /// Recognises the format of the file at `path`: by its first bytes, else by its extension.
+    pub fn detect(path: &Path) -> Result<Self, Error> {
+        let io = |source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut head = Vec::with_capacity(64);
+        File::open(path)
+            .map_err(io)?
+            .take(4096)
+            .read_to_end(&mut head)
+            .map_err(io)?;
+        if head.starts_with(crate::aedat::MAGIC) {
+            return Ok(Self::Aedat4);
+        }
+        if head.starts_with(crate::npy::MAGIC) {
+            return Ok(Self::Npy);
+        }
+        if head.starts_with(b"%") {
+            // The version needs the whole header, which the EVT reader parses.
+            return match EvtReader::new(File::open(path).map_err(io)?) {
+                Ok(r) => Ok(match r.header().version {
+                    EvtVersion::Evt2 => Self::Evt2,
+                    EvtVersion::Evt3 => Self::Evt3,
+                }),
+                Err(source) => Err(Error::Evt {
+                    path: path.to_path_buf(),
+                    source,
+                }),
+            };
+        }
+        let extension = extension(path);
+        match extension.as_str() {
+            "csv" => Ok(Self::Csv),
+            _ if head.is_empty() => Err(Error::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: "the file is empty".into(),
+            }),
+            "aedat4" | "aedat" | "npy" | "raw" => Err(Error::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "the extension says `.{extension}` but the file does not start like one"
+                ),
+            }),
+            _ => Err(Error::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: "no AEDAT4, NPY or EVT signature, and the extension is not .csv".into(),
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for Format {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// One chunk of a recording: views into the reader's reused buffers, valid until the next call.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Chunk<'a> {
+    /// Events, in time order.
+    pub events: &'a [Event],
+    /// IMU samples (AEDAT4 only).
+    pub imu: &'a [ImuSample],
+    /// Triggers (AEDAT4, EVT).
+    pub triggers: &'a [Trigger],
+}
+
+enum Inner {
+    Aedat(Box<AedatReader<BufReader<File>>>),
+    Evt(Box<EvtReader<File>>),
+    Csv(Box<CsvReader<BufReader<File>>>),
+    Npy(Box<NpyReader<File>>),
+}
+
+/// A streaming reader of any supported event file (see [`open`]).
+pub struct EventReader {
+    path: PathBuf,
+    format: Format,
+    source: Option<String>,
+    len: u64,
+    inner: Inner,
+    /// Validation of AEDAT4 events (the other readers validate their own).
+    aedat_check: EventCheck,
+}
+
+impl std::fmt::Debug for EventReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EventReader")
+            .field("path", &self.path)
+            .field("format", &self.format)
+            .field("resolution", &self.resolution())
+            .finish_non_exhaustive()
+    }
+}
+
+/// Opens the event file at `path`, recognising its format (see [`Format::detect`]).
+///
+/// ```no_run
+/// let mut reader = evtac_events::open("recording.aedat4")?;
+/// let mut on = 0;
+/// while let Some(chunk) = reader.next_chunk()? {
+///     on += chunk.events.iter().filter(|e| e.polarity).count();
+/// }
+/// println!("{on} ON events from {:?}", reader.source());
+/// # Ok::<(), evtac_events::Error>(())
+/// ```
+pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
+    let path = path.as_ref();
+    let format = Format::detect(path)?;
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let len = std::fs::metadata(path).map_err(io)?.len();
+    let (inner, source) = match format {
+        Format::Aedat4 => {
+            let r = AedatReader::open(path).map_err(|source| Error::Aedat {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            let name = r.source().map(str::to_string);
+            (Inner::Aedat(Box::new(r)), name)
+        }
+        Format::Evt2 | Format::Evt3 => {
+            let r = EvtReader::from_path(path).map_err(|source| Error::Evt {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            let name = r.header().source();
+            (Inner::Evt(Box::new(r)), name)
+        }
+        Format::Csv => {
+            let r = CsvReader::from_path(path).map_err(|source| Error::Csv {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            (Inner::Csv(Box::new(r)), None)
+        }
+        Format::Npy => {
+            let r = NpyReader::from_path(path).map_err(|source| Error::Npy {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            (Inner::Npy(Box::new(r)), None)
+        }
+    };
+    let aedat_check = EventCheck::new(match &inner {
+        Inner::Aedat(r) => r.resolution(),
+        _ => None,
+    });
+    Ok(EventReader {
+        path: path.to_path_buf(),
+        format,
+        source,
+        len,
+        inner,
+        aedat_check,
+    })
+}
+
+impl EventReader {
+    /// The file being read.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Its format.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// The camera that recorded it, when the file says (AEDAT4 source name; EVT plugin and
+    /// serial number).
+    pub fn source(&self) -> Option<&str> {
+        self.source.as_deref()
+    }
+
+    /// The sensor size events are checked against: the file's own, or the one declared with
+    /// [`set_resolution`](Self::set_resolution).
+    pub fn resolution(&self) -> Option<Resolution> {
+        match &self.inner {
+            Inner::Aedat(_) => self.aedat_check.resolution(),
+            Inner::Evt(r) => r.resolution(),
+            Inner::Csv(r) => r.resolution(),
+            Inner::Npy(r) => r.resolution(),
+        }
+    }
+
+    /// Declares the sensor size (needed for CSV and NPY, which do not store it): events from now
+    /// on must lie inside it. For a file that states its own size, a different one is an error.
+    pub fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
+        if self.format.has_resolution()
+            && let Some(found) = self.resolution()
+            && found != resolution
+        {
+            return Err(Error::ResolutionMismatch {
+                path: self.path.clone(),
+                declared: resolution,
+                found,
+            });
+        }
+        match &mut self.inner {
+            Inner::Aedat(_) => self.aedat_check.set_resolution(Some(resolution)),
+            Inner::Evt(r) => r.set_resolution(resolution),
+            Inner::Csv(r) => r.set_resolution(resolution),
+            Inner::Npy(r) => r.set_resolution(resolution),
+        }
+        Ok(())
+    }
+
+    /// Size of the file in bytes.
+    pub fn file_len(&self) -> u64 {
+        self.len
+    }
+
+    /// Bytes of the file consumed so far (for progress bars).
+    pub fn position(&self) -> u64 {
+        match &self.inner {
+            Inner::Aedat(r) => r.offset(),
+            Inner::Evt(r) => r.position(),
+            Inner::Csv(r) => r.position(),
+            Inner::Npy(r) => r.position(),
+        }
+    }
+
+    /// The next chunk; `Ok(None)` at the end of the file.
+    pub fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
+        let path = &self.path;
+        match &mut self.inner {
+            Inner::Aedat(r) => {
+                let chunk = r.next_chunk().map_err(|source| Error::Aedat {
+                    path: path.clone(),
+                    source,
+                })?;
+                let Some(chunk) = chunk else { return Ok(None) };
+                self.aedat_check
+                    .check(chunk.events)
+                    .map_err(|source| Error::Event {
+                        path: path.clone(),
+                        source,
+                    })?;
+                Ok(Some(Chunk {
+                    events: chunk.events,
+                    imu: chunk.imu,
+                    triggers: chunk.triggers,
+                }))
+            }
+            Inner::Evt(r) => r
+                .next_chunk()
+                .map(|c| {
+                    c.map(|c| Chunk {
+                        events: c.events,
+                        imu: &[],
+                        triggers: c.triggers,
+                    })
+                })
+                .map_err(|source| Error::Evt {
+                    path: path.clone(),
+                    source,
+                }),
+            Inner::Csv(r) => r
+                .next_chunk()
+                .map(|c| {
+                    c.map(|events| Chunk {
+                        events,
+                        ..Chunk::default()
+                    })
+                })
+                .map_err(|source| Error::Csv {
+                    path: path.clone(),
+                    source,
+                }),
+            Inner::Npy(r) => r
+                .next_chunk()
+                .map(|c| {
+                    c.map(|events| Chunk {
+                        events,
+                        ..Chunk::default()
+                    })
+                })
+                .map_err(|source| Error::Npy {
+                    path: path.clone(),
+                    source,
+                }),
+        }
+    }
+
+    /// Reads the rest of the file into a [`Recording`].
+    pub fn into_recording(mut self) -> Result<Recording, Error> {
+        let (mut events, mut imu, mut triggers) = (Vec::new(), Vec::new(), Vec::new());
+        while let Some(chunk) = self.next_chunk()? {
+            events.extend_from_slice(chunk.events);
+            imu.extend_from_slice(chunk.imu);
+            triggers.extend_from_slice(chunk.triggers);
+        }
+        Ok(Recording {
+            format: self.format,
+            resolution: self.resolution(),
+            source: self.source,
+            events,
+            imu,
+            triggers,
+        })
+    }
+}
+
+/// A whole recording in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// The format it was read from.
+    pub format: Format,
+    /// The camera that recorded it, when the file says.
+    pub source: Option<String>,
+    /// The sensor size, when the file states it.
+    pub resolution: Option<Resolution>,
+    /// Events, in time order.
+    pub events: Vec<Event>,
+    /// IMU samples, in time order.
+    pub imu: Vec<ImuSample>,
+    /// Triggers.
+    pub triggers: Vec<Trigger>,
+}
+
+/// Reads the whole event file at `path` (any supported format).
+///
+/// ```no_run
+/// let rec = evtac_events::read_recording("recording.aedat4")?;
+/// println!("{} events, {} IMU samples, {:?}", rec.events.len(), rec.imu.len(), rec.resolution);
+/// # Ok::<(), evtac_events::Error>(())
+/// ```
+pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording, Error> {
+    open(path)?.into_recording()
+}
+
+enum Sink {
+    Aedat(Box<AedatWriter<BufWriter<File>>>),
+    Csv(CsvWriter<BufWriter<File>>),
+    Npy(NpyWriter<BufWriter<File>>),
+}
+
+/// Writes events (and, for AEDAT4, IMU samples) to a file whose extension picks the format:
+/// `.aedat4`, `.csv` or `.npy`.
+pub struct EventWriter {
+    path: PathBuf,
+    format: Format,
+    sink: Sink,
+}
+
+impl std::fmt::Debug for EventWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EventWriter")
+            .field("path", &self.path)
+            .field("format", &self.format)
+            .finish_non_exhaustive()
+    }
+}
+
+impl EventWriter {
+    /// Creates the file at `path`. AEDAT4 needs the sensor `resolution` and stores
+    /// `source_name` (default `evtac`) with LZ4 compression; CSV and NPY store neither.
+    pub fn create(
+        path: impl AsRef<Path>,
+        resolution: Option<Resolution>,
+        source_name: Option<&str>,
+    ) -> Result<Self, Error> {
+        let path = path.as_ref().to_path_buf();
+        let format = Format::for_writing(&path)?;
+        let sink = match format {
+            Format::Aedat4 => {
+                let resolution =
+                    resolution.ok_or_else(|| Error::MissingResolution { path: path.clone() })?;
+                let config = WriterConfig::new(resolution, source_name.unwrap_or("evtac"));
+                let w = AedatWriter::create(&path, config).map_err(|source| Error::Aedat {
+                    path: path.clone(),
+                    source,
+                })?;
+                Sink::Aedat(Box::new(w))
+            }
+            Format::Csv => Sink::Csv(CsvWriter::create(&path).map_err(|source| Error::Csv {
+                path: path.clone(),
+                source,
+            })?),
+            Format::Npy => Sink::Npy(NpyWriter::create(&path).map_err(|source| Error::Npy {
+                path: path.clone(),
+                source,
+            })?),
+            Format::Evt2 | Format::Evt3 => {
+                return Err(Error::NotWritable { path, format });
+            }
+        };
+        Ok(Self { path, format, sink })
+    }
+
+    /// The format being written.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Whether IMU samples are stored (AEDAT4 only).
+    pub fn stores_imu(&self) -> bool {
+        matches!(self.sink, Sink::Aedat(_))
+    }
+
+    /// Appends events.
+    pub fn write_events(&mut self, events: &[Event]) -> Result<(), Error> {
+        let path = &self.path;
+        match &mut self.sink {
+            Sink::Aedat(w) => w.write_events(events).map_err(|source| Error::Aedat {
+                path: path.clone(),
+                source,
+            }),
+            Sink::Csv(w) => w.write_events(events).map_err(|source| Error::Csv {
+                path: path.clone(),
+                source,
+            }),
+            Sink::Npy(w) => w.write_events(events).map_err(|source| Error::Npy {
+                path: path.clone(),
+                source,
+            }),
+        }
+    }
+
+    /// Appends IMU samples when the format stores them ([`stores_imu`](Self::stores_imu));
+    /// CSV and NPY event files have no place for them and ignore them.
+    pub fn write_imu(&mut self, samples: &[ImuSample]) -> Result<(), Error> {
+        match &mut self.sink {
+            Sink::Aedat(w) => w.write_imu(samples).map_err(|source| Error::Aedat {
+                path: self.path.clone(),
+                source,
+            }),
+            Sink::Csv(_) | Sink::Npy(_) => Ok(()),
+        }
+    }
+
+    /// Finishes the file (buffered packets, NPY record count) and flushes it.
+    pub fn finish(self) -> Result<(), Error> {
+        let path = self.path;
+        match self.sink {
+            Sink::Aedat(w) => w
+                .finish()
+                .map(drop)
+                .map_err(|source| Error::Aedat { path, source }),
+            Sink::Csv(w) => w
+                .finish()
+                .map(drop)
+                .map_err(|source| Error::Csv { path, source }),
+            Sink::Npy(w) => w
+                .finish()
+                .map(drop)
+                .map_err(|source| Error::Npy { path, source }),
+        }
+    }
+}
