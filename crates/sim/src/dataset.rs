@@ -1,0 +1,249 @@
+//! Writing a simulated dataset folder: one AEDAT4 file per trial, the manifest, ground truth,
+//! the no-contact recording, the calibration and the simulator's parameters.
+//!
+//! ```text
+//! DIR/trials.csv            the manifest (evtac_events::manifest)
+//! DIR/t0000.aedat4 ...      events (640x480) and IMU samples of each trial
+//! DIR/truth/t0000.csv ...   t_us,theta_deg,pitch_deg,roll_deg at 1 kHz (the commanded pose)
+//! DIR/no_contact.aedat4     the sensor at rest out of contact (for the static mask)
+//! DIR/calibration.json      evtac_labels::geometry::Calibration
+//! DIR/simulator.json        protocol, scale, seed and every SimParams value
+//! ```
+//!
+//! Trials run in parallel on the current rayon pool; each trial's randomness comes from its own
+//! seed (see [`crate::protocol::trial_seed`]), so the same seed gives the same bytes whatever
+//! the number of threads.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use evtac_events::Resolution;
+use evtac_events::aedat::{AedatError, AedatWriter, Compression, WriterConfig};
+use evtac_events::manifest::{Manifest, ManifestError, TrialMeta};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::params::SimParams;
+use crate::protocol::{Protocol, Scale, plan, trial_seed};
+use crate::trial::{Simulator, TrialRecording, TruthSample};
+
+/// The camera name written into every AEDAT4 file.
+pub const SOURCE_NAME: &str = "DVXplorer_SIM00000";
+
+/// Errors writing a dataset.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DatasetError {
+    /// A file or folder could not be created or written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The AEDAT4 writer refused the data or failed.
+    #[error("cannot write AEDAT4 file {path}: {source}")]
+    Aedat {
+        /// The recording being written.
+        path: PathBuf,
+        /// The writer's error.
+        #[source]
+        source: AedatError,
+    },
+    /// The manifest could not be written.
+    #[error(transparent)]
+    Manifest(#[from] ManifestError),
+    /// A JSON file could not be serialised.
+    #[error("cannot serialise {path}: {source}")]
+    Json {
+        /// The JSON file.
+        path: PathBuf,
+        /// The serialiser's error.
+        #[source]
+        source: serde_json::Error,
+    },
+}
+
+/// What to simulate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DatasetConfig {
+    /// The protocol.
+    pub protocol: Protocol,
+    /// How many trials.
+    pub scale: Scale,
+    /// The dataset's seed: the camera's fixed pattern comes from it alone (the same sensor for
+    /// every protocol), the trials from it and the protocol.
+    pub seed: u64,
+    /// The simulator's parameters.
+    pub params: SimParams,
+    /// AEDAT4 packet compression.
+    pub compression: Compression,
+    /// Simulate only the first this many trials of the plan (tests, benchmarks); `None`: all.
+    pub limit: Option<usize>,
+}
+
+impl DatasetConfig {
+    /// `protocol` at `scale` with default parameters and LZ4 compression (DV's default).
+    pub fn new(protocol: Protocol, scale: Scale, seed: u64) -> Self {
+        Self {
+            protocol,
+            scale,
+            seed,
+            params: SimParams::default(),
+            compression: Compression::Lz4,
+            limit: None,
+        }
+    }
+}
+
+/// What `simulator.json` holds.
+#[derive(Serialize)]
+struct SimulatorRecord<'a> {
+    generator: String,
+    protocol: Protocol,
+    scale: Scale,
+    seed: u64,
+    trials: usize,
+    hot_pixels: Vec<(u16, u16, f64)>,
+    params: &'a SimParams,
+}
+
+/// The camera seed of a dataset seed.
+fn camera_seed(seed: u64) -> u64 {
+    trial_seed(seed, usize::MAX)
+}
+
+/// Simulates `config` into `out_dir` (created if missing; existing files of the same names are
+/// replaced). `on_trial_done` is called, from worker threads, after each trial's files are
+/// written. Returns the manifest written to `out_dir/trials.csv`.
+pub fn simulate_dataset(
+    config: &DatasetConfig,
+    out_dir: &Path,
+    on_trial_done: impl Fn(&TrialMeta) + Sync,
+) -> Result<Manifest, DatasetError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| DatasetError::Io { path, source }
+    };
+    let truth_dir = out_dir.join("truth");
+    std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
+    let sim = Simulator::new(config.params.clone(), camera_seed(config.seed));
+    let mut trials = plan(
+        config.protocol,
+        config.scale,
+        config.seed,
+        &config.params.timeline,
+    );
+    trials.truncate(config.limit.unwrap_or(usize::MAX));
+
+    let rest = sim.simulate_rest(trial_seed(config.seed, usize::MAX - 1));
+    let camera = &config.params.camera;
+    let resolution = Resolution::new(camera.width, camera.height);
+    write_recording(
+        &out_dir.join("no_contact.aedat4"),
+        &rest,
+        resolution,
+        config.compression,
+    )?;
+
+    let total = config.params.timeline.total_deg;
+    let metas = trials
+        .par_iter()
+        .map(|spec| {
+            let recording = sim.simulate(spec);
+            let file = format!("{}.aedat4", spec.name);
+            let truth = format!("truth/{}.csv", spec.name);
+            write_recording(
+                &out_dir.join(&file),
+                &recording,
+                resolution,
+                config.compression,
+            )?;
+            write_truth(&out_dir.join(&truth), &recording.truth)?;
+            let meta = recording.meta(&file, Some(&truth), total);
+            on_trial_done(&meta);
+            Ok(meta)
+        })
+        .collect::<Result<Vec<_>, DatasetError>>()?;
+    let manifest = Manifest { trials: metas };
+
+    write_json(&out_dir.join("calibration.json"), sim.calibration())?;
+    write_json(
+        &out_dir.join("simulator.json"),
+        &SimulatorRecord {
+            generator: format!("evtac-sim {}", env!("CARGO_PKG_VERSION")),
+            protocol: config.protocol,
+            scale: config.scale,
+            seed: config.seed,
+            trials: manifest.trials.len(),
+            hot_pixels: sim.pixel_array().hot_pixels(),
+            params: &config.params,
+        },
+    )?;
+    manifest.write(out_dir)?;
+    Ok(manifest)
+}
+
+/// Writes a recording's events and IMU samples as an AEDAT4 file of a `resolution` sensor.
+pub fn write_recording(
+    path: &Path,
+    recording: &TrialRecording,
+    resolution: Resolution,
+    compression: Compression,
+) -> Result<(), DatasetError> {
+    let aedat = |source| DatasetError::Aedat {
+        path: path.to_path_buf(),
+        source,
+    };
+    let config = WriterConfig {
+        resolution,
+        source_name: SOURCE_NAME.into(),
+        compression,
+    };
+    let mut writer = AedatWriter::create(path, config).map_err(aedat)?;
+    // Interleave by time so that readers see IMU and events side by side, as from a camera.
+    let mut imu = recording.imu.as_slice();
+    for chunk in recording.events.chunks(4096) {
+        let until = chunk.last().map_or(i64::MIN, |e| e.t);
+        let n = imu.partition_point(|s| s.t <= until);
+        writer.write_imu(&imu[..n]).map_err(aedat)?;
+        imu = &imu[n..];
+        writer.write_events(chunk).map_err(aedat)?;
+    }
+    writer.write_imu(imu).map_err(aedat)?;
+    writer.finish().map_err(aedat)?;
+    Ok(())
+}
+
+/// Writes ground truth as `t_us,theta_deg,pitch_deg,roll_deg`.
+pub fn write_truth(path: &Path, truth: &[TruthSample]) -> Result<(), DatasetError> {
+    let io = |source| DatasetError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut out = std::io::BufWriter::new(file);
+    writeln!(out, "t_us,theta_deg,pitch_deg,roll_deg").map_err(io)?;
+    for s in truth {
+        writeln!(
+            out,
+            "{},{:.6},{:.6},{:.6}",
+            s.t_us, s.theta_deg, s.pitch_deg, s.roll_deg
+        )
+        .map_err(io)?;
+    }
+    out.flush().map_err(io)
+}
+
+fn write_json(path: &Path, value: &impl Serialize) -> Result<(), DatasetError> {
+    let text = serde_json::to_string_pretty(value).map_err(|source| DatasetError::Json {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    std::fs::write(path, text + "\n").map_err(|source| DatasetError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}

@@ -1,0 +1,338 @@
+//! One trial from start to end: the commanded motion, the skin's lag behind it, the pins, the
+//! event camera and the IMU.
+//!
+//! The skin does not follow the robot instantly: its tilt and depth follow the commanded ones
+//! through a first-order lag with time constant `skin_tau_s` (integrated exactly for inputs that
+//! are linear within a step). The lag of the tilt drives the shear of the contact patch (see
+//! [`crate::sensor`]), so a stop makes the skin relax over a few time constants, a burst of
+//! "elastic recoil" events that dies out, and then the sensor is quiet.
+//!
+//! Steps are adaptive: each is as long as possible (up to `max_step_s`) such that no pin's image
+//! moves more than `max_px_per_step` pixels.
+
+use evtac_events::manifest::TrialMeta;
+use evtac_events::{Event, ImuSample};
+use evtac_labels::geometry::{Calibration, contact_angles};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::dvs::{Dvs, PixelArray, gaussian};
+use crate::imu::simulate_imu;
+use crate::params::SimParams;
+use crate::protocol::{Motion, TrialSpec};
+use crate::sensor::{Dome, Gains, PinImage, SkinPose};
+
+/// One ground-truth sample: the commanded pose.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TruthSample {
+    /// Time, microseconds.
+    pub t_us: i64,
+    /// Commanded tilt magnitude, degrees.
+    pub theta_deg: f64,
+    /// Contact pitch, degrees.
+    pub pitch_deg: f64,
+    /// Contact roll, degrees.
+    pub roll_deg: f64,
+}
+
+/// Everything one simulated trial produced, in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrialRecording {
+    /// What the trial did.
+    pub spec: TrialSpec,
+    /// Events on the full 640x480 sensor, time-sorted.
+    pub events: Vec<Event>,
+    /// IMU samples at the IMU's rate.
+    pub imu: Vec<ImuSample>,
+    /// The commanded pose at the truth rate.
+    pub truth: Vec<TruthSample>,
+    /// When the tilt starts, microseconds.
+    pub motion_start_us: i64,
+    /// When the final tilt is reached, microseconds.
+    pub motion_end_us: i64,
+    /// The stop's start and end, microseconds (Experiment 2).
+    pub stop_us: Option<(i64, i64)>,
+    /// Length of the recording, microseconds.
+    pub duration_us: i64,
+}
+
+impl TrialRecording {
+    /// The manifest row for this trial, given where its files are (relative to the dataset).
+    pub fn meta(&self, file: &str, truth: Option<&str>, total_deg: f64) -> TrialMeta {
+        TrialMeta {
+            trial: self.spec.name.clone(),
+            file: file.into(),
+            truth: truth.map(Into::into),
+            direction_deg: self.spec.direction_deg,
+            speed_deg_s: self.spec.speed_deg_s,
+            depth_mm: if self.spec.contact {
+                self.spec.depth_mm
+            } else {
+                0.0
+            },
+            total_deg,
+            motion_start_us: self.motion_start_us,
+            motion_end_us: self.motion_end_us,
+            stop_start_us: self.stop_us.map(|s| s.0),
+            stop_end_us: self.stop_us.map(|s| s.1),
+            stop_deg: self.spec.stop_deg,
+            group: self.spec.group.clone(),
+        }
+    }
+}
+
+/// The simulator: one sensor (tip, camera with its fixed pattern, IMU mounting) that records
+/// trials.
+pub struct Simulator {
+    params: SimParams,
+    calibration: Calibration,
+    dome: Dome,
+    array: PixelArray,
+}
+
+impl Simulator {
+    /// A sensor with these parameters; `camera_seed` draws the camera's fixed pattern
+    /// (threshold mismatch, hot pixels), shared by all its trials.
+    pub fn new(params: SimParams, camera_seed: u64) -> Self {
+        let dome = Dome::new(&params.sensor, &params.contact, &params.camera);
+        let array = PixelArray::new(&params.dvs, &params.camera, camera_seed);
+        let calibration = Calibration {
+            imu_to_sensor: params.imu.imu_to_sensor,
+            tip_radius_mm: params.sensor.tip_radius_mm,
+        };
+        Self {
+            params,
+            calibration,
+            dome,
+            array,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &SimParams {
+        &self.params
+    }
+
+    /// The sensor's calibration (what `calibration.json` holds).
+    pub fn calibration(&self) -> &Calibration {
+        &self.calibration
+    }
+
+    /// The camera's fixed pattern.
+    pub fn pixel_array(&self) -> &PixelArray {
+        &self.array
+    }
+
+    /// Simulates one trial.
+    pub fn simulate(&self, spec: &TrialSpec) -> TrialRecording {
+        let gap = if spec.contact {
+            self.params.contact.approach_gap_mm
+        } else {
+            self.params.contact.no_contact_gap_mm
+        };
+        let motion = Motion::new(spec, &self.params.timeline, gap);
+        self.run(spec, &motion)
+    }
+
+    /// The `no_contact.aedat4` recording: the sensor at rest out of contact, noise only.
+    pub fn simulate_rest(&self, seed: u64) -> TrialRecording {
+        let spec = TrialSpec {
+            name: "no_contact".into(),
+            direction_deg: 0.0,
+            speed_deg_s: 0.0,
+            depth_mm: 0.0,
+            stop_deg: None,
+            group: None,
+            contact: false,
+            seed,
+        };
+        let motion = Motion::rest(
+            self.params.timeline.no_contact_s,
+            self.params.contact.no_contact_gap_mm,
+        );
+        self.run(&spec, &motion)
+    }
+
+    fn run(&self, spec: &TrialSpec, motion: &Motion) -> TrialRecording {
+        let stream = |k: u64| {
+            let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+            rng.set_stream(k);
+            rng
+        };
+        let mut variation = stream(1);
+        let v = self.params.contact.trial_variation;
+        let mut gain = || (1.0 + v * gaussian(&mut variation)).max(0.1);
+        let gains = Gains {
+            normal: gain(),
+            spread: gain(),
+            shear: gain(),
+        };
+        let events = self.events(spec, motion, &gains, rand::Rng::next_u64(&mut stream(2)));
+        let imu = simulate_imu(
+            &self.params.imu,
+            &self.calibration,
+            motion,
+            spec.direction_deg,
+            rand::Rng::next_u64(&mut stream(3)),
+        );
+        let us = |t: f64| (t * 1e6).round() as i64;
+        let duration_us = us(motion.end_s);
+        let period = (1e6 / self.params.timeline.truth_rate_hz.max(1.0))
+            .round()
+            .max(1.0) as i64;
+        let truth = (0..=duration_us / period)
+            .map(|k| {
+                let t_us = k * period;
+                let theta = motion.theta(t_us as f64 * 1e-6);
+                let (pitch, roll) = contact_angles(theta, spec.direction_deg);
+                TruthSample {
+                    t_us,
+                    theta_deg: theta,
+                    pitch_deg: pitch,
+                    roll_deg: roll,
+                }
+            })
+            .collect();
+        TrialRecording {
+            spec: spec.clone(),
+            events,
+            imu,
+            truth,
+            motion_start_us: us(motion.motion_start_s),
+            motion_end_us: us(motion.motion_end_s),
+            stop_us: motion
+                .stop_start_s
+                .zip(motion.stop_end_s)
+                .map(|(a, b)| (us(a), us(b))),
+            duration_us,
+        }
+    }
+
+    fn events(&self, spec: &TrialSpec, motion: &Motion, gains: &Gains, seed: u64) -> Vec<Event> {
+        let p = &self.params;
+        let tau = p.contact.skin_tau_s.max(1e-6);
+        let (max_px, min_dt, max_dt) = (
+            p.dvs.max_px_per_step.max(1e-3) as f32,
+            p.dvs.min_step_s.max(1e-7),
+            p.dvs.max_step_s.max(p.dvs.min_step_s.max(1e-7)),
+        );
+        let pose = |theta_s: f64, depth_s: f64, t: f64| SkinPose {
+            theta_deg: theta_s,
+            phi_deg: spec.direction_deg,
+            depth_mm: depth_s,
+            lag_deg: motion.theta(t) - theta_s,
+        };
+        // The skin's lagged state: exact first-order response to a linearly changing input.
+        let follow = |x0: f64, c0: f64, c1: f64, dt: f64| {
+            let b = (c1 - c0) / dt;
+            c1 - b * tau + (x0 - c0 + b * tau) * (-dt / tau).exp()
+        };
+        let (mut theta_s, mut depth_s) = (motion.theta(0.0), motion.depth(0.0));
+        let mut pins = Vec::new();
+        self.dome
+            .pins(&pose(theta_s, depth_s, 0.0), gains, &mut pins);
+        let mut dvs = Dvs::new(&self.array, &p.dvs, &p.camera, &pins, seed);
+        let mut next: Vec<PinImage> = Vec::new();
+        let mut events = Vec::new();
+        let (mut t, mut dt) = (0.0, min_dt);
+        while t < motion.end_s {
+            let (mut t1, mut th1, mut de1, mut disp);
+            let mut tries = 0;
+            loop {
+                t1 = (t + dt).min(motion.end_s);
+                let h = t1 - t;
+                th1 = follow(theta_s, motion.theta(t), motion.theta(t1), h);
+                de1 = follow(depth_s, motion.depth(t), motion.depth(t1), h);
+                self.dome.pins(&pose(th1, de1, t1), gains, &mut next);
+                disp = pins
+                    .iter()
+                    .zip(&next)
+                    .map(|(a, b)| (a.x - b.x).abs().max((a.y - b.y).abs()))
+                    .fold(0f32, f32::max);
+                tries += 1;
+                if disp <= max_px || dt <= min_dt || tries >= 6 {
+                    break;
+                }
+                dt = (dt * 0.8 * f64::from(max_px / disp)).max(min_dt);
+            }
+            dvs.step(t1, &next, &mut events);
+            std::mem::swap(&mut pins, &mut next);
+            let used = t1 - t;
+            (t, theta_s, depth_s) = (t1, th1, de1);
+            // Next step: as long as the current pin speed allows, growing at most twofold.
+            let ideal = if disp > 0.0 {
+                used * f64::from(max_px / disp)
+            } else {
+                max_dt
+            };
+            dt = ideal.min(2.0 * used.max(min_dt)).clamp(min_dt, max_dt);
+        }
+        events
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::DvsParams;
+    use crate::protocol::{Protocol, Scale, plan};
+
+    fn spec(speed: f64, depth: f64) -> TrialSpec {
+        let mut s = plan(Protocol::Exp1, Scale::Tiny, 1, &Default::default()).remove(0);
+        s.speed_deg_s = speed;
+        s.depth_mm = depth;
+        s
+    }
+
+    fn quiet_sim() -> Simulator {
+        let params = SimParams {
+            dvs: DvsParams {
+                leak_rate_hz: 0.0,
+                shot_noise_rate_hz: 0.0,
+                hot_pixels: 0,
+                ..DvsParams::default()
+            },
+            ..SimParams::default()
+        };
+        Simulator::new(params, 1)
+    }
+
+    /// Events per second during the tilt.
+    fn motion_rate(r: &TrialRecording) -> f64 {
+        let n = r
+            .events
+            .iter()
+            .filter(|e| e.t >= r.motion_start_us && e.t < r.motion_end_us)
+            .count();
+        n as f64 / ((r.motion_end_us - r.motion_start_us) as f64 * 1e-6)
+    }
+
+    #[test]
+    fn same_seed_same_trial() {
+        let sim = Simulator::new(SimParams::default(), 1);
+        let s = spec(10.0, 2.0);
+        let a = sim.simulate(&s);
+        assert_eq!(a, sim.simulate(&s));
+        assert!(a.events.windows(2).all(|w| w[0].t <= w[1].t));
+        assert!(a.events.iter().all(|e| e.x < 640 && e.y < 480));
+        assert_eq!(
+            a.truth.last().map(|t| t.t_us),
+            Some(a.duration_us / 1000 * 1000)
+        );
+    }
+
+    #[test]
+    fn quiet_before_contact_busy_during_motion() {
+        let r = quiet_sim().simulate(&spec(10.0, 2.0));
+        let rate = motion_rate(&r);
+        assert!(rate > 20_000.0, "{rate}");
+        // The last 100 ms of the settle period: the skin has settled, nothing moves.
+        let settle = r
+            .events
+            .iter()
+            .filter(|e| e.t >= r.motion_start_us - 100_000 && e.t < r.motion_start_us)
+            .count();
+        assert!(settle < 50, "{settle}");
+    }
+}

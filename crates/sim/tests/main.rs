@@ -1,0 +1,4 @@
+//! Integration tests of the simulator: one test binary, one module per concern.
+
+mod behaviour;
+mod dataset;
