@@ -1,2 +1,152 @@
-//! Decoding throughput benchmark (being built).
-fn main() {}
+//! AEDAT 4.0 decoding throughput (events/s), LZ4 and zstd, against the raw decompressors.
+//!
+//! Setup writes two files of 3 million synthetic events (640x480, ~1 Mev/s, seeded) with our
+//! writer into `$EVTAC_BENCH_DIR` (default: `<tmp>/evtac-aedat-bench`), where
+//! `benches/aedat_reference.py` times dv-processing and the `aedat` Python package on the same
+//! files. Groups:
+//! - `aedat_decode/{lz4,zstd}`: `AedatReader` over the file held in memory, all events.
+//! - `decompress_only/{lz4,zstd}`: lz4_flex / zstd alone on the same packet payloads (the floor).
+
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
+use evtac_events::{Event, Resolution};
+
+const EVENTS: usize = 3_000_000;
+
+/// Seeded synthetic events (xorshift64): 0..=1 us apart, uniform over the sensor.
+fn events(res: Resolution) -> Vec<Event> {
+    let mut s = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    };
+    let mut t = 1_700_000_000_000_000i64;
+    (0..EVENTS)
+        .map(|_| {
+            let r = next();
+            t += (r & 1) as i64;
+            Event {
+                t,
+                x: ((r >> 8) % u64::from(res.width)) as u16,
+                y: ((r >> 24) % u64::from(res.height)) as u16,
+                polarity: r >> 63 == 1,
+            }
+        })
+        .collect()
+}
+
+fn bench_dir() -> PathBuf {
+    std::env::var_os("EVTAC_BENCH_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| std::env::temp_dir().join("evtac-aedat-bench"))
+}
+
+/// The compressed bodies of every packet in an AEDAT 4.0 file (up to its data table).
+fn payloads(bytes: &[u8]) -> Vec<&[u8]> {
+    let reader = AedatReader::from_slice(bytes).expect("our own file");
+    let end = reader.header().data_table_position.expect("data table") as usize;
+    let header_len = u32::from_le_bytes(bytes[14..18].try_into().expect("4 bytes")) as usize;
+    let mut pos = 18 + header_len;
+    let mut out = Vec::new();
+    while pos < end {
+        let size = i32::from_le_bytes(bytes[pos + 4..pos + 8].try_into().expect("4 bytes"));
+        let size = usize::try_from(size).expect("non-negative size");
+        out.push(&bytes[pos + 8..pos + 8 + size]);
+        pos += 8 + size;
+    }
+    out
+}
+
+/// Packet bytes fed to the reused LZ4 frame decoder.
+#[derive(Default)]
+struct Source {
+    bytes: Vec<u8>,
+    pos: usize,
+}
+
+impl std::io::Read for Source {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let rest = &self.bytes[self.pos..];
+        let n = rest.len().min(buf.len());
+        buf[..n].copy_from_slice(&rest[..n]);
+        self.pos += n;
+        Ok(n)
+    }
+}
+
+fn decode(c: &mut Criterion) {
+    let res = Resolution::new(640, 480);
+    let events = events(res);
+    let dir = bench_dir();
+    std::fs::create_dir_all(&dir).expect("bench dir");
+    let mut files = Vec::new();
+    for (name, compression) in [("lz4", Compression::Lz4), ("zstd", Compression::Zstd)] {
+        let path = dir.join(format!("bench_{name}.aedat4"));
+        let config = WriterConfig {
+            resolution: res,
+            source_name: "DVXplorer_BENCH".into(),
+            compression,
+        };
+        let mut w = AedatWriter::create(&path, config).expect("create");
+        w.write_events(&events).expect("write");
+        w.finish().expect("finish");
+        eprintln!("wrote {}", path.display());
+        files.push((name, std::fs::read(&path).expect("read back")));
+    }
+
+    let mut g = c.benchmark_group("aedat_decode");
+    g.throughput(Throughput::Elements(EVENTS as u64));
+    for (name, bytes) in &files {
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut r = AedatReader::from_slice(black_box(bytes)).expect("header");
+                let mut n = 0usize;
+                while let Some(chunk) = r.next_chunk().expect("decode") {
+                    n += chunk.events.len();
+                }
+                assert_eq!(n, EVENTS);
+                n
+            })
+        });
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("decompress_only");
+    g.throughput(Throughput::Elements(EVENTS as u64));
+    for (name, bytes) in &files {
+        let packets = payloads(bytes);
+        let mut out = Vec::with_capacity(1 << 20);
+        // One LZ4 frame decoder for all packets (its window buffers reused), as the reader does.
+        let mut lz4 = lz4_flex::frame::FrameDecoder::new(Source::default());
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut total = 0usize;
+                for p in &packets {
+                    out.clear();
+                    if *name == "lz4" {
+                        use std::io::Read;
+                        let src = lz4.get_mut();
+                        src.bytes.clear();
+                        src.bytes.extend_from_slice(p);
+                        src.pos = 0;
+                        lz4.read_to_end(&mut out).expect("lz4");
+                    } else {
+                        out.reserve(1 << 20);
+                        zstd::bulk::decompress_to_buffer(p, &mut out).expect("zstd");
+                    }
+                    total += out.len();
+                }
+                black_box(total)
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, decode);
+criterion_main!(benches);

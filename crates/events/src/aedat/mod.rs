@@ -1,1 +1,64 @@
 //! AEDAT 4.0 (iniVation DV) files and network streams: reader and writer.
+//!
+//! An AEDAT 4.0 file is the magic `#!AER-DAT4.0\r\n`, a size-prefixed `IOHeader` flatbuffer
+//! (compression, data-table position, and an XML description of the streams), then packets:
+//! an 8-byte header (stream id `i32`, size `i32`, little-endian) and the packet's size-prefixed
+//! flatbuffer (`EventPacket`, `IMUPacket`, `TriggerPacket`, ...), compressed on its own with LZ4
+//! or zstd when the header says so. An optional data table (an index of the packets) ends the
+//! file. DV's network protocol (`dv.io.NetworkWriter`) sends the same header and packets without
+//! the magic and the data table. The schemas are in `crates/events/schema/`.
+//!
+//! [`AedatReader`] streams packets from any `Read` with bounded memory; [`AedatWriter`] writes
+//! events and IMU samples that dv-processing reads back exactly.
+//!
+//! ```
+//! use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
+//! use evtac_events::{Event, ImuSample, Resolution};
+//!
+//! let config = WriterConfig {
+//!     resolution: Resolution::new(640, 480),
+//!     source_name: "DVXplorer_DXA00000".into(),
+//!     compression: Compression::Lz4,
+//! };
+//! let mut writer = AedatWriter::new(Vec::new(), config)?;
+//! writer.write_events(&[Event { t: 10, x: 320, y: 240, polarity: false }])?;
+//! writer.write_imu(&[ImuSample { t: 12, accelerometer: [0.0, -1.0, 0.0], ..Default::default() }])?;
+//! let bytes = writer.finish()?;
+//!
+//! let mut reader = AedatReader::from_slice(&bytes)?;
+//! assert_eq!(reader.source(), Some("DVXplorer_DXA00000"));
+//! let (mut events, mut imu) = (0, 0);
+//! while let Some(chunk) = reader.next_chunk()? {
+//!     events += chunk.events.len();
+//!     imu += chunk.imu.len();
+//! }
+//! assert_eq!((events, imu), (1, 1));
+//! # Ok::<(), evtac_events::aedat::AedatError>(())
+//! ```
+
+mod compression;
+mod error;
+mod header;
+mod packet;
+mod reader;
+pub mod schema;
+mod writer;
+
+pub use compression::MAX_PACKET_BYTES;
+pub use error::{AedatError, Result};
+pub use header::{AedatHeader, Compression, MAGIC, StreamInfo, StreamKind, parse_description};
+pub use reader::{AedatChunk, AedatReader, Events};
+pub use writer::{AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, WriterConfig};
+
+/// Decodes `data` completely, as a file and as a network stream, discarding the results: the
+/// entry point of the `aedat` cargo-fuzz target. It must never panic, whatever the bytes.
+#[doc(hidden)]
+pub fn fuzz_decode(data: &[u8]) {
+    if let Ok(mut reader) = AedatReader::from_slice(data) {
+        while let Ok(Some(_)) = reader.next_chunk() {}
+    }
+    if let Ok(mut reader) = AedatReader::network(data) {
+        while let Ok(Some(_)) = reader.next_chunk() {}
+    }
+    let _ = std::str::from_utf8(data).map(parse_description);
+}
