@@ -39,6 +39,7 @@
 //! ```
 
 pub mod bias;
+pub mod dataset;
 pub mod error;
 pub mod filter;
 pub mod geometry;
@@ -49,6 +50,7 @@ pub mod series;
 pub mod trial;
 pub mod validation;
 
+pub use dataset::{DatasetLabels, TrialReport, label_dataset, label_trial, read_calibration};
 pub use error::{Error, TrialError};
 pub use scale::ScaleMethod;
 pub use series::LabelSeries;

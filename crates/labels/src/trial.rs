@@ -267,14 +267,29 @@ pub fn label_imu(
         .collect();
     let integral = CumulativeTrapezoid::new(t, &corrected)?;
     let moving = motion.moving_intervals(config.hold_stops);
-    // The bias-free rate integrated over the moving intervals up to `t_us`.
-    let travelled = |t_us: i64| -> f64 {
-        moving
+    // Each moving interval with the running integral at its ends.
+    let spans: Vec<(i64, i64, f64, f64)> = moving
+        .iter()
+        .map(|&(a, b)| (a, b, integral.at(a), integral.at(b)))
+        .collect();
+    // The bias-free rate integrated over the moving intervals up to sample `i`; the running
+    // integral at a sample is already known, so no search is needed.
+    let travelled_at_sample = |i: usize| -> f64 {
+        let ti = t[i];
+        spans
             .iter()
-            .map(|&(a, b)| integral.between(a, t_us.clamp(a, b)))
+            .map(|&(a, b, ia, ib)| {
+                if ti <= a {
+                    0.0
+                } else if ti >= b {
+                    ib - ia
+                } else {
+                    integral.at_samples()[i] - ia
+                }
+            })
             .sum()
     };
-    let measured_deg = travelled(motion.motion_end_us);
+    let measured_deg: f64 = spans.iter().map(|&(_, _, ia, ib)| ib - ia).sum();
     let scale_factor = match config.scale {
         ScaleMethod::TotalRotation => scale::factor(
             "rotation (deg)",
@@ -299,7 +314,9 @@ pub fn label_imu(
         }
         ScaleMethod::None => 1.0,
     };
-    let held: Vec<f64> = t.iter().map(|&t| scale_factor * travelled(t)).collect();
+    let held: Vec<f64> = (0..t.len())
+        .map(|i| scale_factor * travelled_at_sample(i))
+        .collect();
     let filter = LowPass::new(config.filter_order, config.cutoff_hz, rate.fs_hz())?;
     let mut theta = filter.filtfilt(&held)?;
     // Where the robot is still, the held value is exact; the filter only shapes the motion.

@@ -1,5 +1,6 @@
 //! Integration tests of `evtac-labels`: one test binary, one module per concern.
 
+mod dataset;
 mod degenerate;
 mod pipeline;
 mod simulated;
