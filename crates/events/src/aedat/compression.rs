@@ -2,6 +2,10 @@
 //! *frame* (`LZ4F_compressFrame`: magic `04 22 4D 18`, linked 64 KiB blocks) and zstd as one
 //! zstd frame. Decompressor state and buffers live as long as the reader, so decoding a packet
 //! allocates nothing once the buffers have grown to the largest packet.
+//!
+//! DV reads and writes these with the C libraries (`LZ4F_*`, `ZSTD_*`); the LZ4 frames are
+//! decoded block by block with lz4_flex, the zstd frames with the zstd crate (bindings to the same
+//! C library).
 
 use std::io::{self, Read, Write};
 
@@ -11,49 +15,85 @@ use super::header::Compression;
 /// limit keeps a corrupt or hostile size from exhausting memory.
 pub const MAX_PACKET_BYTES: u64 = 1 << 30;
 
-/// The compressed bytes of the current packet, read by the LZ4 frame decoder. Owning the bytes
-/// here lets one `FrameDecoder` (and its 64 KiB window buffers) serve every packet.
-#[derive(Default)]
-struct PacketSource {
-    bytes: Vec<u8>,
-    pos: usize,
-}
+/// LZ4 frame magic number (little-endian `04 22 4D 18`).
+const LZ4_MAGIC: u32 = 0x184D_2204;
 
-impl Read for PacketSource {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        let rest = self.bytes.get(self.pos..).unwrap_or_default();
-        let n = rest.len().min(buf.len());
-        buf[..n].copy_from_slice(&rest[..n]);
-        self.pos += n;
-        Ok(n)
-    }
-}
-
-/// Walks an LZ4 frame's block structure and checks that it ends with its end mark (and content
-/// checksum, when flagged) exactly at the end of `bytes`. lz4_flex's `FrameDecoder` reports a
-/// frame cut at a block boundary as a clean end, which would hide a truncated packet.
-fn lz4_frame_is_complete(bytes: &[u8]) -> Result<(), String> {
+/// Decodes one LZ4 frame (the format of the LZ4 frame specification, v1.6) into
+/// the front of `out`, growing `out` as needed; returns the decoded length.
+///
+/// Written here rather than with lz4_flex's `FrameDecoder` because that decoder (a) reports a
+/// frame cut at a block boundary as a clean end, which would hide truncated packets, and (b)
+/// copies every byte twice through its own buffers; this walks the blocks and hands each to
+/// lz4_flex's block decoder, writing straight into the packet buffer. Block and content
+/// checksums (which DV does not write) are skipped, not verified. `out` keeps its length
+/// between packets (only `..returned` is meaningful) so it is zeroed only when it grows.
+fn lz4_decode_frame(bytes: &[u8], out: &mut Vec<u8>) -> Result<usize, String> {
     let cut = || "the LZ4 frame is cut short".to_owned();
-    let flg = *bytes.get(4).ok_or_else(cut)?;
-    // magic (4), FLG, BD, optional content size (8) and dictionary id (4), header checksum.
-    let mut pos =
-        4 + 2 + if flg & 0x08 != 0 { 8 } else { 0 } + if flg & 0x01 != 0 { 4 } else { 0 } + 1;
+    let take = |pos: usize, n: usize| bytes.get(pos..pos + n).ok_or_else(cut);
+    let word = |pos: usize| -> Result<u32, String> {
+        let w = take(pos, 4)?;
+        Ok(u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+    };
+    if word(0)? != LZ4_MAGIC {
+        return Err("not an LZ4 frame (bad magic number)".to_owned());
+    }
+    let flg = take(4, 1)?[0];
+    let bd = take(5, 1)?[0];
+    if flg >> 6 != 1 {
+        return Err(format!("unsupported LZ4 frame version {}", flg >> 6));
+    }
+    let linked = flg & 0x20 == 0;
     let block_checksum = if flg & 0x10 != 0 { 4 } else { 0 };
+    let max_block = match (bd >> 4) & 7 {
+        4 => 64 << 10,
+        5 => 256 << 10,
+        6 => 1 << 20,
+        7 => 4 << 20,
+        other => return Err(format!("bad LZ4 block size code {other}")),
+    };
+    // magic, FLG, BD, optional content size (8) and dictionary id (4), header checksum (1).
+    let mut pos = 6 + if flg & 0x08 != 0 { 8 } else { 0 } + if flg & 0x01 != 0 { 4 } else { 0 } + 1;
+    let mut len = 0usize;
     loop {
-        let word = bytes
-            .get(pos..pos + 4)
-            .and_then(|w| w.first_chunk::<4>())
-            .ok_or_else(cut)?;
-        let size = u32::from_le_bytes(*word) & 0x7FFF_FFFF;
+        let head = word(pos)?;
         pos += 4;
-        if size == 0 {
+        if head == 0 {
             break;
         }
-        pos += size as usize + block_checksum;
+        let size = (head & 0x7FFF_FFFF) as usize;
+        if size > max_block {
+            return Err(format!(
+                "LZ4 block of {size} bytes exceeds the frame's {max_block}"
+            ));
+        }
+        let block = take(pos, size)?;
+        pos += size + block_checksum;
+        if (len + max_block) as u64 > MAX_PACKET_BYTES {
+            return Err(format!(
+                "decompresses to more than the {MAX_PACKET_BYTES} bytes accepted"
+            ));
+        }
+        if out.len() < len + max_block {
+            out.resize(len + max_block, 0);
+        }
+        let n = if head & 0x8000_0000 != 0 {
+            out[len..len + size].copy_from_slice(block);
+            size
+        } else if linked && len > 0 {
+            // Linked blocks may refer to the previous 64 KiB of output.
+            let (before, rest) = out.split_at_mut(len);
+            let dict = &before[len.saturating_sub(64 << 10)..];
+            lz4_flex::block::decompress_into_with_dict(block, &mut rest[..max_block], dict)
+                .map_err(|e| e.to_string())?
+        } else {
+            lz4_flex::block::decompress_into(block, &mut out[len..len + max_block])
+                .map_err(|e| e.to_string())?
+        };
+        len += n;
     }
     pos += if flg & 0x04 != 0 { 4 } else { 0 };
     match pos.cmp(&bytes.len()) {
-        std::cmp::Ordering::Equal => Ok(()),
+        std::cmp::Ordering::Equal => Ok(len),
         std::cmp::Ordering::Greater => Err(cut()),
         std::cmp::Ordering::Less => Err(format!(
             "{} bytes left over after the LZ4 frame",
@@ -65,7 +105,7 @@ fn lz4_frame_is_complete(bytes: &[u8]) -> Result<(), String> {
 /// Decompresses packets one after the other into a reused buffer.
 pub(crate) struct Decompressor {
     compression: Compression,
-    lz4: lz4_flex::frame::FrameDecoder<PacketSource>,
+    input: Vec<u8>,
     zstd: Option<zstd::bulk::Decompressor<'static>>,
     out: Vec<u8>,
 }
@@ -75,7 +115,7 @@ impl Decompressor {
     pub fn new(compression: Compression) -> Self {
         Self {
             compression,
-            lz4: lz4_flex::frame::FrameDecoder::new(PacketSource::default()),
+            input: Vec::new(),
             zstd: None,
             out: Vec::new(),
         }
@@ -83,37 +123,21 @@ impl Decompressor {
 
     /// The buffer to fill with the next packet's (compressed) body; cleared.
     pub fn input(&mut self) -> &mut Vec<u8> {
-        let src = self.lz4.get_mut();
-        src.bytes.clear();
-        src.pos = 0;
-        &mut src.bytes
+        self.input.clear();
+        &mut self.input
     }
 
     /// Decompresses the bytes put into [`Self::input`] and returns the packet's flatbuffer.
     pub fn decompress(&mut self) -> Result<&[u8], String> {
+        let input = &self.input;
         match self.compression {
-            Compression::None => Ok(&self.lz4.get_ref().bytes),
+            Compression::None => Ok(input),
             Compression::Lz4 | Compression::Lz4High => {
-                self.out.clear();
-                (&mut self.lz4)
-                    .take(MAX_PACKET_BYTES + 1)
-                    .read_to_end(&mut self.out)
-                    .map_err(|e| e.to_string())?;
-                let src = self.lz4.get_ref();
-                // lz4_flex takes a frame cut at a block boundary as complete: check the framing.
-                lz4_frame_is_complete(&src.bytes)?;
-                if src.pos != src.bytes.len() {
-                    return Err(format!(
-                        "{} bytes left over after the LZ4 frame",
-                        src.bytes.len() - src.pos
-                    ));
-                }
-                self.check_size()?;
-                Ok(&self.out)
+                let n = lz4_decode_frame(input, &mut self.out)?;
+                Ok(&self.out[..n])
             }
             Compression::Zstd | Compression::ZstdHigh => {
                 self.out.clear();
-                let input = &self.lz4.get_ref().bytes;
                 let size = zstd::zstd_safe::get_frame_content_size(input)
                     .map_err(|_| "not a zstd frame (bad frame header)".to_owned())?;
                 match size {
@@ -145,21 +169,15 @@ impl Decompressor {
                             .take(MAX_PACKET_BYTES + 1)
                             .read_to_end(&mut self.out)
                             .map_err(|e| e.to_string())?;
-                        self.check_size()?;
+                        if self.out.len() as u64 > MAX_PACKET_BYTES {
+                            return Err(format!(
+                                "decompresses to more than the {MAX_PACKET_BYTES} bytes accepted"
+                            ));
+                        }
                     }
                 }
                 Ok(&self.out)
             }
-        }
-    }
-
-    fn check_size(&self) -> Result<(), String> {
-        if self.out.len() as u64 > MAX_PACKET_BYTES {
-            Err(format!(
-                "decompresses to more than the {MAX_PACKET_BYTES} bytes accepted"
-            ))
-        } else {
-            Ok(())
         }
     }
 }
@@ -247,6 +265,45 @@ mod tests {
                 d.input().extend_from_slice(&packed);
                 assert_eq!(d.decompress().unwrap(), &data[..], "{c}");
             }
+        }
+    }
+
+    #[test]
+    fn lz4_frames_with_checksums_and_independent_blocks_decode() {
+        let data: Vec<u8> = (0..300_000u32)
+            .flat_map(|i| (i / 3).to_le_bytes())
+            .collect();
+        for (mode, checksums) in [
+            (lz4_flex::frame::BlockMode::Linked, true),
+            (lz4_flex::frame::BlockMode::Independent, false),
+            (lz4_flex::frame::BlockMode::Independent, true),
+        ] {
+            let info = lz4_flex::frame::FrameInfo::new()
+                .block_mode(mode)
+                .block_checksums(checksums)
+                .content_checksum(checksums);
+            let mut enc = lz4_flex::frame::FrameEncoder::with_frame_info(info, Vec::new());
+            enc.write_all(&data).unwrap();
+            let frame = enc.finish().unwrap();
+            let mut out = Vec::new();
+            let n = lz4_decode_frame(&frame, &mut out).unwrap();
+            assert_eq!(&out[..n], &data[..]);
+        }
+    }
+
+    #[test]
+    fn lz4_frame_cut_at_a_block_boundary_is_an_error() {
+        let data: Vec<u8> = (0..100_000u32).flat_map(|i| i.to_le_bytes()).collect();
+        let mut c = Compressor::new(Compression::Lz4).unwrap();
+        let frame = c.compress(&data).unwrap().to_vec();
+        // Drop the end mark, then also the last block.
+        let mut out = Vec::new();
+        assert!(lz4_decode_frame(&frame[..frame.len() - 4], &mut out).is_err());
+        for cut in 0..frame.len() {
+            assert!(
+                lz4_decode_frame(&frame[..cut], &mut out).is_err(),
+                "cut {cut}"
+            );
         }
     }
 

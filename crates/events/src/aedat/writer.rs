@@ -136,6 +136,14 @@ impl<W: Write> AedatWriter<W> {
     }
 
     fn start(writer: W, config: WriterConfig, patch: Option<PatchHeader<W>>) -> Result<Self> {
+        let res = config.resolution;
+        if res.width == 0 || res.height == 0 || res.width > 32768 || res.height > 32768 {
+            return Err(AedatError::InvalidInput {
+                what: format!("resolution {res}"),
+                reason: "AEDAT stores coordinates as int16: width and height must be 1..=32768"
+                    .into(),
+            });
+        }
         let compressor = Compressor::new(config.compression)
             .map_err(|source| AedatError::Io { offset: 0, source })?;
         let mut me = Self {
@@ -240,15 +248,15 @@ impl<W: Write> AedatWriter<W> {
             if self.events.is_empty() {
                 self.packet_start_t = e.t;
             }
-            self.last_event_t = e.t;
-            self.event_count += 1;
-            // Inside the resolution, so x and y fit in i16 only if < 32768: DV stores int16.
+            // `start` checked that the resolution fits AEDAT's int16 coordinates.
             let (Ok(x), Ok(y)) = (i16::try_from(e.x), i16::try_from(e.y)) else {
                 return Err(AedatError::InvalidInput {
                     what: what(),
                     reason: format!("x={}, y={} does not fit AEDAT's int16", e.x, e.y),
                 });
             };
+            self.last_event_t = e.t;
+            self.event_count += 1;
             self.events.push(FbEvent::new(e.t, x, y, e.polarity));
         }
         Ok(())
