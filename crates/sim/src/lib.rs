@@ -26,4 +26,5 @@ pub mod trial;
 pub use dataset::{DatasetConfig, DatasetError, simulate_dataset};
 pub use params::SimParams;
 pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan};
+pub use sensor::SkinPose;
 pub use trial::{Simulator, TrialRecording, TruthSample};

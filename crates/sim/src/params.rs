@@ -52,7 +52,7 @@ impl Default for SensorParams {
             pin_length_mm: 1.0,
             rings: 10,
             outer_ring_deg: 55.0,
-            pin_sigma_mm: 0.45,
+            pin_sigma_mm: 0.35,
         }
     }
 }
@@ -108,7 +108,7 @@ impl Default for ContactParams {
             spread_ref_deg: 20.0,
             fade_mm: 0.3,
             skin_tau_s: 0.06,
-            shear_mm_per_deg: 2.0,
+            shear_mm_per_deg: 1.2,
             shear_grip_mm: 0.3,
             trial_variation: 0.03,
             approach_gap_mm: 0.5,

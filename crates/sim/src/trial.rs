@@ -154,6 +154,14 @@ impl Simulator {
         self.run(&spec, &motion)
     }
 
+    /// The camera's linear brightness image (row-major, full sensor) with the skin at `pose`:
+    /// what a conventional camera inside the tip would see, for figures and checks.
+    pub fn brightness_image(&self, pose: &SkinPose) -> Vec<f32> {
+        let mut pins = Vec::new();
+        self.dome.pins(pose, &Gains::default(), &mut pins);
+        Dvs::new(&self.array, &self.params.dvs, &self.params.camera, &pins, 0).brightness_image()
+    }
+
     fn run(&self, spec: &TrialSpec, motion: &Motion) -> TrialRecording {
         let stream = |k: u64| {
             let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
