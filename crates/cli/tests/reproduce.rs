@@ -1,1 +1,109 @@
-//! Tests of `evtac reproduce`.
+//! Tests of `evtac reproduce`: the whole protocol at the tiny scale, the report with every
+//! figure, resuming, and the exported job list.
+
+use crate::common::run_ok;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// One tiny reproduction shared by the tests of `train`, `evaluate`, `tune` and `reproduce`
+/// (simulated once per test binary): its output folder.
+pub fn tiny_run() -> &'static Path {
+    static RUN: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, out) = RUN.get_or_init(|| {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let out = dir.path().join("out");
+        run_ok(&[
+            "reproduce",
+            "--scale",
+            "tiny",
+            "--seed",
+            "1",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ]);
+        (dir, out)
+    });
+    out
+}
+
+const FIGURES: [&str; 6] = [
+    "tuning.png",
+    "phase_mae.png",
+    "example_trial.png",
+    "contours.png",
+    "speed_depth.png",
+    "latency.png",
+];
+
+#[test]
+fn tiny_reproduction_writes_the_report_with_every_figure() {
+    let out = tiny_run();
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for row in ["| Static |", "| Dynamic |", "| Combined |"] {
+        assert!(report.contains(row), "no `{row}` row in:\n{report}");
+    }
+    assert!(
+        report.contains("0.160 ± 0.004"),
+        "the paper's numbers are quoted"
+    );
+    for fig in FIGURES {
+        let bytes = std::fs::read(out.join("figures").join(fig)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{fig} is not a PNG");
+        assert!(bytes.len() > 5_000, "{fig} is nearly empty");
+        assert!(
+            report.contains(&format!("(figures/{fig})")),
+            "{fig} not referenced"
+        );
+    }
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
+    assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
+    assert!(!results["exp3_speed"].as_array().unwrap().is_empty());
+    assert!(!results["exp3_depth"].as_array().unwrap().is_empty());
+    assert_eq!(results["latency"].as_array().map(Vec::len), Some(12));
+    let mae = results["exp1"][0]["test"]["overall"]["mean"]
+        .as_f64()
+        .unwrap();
+    assert!(mae.is_finite() && mae > 0.0);
+}
+
+#[test]
+fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
+    let out = tiny_run();
+    let data = out.join("data");
+    let dir = tempfile::tempdir().unwrap();
+    let list = dir.path().join("jobs.txt");
+    let args = |o: &Path| {
+        vec![
+            "reproduce".to_string(),
+            "--scale".into(),
+            "tiny".into(),
+            "--seed".into(),
+            "1".into(),
+            "--data".into(),
+            data.display().to_string(),
+            "--out".into(),
+            o.display().to_string(),
+            "--export-jobs".into(),
+            list.display().to_string(),
+        ]
+    };
+    let a = args(out);
+    run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(std::fs::read_to_string(&list).unwrap(), "");
+    let fresh = dir.path().join("fresh");
+    let a = args(&fresh);
+    run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let text = std::fs::read_to_string(&list).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    // The tiny cross: 3 static and 3 dynamic settings.
+    assert_eq!(lines.len(), 6, "{text}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.contains(" train ") && l.contains("--out"))
+    );
+    assert!(lines.iter().any(|l| l.contains("--repr static")));
+    assert!(lines.iter().any(|l| l.contains("--repr dynamic")));
+}

@@ -1,1 +1,46 @@
-//! Datasets, splits, sampling, feature caches, the paper's experiments and the report.
+//! The paper's protocol on datasets of trials: splits, sampling, feature caches, training jobs,
+//! Experiments 1-3, the latency study, and the report with its figures.
+//!
+//! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
+//!   `no_contact.aedat4`, `labels/`), labels computed when missing.
+//! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
+//! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
+//! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
+//!   computed in one pass for many configs, reused.
+//! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption.
+//! - [`training`]: one training job (`evtac train`), model loading and evaluation.
+//! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
+//!   experiments; [`pipeline`] runs them all; [`results`], [`report`] and [`plots`] write
+//!   `report.md`, `results.json` and the PNG figures.
+//!
+//! ```no_run
+//! use evtac_experiments::jobs::Quiet;
+//! use evtac_experiments::pipeline::{Datasets, reproduce};
+//! use evtac_experiments::plan::Plan;
+//! use std::path::Path;
+//!
+//! // Datasets as `evtac simulate` writes them: data/exp1, data/exp2, data/exp3-speed, ...
+//! let data = Datasets::in_dir(Path::new("data"));
+//! let plan = Plan::for_scale("small").expect("a known scale");
+//! let results = reproduce(&data, &plan, 0, Path::new("out"), &Quiet)?;
+//! println!("static test MAE {}", results.exp1[0].test.overall.display());
+//! # Ok::<(), evtac_experiments::pipeline::Error>(())
+//! ```
+
+pub mod cache;
+pub mod dataset;
+pub mod examples;
+pub mod exp1;
+pub mod exp2;
+pub mod exp3;
+pub mod jobs;
+pub mod latency;
+pub mod pipeline;
+pub mod plan;
+pub mod plots;
+pub mod report;
+pub mod results;
+pub mod sampling;
+pub mod splits;
+pub mod training;
+pub mod tuning;

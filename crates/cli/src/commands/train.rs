@@ -1,10 +1,191 @@
-//! `evtac train`.
+//! `evtac train`: train the MLP regressor on a dataset's training split (features computed and
+//! cached when missing, splits made when missing), select on its validation split, save a model
+//! bundle.
+
+use anyhow::Context;
+use evtac_experiments::cache::FeatureCache;
+use evtac_experiments::dataset::Dataset;
+use evtac_experiments::jobs;
+use evtac_experiments::sampling::{Phase, Sampling};
+use evtac_experiments::training::{self, TrainSpec};
+use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use std::path::PathBuf;
+
+/// Which representation to build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ReprKind {
+    /// Exponential-decay accumulator, masked and thresholded.
+    Static,
+    /// Sliding-window event count, thresholded.
+    Dynamic,
+    /// Pixel-wise OR of the static and dynamic frames.
+    Combined,
+}
+
+/// Representation settings shared by `train` and `tune`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ReprArgs {
+    /// Representation: static, dynamic or combined.
+    #[arg(long, value_enum)]
+    pub repr: ReprKind,
+    /// Static decay constant tau in ms (the paper's choice: 1000).
+    #[arg(long, default_value_t = 1000.0)]
+    pub tau_ms: f64,
+    /// Static binarization threshold in event contributions (the paper's choice: 2).
+    #[arg(long, default_value_t = 2.0)]
+    pub threshold: f32,
+    /// Dynamic window length in ms (the paper's choice: 640).
+    #[arg(long, default_value_t = 640.0)]
+    pub window_ms: f64,
+    /// Dynamic binarization threshold in events per pixel (the paper's choice: 0).
+    #[arg(long, default_value_t = 0)]
+    pub count_threshold: u32,
+    /// A full representation config as JSON (`evtac_repr::ReprConfig`), overriding the flags
+    /// above (for the static accumulator's other settings).
+    #[arg(long)]
+    pub repr_json: Option<PathBuf>,
+}
+
+impl ReprArgs {
+    /// The representation config these flags describe.
+    pub fn config(&self) -> anyhow::Result<ReprConfig> {
+        if let Some(path) = &self.repr_json {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            let config: ReprConfig = serde_json::from_str(&text)
+                .with_context(|| format!("{} is not a representation config", path.display()))?;
+            config.validate()?;
+            return Ok(config);
+        }
+        let s = StaticConfig {
+            tau_ms: self.tau_ms,
+            threshold: self.threshold,
+            ..StaticConfig::default()
+        };
+        let d = DynamicConfig {
+            window_ms: self.window_ms,
+            count_threshold: self.count_threshold,
+        };
+        let config = match self.repr {
+            ReprKind::Static => ReprConfig::Static(s),
+            ReprKind::Dynamic => ReprConfig::Dynamic(d),
+            ReprKind::Combined => ReprConfig::Combined {
+                static_part: s,
+                dynamic_part: d,
+            },
+        };
+        config.validate()?;
+        Ok(config)
+    }
+}
 
 /// Arguments of `evtac train`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Dataset folder (with `trials.csv`).
+    pub dataset: PathBuf,
+    /// The representation.
+    #[command(flatten)]
+    pub repr: ReprArgs,
+    /// Training epochs (the paper: 100).
+    #[arg(long, default_value_t = 100)]
+    pub epochs: usize,
+    /// Seed of the initial weights and the shuffling.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Seed of the train/validation/test split, used when `splits.json` is missing.
+    #[arg(long, default_value_t = 0)]
+    pub splits_seed: u64,
+    /// Also sample 10 points of each trial's stop phase (Experiment 2's sampling).
+    #[arg(long)]
+    pub stop_samples: bool,
+    /// Train and validate on the stop samples too (needs `--stop-samples`).
+    #[arg(long, requires = "stop_samples")]
+    pub train_on_stop: bool,
+    /// Model folder to write (a model bundle).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Train again even when `OUT` holds a finished model.
+    #[arg(long)]
+    pub force: bool,
+    /// No progress bar or summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
 
 /// Runs `evtac train`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac train is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if jobs::is_done(&args.out) && !args.force {
+        if !args.quiet {
+            eprintln!(
+                "{} already holds a finished model (use --force to train again)",
+                args.out.display()
+            );
+        }
+        return Ok(());
+    }
+    let repr = args.repr.config()?;
+    let ds = Dataset::open(&args.dataset)
+        .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
+    let splits = ds.splits(args.splits_seed)?;
+    let cache = FeatureCache::new(&ds)?;
+    let sampling = if args.stop_samples {
+        Sampling::WITH_STOP
+    } else {
+        Sampling::MOTION
+    };
+    let phases = if args.train_on_stop {
+        vec![Phase::Motion, Phase::Stop]
+    } else {
+        vec![Phase::Motion]
+    };
+    let spec = TrainSpec {
+        repr,
+        seed: args.seed,
+        epochs: args.epochs,
+        sampling,
+        phases,
+    };
+    let trials = ds.manifest.trials.iter().collect::<Vec<_>>();
+    let fbar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        crate::progress::bar(trials.len() as u64, "features")
+    };
+    cache.ensure(&trials, std::slice::from_ref(&repr), sampling, &|| {
+        fbar.inc(1)
+    })?;
+    fbar.finish_and_clear();
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        crate::progress::bar(args.epochs as u64, "training")
+    };
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "training [{elapsed_precise}] {wide_bar} epoch {pos}/{len} {msg} (eta {eta})",
+    ) {
+        bar.set_style(style);
+    }
+    let started = std::time::Instant::now();
+    let val = training::train_job(&cache, &splits, &spec, &args.out, |r| {
+        bar.set_message(format!(
+            "loss {:.4} val MAE {:.3} deg",
+            r.train_loss, r.val_mae
+        ));
+        bar.inc(1);
+    })
+    .with_context(|| format!("training into {}", args.out.display()))?;
+    bar.finish_and_clear();
+    if !args.quiet {
+        eprintln!(
+            "trained {} epochs in {:.1} s: best validation MAE {:.3} deg (pitch {:.3}, roll {:.3}); model in {}",
+            args.epochs,
+            started.elapsed().as_secs_f64(),
+            val.overall,
+            val.pitch,
+            val.roll,
+            args.out.display()
+        );
+    }
+    Ok(())
 }

@@ -1,10 +1,136 @@
-//! `evtac tune`.
+//! `evtac tune`: Experiment 1's grid search for one representation on a dataset: one training
+//! run per (decay tau x threshold) or (window x threshold), the lowest validation MAE chosen.
+
+use anyhow::Context;
+use evtac_experiments::cache::FeatureCache;
+use evtac_experiments::dataset::Dataset;
+use evtac_experiments::jobs::Progress;
+use evtac_experiments::plan::Plan;
+use evtac_experiments::tuning::{self, Kind};
+use std::path::PathBuf;
+
+/// The representation to tune.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TuneKind {
+    /// Decay tau x threshold.
+    Static,
+    /// Window x threshold.
+    Dynamic,
+}
 
 /// Arguments of `evtac tune`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Dataset folder (with `trials.csv`).
+    pub dataset: PathBuf,
+    /// Representation to tune: static or dynamic.
+    #[arg(long, value_enum)]
+    pub repr: TuneKind,
+    /// Grid and epochs of this scale: tiny, small or paper (the paper's full grid, 100 epochs).
+    #[arg(long, default_value = "paper")]
+    pub scale: String,
+    /// Epochs per run (overrides the scale's).
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// Seed of every run and of the split (when `splits.json` is missing).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Output folder for the runs' models and `tuning-<repr>.json` (default: DATASET/tuning).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+}
+
+/// Progress bars for library stages.
+#[derive(Default)]
+pub struct Bars {
+    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+}
+
+impl Progress for Bars {
+    fn stage(&self, name: &str, total: u64) {
+        if let Ok(mut b) = self.bar.lock() {
+            if let Some(old) = b.take() {
+                old.finish_and_clear();
+            }
+            *b = Some(crate::progress::bar(total, name));
+        }
+    }
+    fn advance(&self, n: u64) {
+        if let Ok(b) = self.bar.lock()
+            && let Some(b) = b.as_ref()
+        {
+            b.inc(n);
+        }
+    }
+    fn message(&self, text: &str) {
+        if let Ok(b) = self.bar.lock() {
+            match b.as_ref() {
+                Some(b) => b.suspend(|| eprintln!("{text}")),
+                None => eprintln!("{text}"),
+            }
+        }
+    }
+}
+
+impl Bars {
+    /// Clears the current bar.
+    pub fn finish(&self) {
+        if let Ok(mut b) = self.bar.lock()
+            && let Some(old) = b.take()
+        {
+            old.finish_and_clear();
+        }
+    }
+}
 
 /// Runs `evtac tune`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac tune is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let mut plan = Plan::for_scale(&args.scale)
+        .with_context(|| format!("unknown scale `{}` (tiny, small or paper)", args.scale))?;
+    if let Some(e) = args.epochs {
+        plan.tuning_epochs = e;
+    }
+    let kind = match args.repr {
+        TuneKind::Static => Kind::Static,
+        TuneKind::Dynamic => Kind::Dynamic,
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| args.dataset.join("tuning"));
+    let ds = Dataset::open(&args.dataset)
+        .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
+    let splits = ds.splits(args.seed)?;
+    let cache = FeatureCache::new(&ds)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build()
+        .context("starting worker threads")?;
+    let bars = Bars::default();
+    let t = pool.install(|| tuning::tune(&cache, &splits, &plan, kind, args.seed, &out, &bars))?;
+    bars.finish();
+    let json_path = out.join(format!("tuning-{}.json", kind.name()));
+    std::fs::write(&json_path, serde_json::to_string_pretty(&t)?)
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    println!(
+        "{:>10} {:>9} {:>9} {:>7} {:>7}",
+        t.time_name, "threshold", "val MAE", "pitch", "roll"
+    );
+    for r in &t.runs {
+        println!(
+            "{:>10} {:>9} {:>9.4} {:>7.4} {:>7.4}",
+            r.time_ms, r.threshold, r.val.overall, r.val.pitch, r.val.roll
+        );
+    }
+    println!(
+        "chosen: {} {} ms, threshold {} ({})",
+        t.time_name,
+        t.chosen_time_ms,
+        t.chosen_threshold,
+        json_path.display()
+    );
+    Ok(())
 }

@@ -1,0 +1,297 @@
+//! A dataset folder: `trials.csv` (the manifest), the trial recordings, `calibration.json`,
+//! `no_contact.aedat4` (for the static representation's mask), and what evtac adds to it:
+//! `labels/<trial>.csv` (computed from the IMU when missing), `splits.json` and `cache/`.
+
+use crate::sampling::{SampleTime, Sampling};
+use crate::splits::{self, Splits, Stratum};
+use evtac_events::manifest::{Manifest, TrialMeta};
+use evtac_events::{Event, Resolution, Roi};
+use evtac_labels::geometry::Calibration;
+use evtac_labels::{LabelConfig, LabelSeries, TrialMotion, label_imu};
+use evtac_repr::{Mask, ReprConfig};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// The crop every representation works on: the sensor's centered 240 x 240 pixels.
+pub const FRAME: Resolution = Resolution::new(240, 240);
+/// The calibration file inside a dataset folder.
+pub const CALIBRATION_FILE: &str = "calibration.json";
+/// The no-contact recording inside a dataset folder.
+pub const NO_CONTACT_FILE: &str = "no_contact.aedat4";
+/// The labels folder inside a dataset folder.
+pub const LABELS_DIR: &str = "labels";
+
+/// Errors opening or reading a dataset.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// `trials.csv` could not be read.
+    #[error(transparent)]
+    Manifest(#[from] evtac_events::manifest::ManifestError),
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// `calibration.json` is not a calibration.
+    #[error("{path}: not a calibration: {source}")]
+    Calibration {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: serde_json::Error,
+    },
+    /// A recording could not be decoded.
+    #[error("{path}: {source}")]
+    Recording {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: evtac_events::Error,
+    },
+    /// A recording is smaller than the 240 x 240 crop.
+    #[error("{path}: sensor {sensor} is smaller than the {FRAME} crop")]
+    SensorTooSmall {
+        /// The file.
+        path: PathBuf,
+        /// The sensor's resolution.
+        sensor: Resolution,
+    },
+    /// Labels could not be computed or read.
+    #[error("labels of trial `{trial}`: {message}")]
+    Labels {
+        /// The trial.
+        trial: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// The splits file is broken or does not match the manifest.
+    #[error(transparent)]
+    Splits(#[from] splits::Error),
+    /// The mask could not be built.
+    #[error("{path}: mask: {source}")]
+    Mask {
+        /// The no-contact file.
+        path: PathBuf,
+        /// The cause.
+        source: evtac_repr::ReprError,
+    },
+    /// A trial name is not in the manifest.
+    #[error("{dir}: no trial `{trial}` in trials.csv")]
+    UnknownTrial {
+        /// The dataset folder.
+        dir: PathBuf,
+        /// The name.
+        trial: String,
+    },
+}
+
+/// An opened dataset folder.
+#[derive(Debug, Clone)]
+pub struct Dataset {
+    /// The folder.
+    pub dir: PathBuf,
+    /// Its trials.
+    pub manifest: Manifest,
+    /// Its sensor calibration (the default when `calibration.json` is absent).
+    pub calibration: Calibration,
+}
+
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |e| Error::Io {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Reads a recording's events (any format evtac reads) on the full sensor, with the sensor's resolution (the
+/// crop size when the header has none, i.e. the recording is taken as already cropped).
+pub fn read_full(path: &Path) -> Result<(Resolution, Vec<Event>), Error> {
+    let rec = evtac_events::read_recording(path).map_err(|source| Error::Recording {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok((rec.resolution.unwrap_or(FRAME), rec.events))
+}
+
+/// The centered [`FRAME`] crop of `sensor`.
+pub fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
+    Roi::centered(sensor, FRAME).ok_or(Error::SensorTooSmall {
+        path: path.to_path_buf(),
+        sensor,
+    })
+}
+
+/// Reads a recording's events, cropped to the centered [`FRAME`], in time order.
+pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
+    let (sensor, events) = read_full(path)?;
+    let roi = crop_of(sensor, path)?;
+    Ok(events.into_iter().filter_map(|e| roi.map(e)).collect())
+}
+
+impl Dataset {
+    /// Opens the dataset at `dir`: reads `trials.csv` and `calibration.json` (default when
+    /// absent).
+    pub fn open(dir: &Path) -> Result<Dataset, Error> {
+        let manifest = Manifest::read(dir)?;
+        let cal_path = dir.join(CALIBRATION_FILE);
+        let calibration = match std::fs::read_to_string(&cal_path) {
+            Ok(text) => serde_json::from_str(&text).map_err(|source| Error::Calibration {
+                path: cal_path.clone(),
+                source,
+            })?,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Calibration::default(),
+            Err(e) => return Err(io_err(&cal_path)(e)),
+        };
+        Ok(Dataset {
+            dir: dir.to_path_buf(),
+            manifest,
+            calibration,
+        })
+    }
+
+    /// The trial called `name`.
+    pub fn trial(&self, name: &str) -> Result<&TrialMeta, Error> {
+        self.manifest.get(name).ok_or_else(|| Error::UnknownTrial {
+            dir: self.dir.clone(),
+            trial: name.to_string(),
+        })
+    }
+
+    /// The trials called `names`, in that order.
+    pub fn trials(&self, names: &[String]) -> Result<Vec<&TrialMeta>, Error> {
+        names.iter().map(|n| self.trial(n)).collect()
+    }
+
+    /// Every trial's conditions, for splitting.
+    pub fn strata(&self) -> Vec<Stratum> {
+        self.manifest
+            .trials
+            .iter()
+            .map(|t| Stratum {
+                trial: t.trial.clone(),
+                speed_deg_s: t.speed_deg_s,
+                depth_mm: t.depth_mm,
+                direction_deg: t.direction_deg,
+            })
+            .collect()
+    }
+
+    /// The dataset's splits: `splits.json`, made (with `seed`) and written when missing.
+    pub fn splits(&self, seed: u64) -> Result<Splits, Error> {
+        Ok(Splits::read_or_make(&self.dir, &self.strata(), seed)?)
+    }
+
+    /// Whether any trial has a stop phase.
+    pub fn has_stops(&self) -> bool {
+        self.manifest
+            .trials
+            .iter()
+            .any(|t| t.stop_start_us.is_some() && t.stop_end_us.is_some())
+    }
+
+    /// The labels file of `trial`.
+    pub fn labels_path(&self, trial: &str) -> PathBuf {
+        self.dir.join(LABELS_DIR).join(format!("{trial}.csv"))
+    }
+
+    /// The labels of `meta`: `labels/<trial>.csv`, computed from the trial's IMU (and written)
+    /// when missing.
+    pub fn labels(&self, meta: &TrialMeta) -> Result<LabelSeries, Error> {
+        let path = self.labels_path(&meta.trial);
+        let lab = |message: String| Error::Labels {
+            trial: meta.trial.clone(),
+            message,
+        };
+        if !path.is_file() {
+            let labels = self.compute_labels(meta)?;
+            let tmp = crate::jobs::tmp_path(&path);
+            std::fs::create_dir_all(self.dir.join(LABELS_DIR)).map_err(io_err(&path))?;
+            labels
+                .labels
+                .write_csv(&tmp)
+                .map_err(|e| lab(e.to_string()))?;
+            std::fs::rename(&tmp, &path).map_err(io_err(&path))?;
+            return Ok(labels.labels);
+        }
+        LabelSeries::read_csv(&path).map_err(|e| lab(e.to_string()))
+    }
+
+    /// Labels `meta` from its recording's IMU stream with the default label settings (what
+    /// `evtac labels` does for one trial).
+    fn compute_labels(&self, meta: &TrialMeta) -> Result<evtac_labels::TrialLabels, Error> {
+        let lab = |message: String| Error::Labels {
+            trial: meta.trial.clone(),
+            message,
+        };
+        let path = self.dir.join(&meta.file);
+        let rec = evtac_events::read_recording(&path).map_err(|source| Error::Recording {
+            path: path.clone(),
+            source,
+        })?;
+        let motion = TrialMotion::from_meta(meta).map_err(|e| lab(e.to_string()))?;
+        label_imu(
+            &rec.imu,
+            &motion,
+            &self.calibration,
+            &LabelConfig::default(),
+        )
+        .map_err(|e| lab(e.to_string()))
+    }
+
+    /// The sample times of `meta` under `sampling`.
+    pub fn sample_times(&self, meta: &TrialMeta, sampling: Sampling) -> Vec<SampleTime> {
+        let stop = meta.stop_start_us.zip(meta.stop_end_us);
+        sampling.times((meta.motion_start_us, meta.motion_end_us), stop)
+    }
+
+    /// The events of `meta`'s recording cropped to [`FRAME`].
+    pub fn events(&self, meta: &TrialMeta) -> Result<Vec<Event>, Error> {
+        read_cropped(&self.dir.join(&meta.file))
+    }
+
+    /// The no-contact recording's events cropped to [`FRAME`], or `None` when the dataset has
+    /// no `no_contact.aedat4`.
+    pub fn no_contact_events(&self) -> Result<Option<Vec<Event>>, Error> {
+        let path = self.dir.join(NO_CONTACT_FILE);
+        if !path.is_file() {
+            return Ok(None);
+        }
+        read_cropped(&path).map(Some)
+    }
+
+    /// The no-contact mask for `config` (built with its static part's settings, as the paper's
+    /// rule implies), or `None` for a dynamic config or a dataset without a no-contact
+    /// recording.
+    pub fn mask_for(
+        &self,
+        config: &ReprConfig,
+        no_contact: Option<&[Event]>,
+    ) -> Result<Option<Mask>, Error> {
+        let (Some(s), Some(events)) = (config.static_part(), no_contact) else {
+            return Ok(None);
+        };
+        Mask::from_no_contact(FRAME, s, events)
+            .map(Some)
+            .map_err(|source| Error::Mask {
+                path: self.dir.join(NO_CONTACT_FILE),
+                source,
+            })
+    }
+}
+
+/// A short identity of a mask for cache keys: `nomask` or the first 12 hex digits of the
+/// SHA-256 of its pixels.
+pub fn mask_id(mask: Option<&Mask>) -> String {
+    match mask {
+        None => "nomask".to_string(),
+        Some(m) => {
+            let digest = Sha256::digest(m.pixels());
+            let hex: String = digest.iter().take(6).map(|b| format!("{b:02x}")).collect();
+            format!("mask{hex}")
+        }
+    }
+}

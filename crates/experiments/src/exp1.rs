@@ -1,0 +1,165 @@
+//! Experiment 1: the static, dynamic and combined representations with the chosen settings,
+//! trained with several seeds on the continuous-motion dataset; test MAE overall, pitch and roll
+//! as mean ± std over seeds.
+
+use crate::cache::FeatureCache;
+use crate::jobs::{self, Progress};
+use crate::plan::Plan;
+use crate::results::{Exp1Repr, Mae, MaeStats};
+use crate::sampling::{Phase, Sampling};
+use crate::splits::{Split, Splits};
+use crate::training::{self, Error, Model, TrainSpec};
+use evtac_learn::ModelBundle;
+use evtac_repr::ReprConfig;
+use std::path::{Path, PathBuf};
+
+/// The three representations compared: display name and config.
+pub fn representations(
+    static_cfg: ReprConfig,
+    dynamic_cfg: ReprConfig,
+) -> Vec<(&'static str, ReprConfig)> {
+    let mut out = vec![("Static", static_cfg), ("Dynamic", dynamic_cfg)];
+    if let (Some(s), Some(d)) = (static_cfg.static_part(), dynamic_cfg.dynamic_part()) {
+        out.push((
+            "Combined",
+            ReprConfig::Combined {
+                static_part: *s,
+                dynamic_part: *d,
+            },
+        ));
+    }
+    out
+}
+
+/// The seeds of `n` runs from the master `seed`.
+pub fn seeds(seed: u64, n: usize) -> Vec<u64> {
+    (0..n as u64).map(|k| seed.wrapping_add(k)).collect()
+}
+
+/// The folder of one Experiment 1 model.
+pub fn model_dir(out: &Path, name: &str, seed: u64) -> PathBuf {
+    out.join("exp1")
+        .join(name.to_lowercase())
+        .join(format!("seed{seed}"))
+}
+
+/// A job of a multi-seed experiment.
+#[derive(Debug, Clone)]
+pub struct SeedJob {
+    /// Representation name.
+    pub name: &'static str,
+    /// The training job.
+    pub spec: TrainSpec,
+    /// Its folder.
+    pub dir: PathBuf,
+}
+
+/// The training jobs of Experiment 1.
+pub fn jobs(
+    reprs: &[(&'static str, ReprConfig)],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> Vec<SeedJob> {
+    let mut v = Vec::new();
+    for &(name, config) in reprs {
+        for s in seeds(seed, plan.seeds) {
+            v.push(SeedJob {
+                name,
+                spec: TrainSpec {
+                    repr: config,
+                    seed: s,
+                    epochs: plan.epochs,
+                    sampling: Sampling::MOTION,
+                    phases: vec![Phase::Motion],
+                },
+                dir: model_dir(out, name, s),
+            });
+        }
+    }
+    v
+}
+
+/// Runs (or resumes) `jobs` on `cache`'s dataset, in parallel.
+pub fn train_all(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    jobs: &[SeedJob],
+    progress: &dyn Progress,
+) -> Result<(), Error> {
+    jobs::run_all(
+        jobs,
+        |j| j.dir.clone(),
+        |j| training::train_job(cache, splits, &j.spec, &j.dir, |_| {}).map(|_| ()),
+        || progress.advance(1),
+    )
+}
+
+/// Runs Experiment 1 and evaluates every model on the test split.
+pub fn run(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    reprs: &[(&'static str, ReprConfig)],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Vec<Exp1Repr>, Error> {
+    let ds = cache.dataset();
+    let all = ds.trials(
+        &[
+            splits.get(Split::Train),
+            splits.get(Split::Val),
+            splits.get(Split::Test),
+        ]
+        .concat(),
+    )?;
+    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
+    progress.stage("features (experiment 1)", all.len() as u64);
+    cache.ensure(&all, &configs, Sampling::MOTION, &|| progress.advance(1))?;
+    let jobs = jobs(reprs, plan, seed, out);
+    progress.stage("experiment 1 training", jobs.len() as u64);
+    train_all(cache, splits, &jobs, progress)?;
+    let mut results = Vec::new();
+    for &(name, config) in reprs {
+        let test = training::load_split(
+            cache,
+            splits,
+            Split::Test,
+            &config,
+            Sampling::MOTION,
+            &[Phase::Motion],
+        )?;
+        let mut runs = Vec::new();
+        let mut val_runs = Vec::new();
+        let seeds = seeds(seed, plan.seeds);
+        for &s in &seeds {
+            let model = Model::load(&model_dir(out, name, s))?;
+            let pred = model.predict(&test)?;
+            runs.push(training::mae_in(&test, &pred, None));
+            val_runs.push(Mae::from(model.bundle.config.metrics.validation));
+        }
+        results.push(Exp1Repr {
+            name: name.into(),
+            config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
+            seeds,
+            test: MaeStats::of(&runs),
+            runs,
+            val_runs,
+        });
+    }
+    Ok(results)
+}
+
+/// Loads the Experiment 1 models of `name`.
+pub fn models(out: &Path, name: &str, seed: u64, n: usize) -> Result<Vec<Model>, Error> {
+    seeds(seed, n)
+        .into_iter()
+        .map(|s| Model::load(&model_dir(out, name, s)))
+        .collect()
+}
+
+/// Whether the bundle in `dir` is complete.
+pub fn finished(dir: &Path) -> bool {
+    jobs::is_done(dir) && ModelBundle::load(dir).is_ok()
+}

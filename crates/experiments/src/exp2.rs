@@ -1,0 +1,125 @@
+//! Experiment 2: motion interrupted by a stop. The chosen settings are trained on the pause
+//! dataset under three settings and evaluated on its test trials per phase:
+//! `continuous-only` (the Experiment 1 models, not retrained), `pause-motion` (trained on the
+//! motion-phase samples of pause trials) and `pause-motion-stop` (motion and stop samples).
+
+use crate::cache::FeatureCache;
+use crate::exp1::{self, SeedJob};
+use crate::jobs::Progress;
+use crate::plan::Plan;
+use crate::results::{Exp2Cell, MaeStats};
+use crate::sampling::{Phase, Sampling};
+use crate::splits::{Split, Splits};
+use crate::training::{self, Error, Model, TrainSpec};
+use evtac_repr::ReprConfig;
+use std::path::{Path, PathBuf};
+
+/// The training settings: file name and label in the report.
+pub const SETTINGS: [(&str, &str); 3] = [
+    ("continuous-only", "Continuous-only"),
+    ("pause-motion", "Pause-inclusive (motion only)"),
+    ("pause-motion-stop", "Pause-inclusive (motion + stop)"),
+];
+
+/// The folder of one Experiment 2 model.
+pub fn model_dir(out: &Path, setting: &str, name: &str, seed: u64) -> PathBuf {
+    out.join("exp2")
+        .join(setting)
+        .join(name.to_lowercase())
+        .join(format!("seed{seed}"))
+}
+
+/// The training jobs of Experiment 2 (the two pause-inclusive settings).
+pub fn jobs(
+    reprs: &[(&'static str, ReprConfig)],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> Vec<SeedJob> {
+    let mut v = Vec::new();
+    for (setting, phases) in [
+        (SETTINGS[1].0, vec![Phase::Motion]),
+        (SETTINGS[2].0, vec![Phase::Motion, Phase::Stop]),
+    ] {
+        for &(name, config) in reprs {
+            for s in exp1::seeds(seed, plan.exp2_seeds) {
+                v.push(SeedJob {
+                    name,
+                    spec: TrainSpec {
+                        repr: config,
+                        seed: s,
+                        epochs: plan.epochs,
+                        sampling: Sampling::WITH_STOP,
+                        phases: phases.clone(),
+                    },
+                    dir: model_dir(out, setting, name, s),
+                });
+            }
+        }
+    }
+    v
+}
+
+/// Runs Experiment 2 on the pause dataset `cache` with its `splits`; `out` holds the
+/// Experiment 1 models.
+pub fn run(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    reprs: &[(&'static str, ReprConfig)],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Vec<Exp2Cell>, Error> {
+    let ds = cache.dataset();
+    let all = ds.trials(
+        &[
+            splits.get(Split::Train),
+            splits.get(Split::Val),
+            splits.get(Split::Test),
+        ]
+        .concat(),
+    )?;
+    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
+    progress.stage("features (experiment 2)", all.len() as u64);
+    cache.ensure(&all, &configs, Sampling::WITH_STOP, &|| progress.advance(1))?;
+    let jobs = jobs(reprs, plan, seed, out);
+    progress.stage("experiment 2 training", jobs.len() as u64);
+    exp1::train_all(cache, splits, &jobs, progress)?;
+    let mut cells = Vec::new();
+    for (setting, _) in SETTINGS {
+        for &(name, config) in reprs {
+            let test = training::load_split(
+                cache,
+                splits,
+                Split::Test,
+                &config,
+                Sampling::WITH_STOP,
+                &[Phase::Motion, Phase::Stop],
+            )?;
+            let models: Vec<Model> = if setting == SETTINGS[0].0 {
+                exp1::models(out, name, seed, plan.seeds)?
+            } else {
+                exp1::seeds(seed, plan.exp2_seeds)
+                    .into_iter()
+                    .map(|s| Model::load(&model_dir(out, setting, name, s)))
+                    .collect::<Result<_, _>>()?
+            };
+            let (mut motion, mut stop) = (Vec::new(), Vec::new());
+            for m in &models {
+                let pred = m.predict(&test)?;
+                motion.push(training::mae_in(&test, &pred, Some(Phase::Motion)));
+                stop.push(training::mae_in(&test, &pred, Some(Phase::Stop)));
+            }
+            cells.push(Exp2Cell {
+                setting: setting.into(),
+                name: name.into(),
+                motion: MaeStats::of(&motion),
+                stop: MaeStats::of(&stop),
+                motion_runs: motion,
+                stop_runs: stop,
+            });
+        }
+    }
+    Ok(cells)
+}

@@ -1,0 +1,108 @@
+//! Experiment 3: the Experiment 1 models on the speed-wise and depth-wise datasets; MAE per
+//! speed and per depth, with seen (training) and unseen (interpolated) values marked.
+
+use crate::cache::FeatureCache;
+use crate::jobs::Progress;
+use crate::results::{Exp3Point, MaeStats};
+use crate::sampling::{Phase, Sampling};
+use crate::training::{self, Error, Model};
+use evtac_events::manifest::TrialMeta;
+use std::collections::BTreeMap;
+
+/// Which condition a dataset varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// Speed, deg/s.
+    Speed,
+    /// Depth, mm.
+    Depth,
+}
+
+impl Axis {
+    fn value(self, t: &TrialMeta) -> f64 {
+        match self {
+            Axis::Speed => t.speed_deg_s,
+            Axis::Depth => t.depth_mm,
+        }
+    }
+}
+
+/// Evaluates `models` (name, Experiment 1 models) on every trial of `cache`'s dataset, grouped by
+/// the value of `axis`. A value is seen when its trials say `group = seen` or, without groups,
+/// when it is one of `training_values`.
+pub fn run(
+    cache: &FeatureCache<'_>,
+    axis: Axis,
+    models: &[(&str, Vec<Model>)],
+    training_values: &[f64],
+    progress: &dyn Progress,
+) -> Result<Vec<Exp3Point>, Error> {
+    let ds = cache.dataset();
+    let trials: Vec<&TrialMeta> = ds.manifest.trials.iter().collect();
+    let mut by_value: BTreeMap<i64, Vec<usize>> = BTreeMap::new();
+    for (i, t) in trials.iter().enumerate() {
+        // Keyed in thousandths so float values group exactly.
+        by_value
+            .entry((axis.value(t) * 1000.0).round() as i64)
+            .or_default()
+            .push(i);
+    }
+    let configs: Vec<_> = models
+        .iter()
+        .filter_map(|(_, m)| m.first().map(|m| m.representation.config))
+        .collect();
+    progress.stage(
+        match axis {
+            Axis::Speed => "features (experiment 3, speed)",
+            Axis::Depth => "features (experiment 3, depth)",
+        },
+        trials.len() as u64,
+    );
+    cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
+    let mut out = Vec::new();
+    for (name, ms) in models {
+        let Some(first) = ms.first() else { continue };
+        let set = cache.load(
+            &trials,
+            &first.representation.config,
+            Sampling::MOTION,
+            &[Phase::Motion],
+        )?;
+        let preds: Vec<Vec<[f32; 2]>> = ms
+            .iter()
+            .map(|m| m.predict(&set))
+            .collect::<Result<_, _>>()?;
+        let labels = training::label_rows(&set);
+        for (&key, members) in &by_value {
+            let value = key as f64 / 1000.0;
+            let seen = match trials[members[0]].group.as_deref() {
+                Some(g) => g == "seen",
+                None => training_values.iter().any(|v| (v - value).abs() < 1e-6),
+            };
+            let rows: Vec<usize> = set
+                .samples
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| members.contains(&s.trial))
+                .map(|(i, _)| i)
+                .collect();
+            let runs: Vec<_> = preds
+                .iter()
+                .map(|p| {
+                    let pp: Vec<[f32; 2]> = rows.iter().map(|&i| p[i]).collect();
+                    let ll: Vec<[f32; 2]> = rows.iter().map(|&i| labels[i]).collect();
+                    crate::results::Mae::of(&pp, &ll)
+                })
+                .collect();
+            out.push(Exp3Point {
+                name: (*name).into(),
+                value,
+                seen,
+                trials: members.len(),
+                stats: MaeStats::of(&runs),
+                runs,
+            });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,184 @@
+//! Jobs: every expensive step is a pure function of (inputs, config, seed) that writes its own
+//! output folder and, last, a `done` marker. A run that is interrupted resumes from the finished
+//! jobs (folders with `done`); a half-written folder is redone. The same job list can be exported
+//! as one `evtac ...` command per line for a Slurm array or GNU parallel.
+
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Name of the marker file a finished job writes last.
+pub const DONE: &str = "done";
+
+/// Errors of the job machinery.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A job's folder or marker could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+/// Progress of a long run, reported by the library and shown by the binary (libraries never
+/// print). Every method has a do-nothing default.
+pub trait Progress: Sync {
+    /// A stage named `name` starts with `total` units of work.
+    fn stage(&self, name: &str, total: u64) {
+        let _ = (name, total);
+    }
+    /// `n` units of the current stage are done.
+    fn advance(&self, n: u64) {
+        let _ = n;
+    }
+    /// A one-line status message (e.g. the latest epoch's loss).
+    fn message(&self, text: &str) {
+        let _ = text;
+    }
+}
+
+/// A [`Progress`] that shows nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Quiet;
+
+impl Progress for Quiet {}
+
+/// Whether the job writing to `dir` has finished.
+pub fn is_done(dir: &Path) -> bool {
+    dir.join(DONE).is_file()
+}
+
+/// Marks the job writing to `dir` as finished (its outputs must be complete by now).
+pub fn mark_done(dir: &Path) -> Result<(), Error> {
+    write_atomic(&dir.join(DONE), b"").map_err(|source| Error::Io {
+        path: dir.join(DONE).display().to_string(),
+        source,
+    })
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename, so readers (and resumed runs)
+/// never see a half-written file. Creates the parent folder.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    let tmp = tmp_path(path);
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
+}
+
+/// A sibling temporary path for `path` (same folder, so a rename is atomic).
+pub fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".tmp{}", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Runs `work` on every item in parallel (rayon), skipping those whose `dir(item)` is done, and
+/// calling `progress` after each item (finished or skipped). Returns the first error, after the
+/// other items finished (their work is kept for a resumed run).
+pub fn run_all<T, E, D, W, P>(items: &[T], dir: D, work: W, progress: P) -> Result<(), E>
+where
+    T: Sync,
+    E: Send,
+    D: Fn(&T) -> PathBuf + Sync,
+    W: Fn(&T) -> Result<(), E> + Sync,
+    P: Fn() + Sync,
+{
+    let errors: Vec<E> = items
+        .par_iter()
+        .filter_map(|item| {
+            let result = if is_done(&dir(item)) {
+                Ok(())
+            } else {
+                work(item)
+            };
+            progress();
+            result.err()
+        })
+        .collect();
+    match errors.into_iter().next() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Quotes `arg` for a POSIX shell when it needs it.
+pub fn shell_quote(arg: &str) -> String {
+    let plain = !arg.is_empty()
+        && arg
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c));
+    if plain {
+        arg.to_string()
+    } else {
+        format!("'{}'", arg.replace('\'', r"'\''"))
+    }
+}
+
+/// One shell command line from program arguments.
+pub fn command_line(args: &[String]) -> String {
+    args.iter()
+        .map(|a| shell_quote(a))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn finished_jobs_are_skipped_and_failures_keep_the_rest() {
+        let dir = tempfile::tempdir().unwrap();
+        let items: Vec<usize> = (0..8).collect();
+        let ran = AtomicUsize::new(0);
+        let job_dir = |i: &usize| dir.path().join(format!("job{i}"));
+        // First run: job 5 fails ("interrupted"); the others finish.
+        let result = run_all(
+            &items,
+            job_dir,
+            |&i| {
+                ran.fetch_add(1, Ordering::SeqCst);
+                if i == 5 {
+                    return Err(format!("job {i} failed"));
+                }
+                std::fs::create_dir_all(job_dir(&i)).unwrap();
+                mark_done(&job_dir(&i)).map_err(|e| e.to_string())
+            },
+            || {},
+        );
+        assert_eq!(result, Err("job 5 failed".to_string()));
+        assert_eq!(ran.load(Ordering::SeqCst), 8);
+        // Resumed run: only job 5 runs again.
+        let ran_again = AtomicUsize::new(0);
+        let result: Result<(), String> = run_all(
+            &items,
+            job_dir,
+            |&i| {
+                ran_again.fetch_add(1, Ordering::SeqCst);
+                assert_eq!(i, 5);
+                std::fs::create_dir_all(job_dir(&i)).unwrap();
+                mark_done(&job_dir(&i)).map_err(|e| e.to_string())
+            },
+            || {},
+        );
+        assert!(result.is_ok());
+        assert_eq!(ran_again.load(Ordering::SeqCst), 1);
+    }
+
+    #[test]
+    fn quoting() {
+        assert_eq!(shell_quote("abc-1.0/x"), "abc-1.0/x");
+        assert_eq!(shell_quote("a b"), "'a b'");
+        assert_eq!(shell_quote("it's"), r"'it'\''s'");
+        assert_eq!(
+            command_line(&["evtac".into(), "train".into(), "my dir".into()]),
+            "evtac train 'my dir'"
+        );
+    }
+}

@@ -1,0 +1,126 @@
+//! The latency study: Experiment 1's test trials processed sequentially at sampling intervals of
+//! 1, 2, 5 and 10 ms; the end-to-end time of each step, from handing the step's new events to the
+//! representation (crop included) to the end of the MLP's forward pass, at 50 uniformly spaced
+//! steps per trial (so long trials do not dominate). Median, P99 and max per representation and
+//! interval.
+//!
+//! Events before motion onset are applied before timing starts: the sensor is still then and an
+//! online system would have processed them as they came. Runs on the calling thread, alone.
+
+use crate::dataset::{self, Dataset, FRAME};
+use crate::results::LatencyCell;
+use crate::sampling::{MOTION_POINTS, equally_spaced_indices};
+use crate::training::Model;
+use evtac_events::manifest::TrialMeta;
+use evtac_repr::{FeatureExtractor, Mask};
+use std::time::Instant;
+
+/// Errors of the latency study.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A recording could not be read.
+    #[error(transparent)]
+    Dataset(#[from] dataset::Error),
+    /// The representation failed.
+    #[error("trial `{trial}`: {source}")]
+    Repr {
+        /// The trial.
+        trial: String,
+        /// The cause.
+        source: evtac_repr::ReprError,
+    },
+}
+
+/// Measures one representation (`model` with its `mask`) at `interval_ms` over `trials`.
+pub fn measure(
+    ds: &Dataset,
+    trials: &[&TrialMeta],
+    name: &str,
+    model: &Model,
+    mask: Option<&Mask>,
+    interval_ms: u32,
+) -> Result<LatencyCell, Error> {
+    evtac_learn::flush_denormals();
+    let config = model.representation.config;
+    let step = i64::from(interval_ms.max(1)) * 1000;
+    let mut fx =
+        FeatureExtractor::new(std::slice::from_ref(&config), FRAME, mask).map_err(|source| {
+            Error::Repr {
+                trial: String::new(),
+                source,
+            }
+        })?;
+    let mut times_us = Vec::new();
+    for meta in trials {
+        let path = ds.dir.join(&meta.file);
+        let (sensor, events) = dataset::read_full(&path)?;
+        let roi = dataset::crop_of(sensor, &path)?;
+        let repr = |source| Error::Repr {
+            trial: meta.trial.clone(),
+            source,
+        };
+        fx.reset();
+        let mut cursor = events.partition_point(|e| e.t <= meta.motion_start_us);
+        fx.push_with_roi(&events[..cursor], &roi).map_err(repr)?;
+        fx.advance_to(meta.motion_start_us).map_err(repr)?;
+        let mut trial_times = Vec::new();
+        let mut t_k = meta.motion_start_us + step;
+        while t_k <= meta.motion_end_us {
+            let started = Instant::now();
+            let end = cursor + events[cursor..].partition_point(|e| e.t <= t_k);
+            fx.push_with_roi(&events[cursor..end], &roi).map_err(repr)?;
+            fx.advance_to(t_k).map_err(repr)?;
+            let y = model.predictor.predict_one(fx.features(0));
+            std::hint::black_box(y);
+            trial_times.push(started.elapsed().as_secs_f64() * 1e6);
+            cursor = end;
+            t_k += step;
+        }
+        for i in equally_spaced_indices(trial_times.len(), MOTION_POINTS) {
+            times_us.push(trial_times[i]);
+        }
+    }
+    Ok(cell(name, interval_ms, times_us))
+}
+
+/// Summary statistics of measured times.
+pub fn cell(name: &str, interval_ms: u32, times_us: Vec<f64>) -> LatencyCell {
+    let mut sorted = times_us.clone();
+    sorted.sort_by(f64::total_cmp);
+    let q = |p: f64| {
+        if sorted.is_empty() {
+            0.0
+        } else {
+            // Nearest-rank percentile.
+            let rank = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+            sorted[rank - 1]
+        }
+    };
+    let interval_us = f64::from(interval_ms) * 1000.0;
+    LatencyCell {
+        name: name.into(),
+        interval_ms,
+        samples: sorted.len(),
+        median_us: q(0.5),
+        p99_us: q(0.99),
+        max_us: sorted.last().copied().unwrap_or(0.0),
+        over_interval: sorted.iter().filter(|&&t| t > interval_us).count(),
+        over_10ms: sorted.iter().filter(|&&t| t > 10_000.0).count(),
+        times_us,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles_are_nearest_rank() {
+        let c = cell("Static", 1, (1..=100).map(f64::from).collect());
+        assert_eq!((c.median_us, c.p99_us, c.max_us), (50.0, 99.0, 100.0));
+        assert_eq!(c.over_interval, 0);
+        let c = cell("Static", 1, vec![500.0, 1500.0, 20_000.0]);
+        assert_eq!((c.over_interval, c.over_10ms), (2, 1));
+    }
+}

@@ -1,0 +1,359 @@
+//! The whole protocol on existing datasets: labels, splits, tuning, Experiments 1-3, latency and
+//! the report. Every stage resumes from finished jobs; [`export_jobs`] lists the training jobs
+//! that are ready to run as `evtac train` command lines for an external scheduler.
+
+use crate::cache::FeatureCache;
+use crate::dataset::{self, Dataset};
+use crate::exp3::Axis;
+use crate::jobs::{self, Progress};
+use crate::plan::Plan;
+use crate::results::{Results, RunInfo};
+use crate::sampling::Sampling;
+use crate::splits::Split;
+use crate::training::{self, Model, TrainSpec};
+use crate::tuning::{self, Kind};
+use crate::{examples, exp1, exp2, exp3, latency, report};
+use evtac_repr::ReprConfig;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Errors of a reproduction.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A dataset could not be opened.
+    #[error(transparent)]
+    Dataset(#[from] dataset::Error),
+    /// Features, training or evaluation failed.
+    #[error(transparent)]
+    Training(#[from] training::Error),
+    /// The latency study failed.
+    #[error(transparent)]
+    Latency(#[from] latency::Error),
+    /// The report could not be written.
+    #[error(transparent)]
+    Report(#[from] report::Error),
+    /// The feature cache failed.
+    #[error(transparent)]
+    Cache(#[from] crate::cache::Error),
+    /// A tuning run's chosen config could not be read back.
+    #[error("the {0} tuning chose no readable config")]
+    NoChoice(&'static str),
+    /// The job list could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+/// The datasets of a reproduction (Experiment 1 is required).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Datasets {
+    /// Continuous motion (Experiment 1).
+    pub exp1: PathBuf,
+    /// Motion with a stop (Experiment 2).
+    pub exp2: Option<PathBuf>,
+    /// Speed-wise (Experiment 3).
+    pub exp3_speed: Option<PathBuf>,
+    /// Depth-wise (Experiment 3).
+    pub exp3_depth: Option<PathBuf>,
+}
+
+impl Datasets {
+    /// The datasets under `dir` as `evtac simulate` lays them out (`exp1/`, `exp2/`,
+    /// `exp3-speed/`, `exp3-depth/`); absent optional ones are `None`.
+    pub fn in_dir(dir: &Path) -> Datasets {
+        let opt = |name: &str| {
+            let p = dir.join(name);
+            p.join(evtac_events::manifest::FILE_NAME)
+                .is_file()
+                .then_some(p)
+        };
+        Datasets {
+            exp1: dir.join("exp1"),
+            exp2: opt("exp2"),
+            exp3_speed: opt("exp3-speed"),
+            exp3_depth: opt("exp3-depth"),
+        }
+    }
+}
+
+struct Stages<'a> {
+    list: Vec<(String, f64)>,
+    started: Instant,
+    progress: &'a dyn Progress,
+}
+
+impl Stages<'_> {
+    fn done(&mut self, name: &str) {
+        let s = self.started.elapsed().as_secs_f64();
+        self.list.push((name.to_string(), s));
+        self.progress.message(&format!("{name}: {s:.1} s"));
+        self.started = Instant::now();
+    }
+}
+
+fn chosen(t: &crate::results::Tuning, kind: Kind) -> Result<ReprConfig, Error> {
+    tuning::chosen(t).ok_or(Error::NoChoice(kind.name()))
+}
+
+/// Runs the whole protocol on `data` and writes the report into `out`.
+pub fn reproduce(
+    data: &Datasets,
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Results, Error> {
+    evtac_learn::flush_denormals();
+    let mut stages = Stages {
+        list: Vec::new(),
+        started: Instant::now(),
+        progress,
+    };
+    let models = out.join("models");
+    let ds1 = Dataset::open(&data.exp1)?;
+    let splits1 = ds1.splits(seed)?;
+    let cache1 = FeatureCache::new(&ds1)?;
+    let mut datasets = vec![("exp1".to_string(), ds1.manifest.trials.len())];
+
+    let st = tuning::tune(
+        &cache1,
+        &splits1,
+        plan,
+        Kind::Static,
+        seed,
+        &models,
+        progress,
+    )?;
+    stages.done("tuning (static)");
+    let dt = tuning::tune(
+        &cache1,
+        &splits1,
+        plan,
+        Kind::Dynamic,
+        seed,
+        &models,
+        progress,
+    )?;
+    stages.done("tuning (dynamic)");
+    let reprs = exp1::representations(chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
+
+    let e1 = exp1::run(&cache1, &splits1, &reprs, plan, seed, &models, progress)?;
+    stages.done("experiment 1");
+
+    let mut e2 = Vec::new();
+    let mut example = None;
+    if let Some(dir) = &data.exp2 {
+        let ds2 = Dataset::open(dir)?;
+        datasets.push(("exp2".into(), ds2.manifest.trials.len()));
+        let splits2 = ds2.splits(seed)?;
+        let cache2 = FeatureCache::new(&ds2)?;
+        e2 = exp2::run(&cache2, &splits2, &reprs, plan, seed, &models, progress)?;
+        // The example: the first test trial with a stop, with the motion + stop models.
+        let test = ds2.trials(splits2.get(Split::Test))?;
+        if let Some(meta) = test.iter().find(|t| t.stop_start_us.is_some()) {
+            let loaded: Vec<(&str, Model)> = reprs
+                .iter()
+                .map(|(name, _)| {
+                    Model::load(&exp2::model_dir(&models, exp2::SETTINGS[2].0, name, seed))
+                        .map(|m| (*name, m))
+                })
+                .collect::<Result<_, _>>()?;
+            let refs: Vec<(&str, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
+            example = Some(examples::example_trial(&cache2, meta, &refs)?);
+        }
+        stages.done("experiment 2");
+    }
+
+    let exp1_models: Vec<(&str, Vec<Model>)> = reprs
+        .iter()
+        .map(|(name, _)| exp1::models(&models, name, seed, plan.seeds).map(|m| (*name, m)))
+        .collect::<Result<_, _>>()?;
+    let speeds: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.speed_deg_s).collect();
+    let depths: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.depth_mm).collect();
+    let mut e3s = Vec::new();
+    let mut e3d = Vec::new();
+    for (dir, axis, values) in [
+        (&data.exp3_speed, Axis::Speed, &speeds),
+        (&data.exp3_depth, Axis::Depth, &depths),
+    ] {
+        let Some(dir) = dir else { continue };
+        let ds = Dataset::open(dir)?;
+        datasets.push((
+            match axis {
+                Axis::Speed => "exp3-speed".into(),
+                Axis::Depth => "exp3-depth".into(),
+            },
+            ds.manifest.trials.len(),
+        ));
+        let cache = FeatureCache::new(&ds)?;
+        let points = exp3::run(&cache, axis, &exp1_models, values, progress)?;
+        match axis {
+            Axis::Speed => e3s = points,
+            Axis::Depth => e3d = points,
+        }
+    }
+    if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
+        stages.done("experiment 3");
+    }
+    let overlays = examples::overlays(&cache1, reprs[0].1, reprs[1].1)?;
+
+    // Latency: the first model of each representation on the Experiment 1 test trials, alone.
+    let test = ds1.trials(splits1.get(Split::Test))?;
+    let test = &test[..test.len().min(plan.latency_trials)];
+    progress.stage(
+        "latency",
+        (exp1_models.len() * plan.latency_intervals_ms.len()) as u64,
+    );
+    let mut lat = Vec::new();
+    for (name, ms) in &exp1_models {
+        let Some(model) = ms.first() else { continue };
+        let mask = cache1.mask(&model.representation.config)?;
+        for &iv in &plan.latency_intervals_ms {
+            lat.push(latency::measure(
+                &ds1,
+                test,
+                name,
+                model,
+                mask.as_ref(),
+                iv,
+            )?);
+            progress.advance(1);
+        }
+    }
+    stages.done("latency");
+
+    let mut results = Results {
+        run: RunInfo {
+            scale: plan.scale.clone(),
+            seed,
+            plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
+            stage_seconds: Vec::new(),
+            datasets,
+        },
+        tuning: vec![st, dt],
+        exp1: e1,
+        exp2: e2,
+        exp3_speed: e3s,
+        exp3_depth: e3d,
+        latency: lat,
+        example,
+        overlays,
+    };
+    results.run.stage_seconds = stages.list.clone();
+    report::write(out, &results)?;
+    stages.done("report");
+    results.run.stage_seconds = stages.list;
+    Ok(results)
+}
+
+/// One `evtac train` command line for `spec` on `dataset`, writing into `dir`.
+pub fn train_command(
+    exe: &str,
+    dataset: &Path,
+    spec: &TrainSpec,
+    splits_seed: u64,
+    dir: &Path,
+) -> String {
+    let mut args: Vec<String> = vec![exe.into(), "train".into(), dataset.display().to_string()];
+    match spec.repr {
+        ReprConfig::Static(s) => {
+            args.extend(["--repr".into(), "static".into()]);
+            args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
+            args.extend(["--threshold".into(), s.threshold.to_string()]);
+        }
+        ReprConfig::Dynamic(d) => {
+            args.extend(["--repr".into(), "dynamic".into()]);
+            args.extend(["--window-ms".into(), d.window_ms.to_string()]);
+            args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
+        }
+        ReprConfig::Combined {
+            static_part: s,
+            dynamic_part: d,
+        } => {
+            args.extend(["--repr".into(), "combined".into()]);
+            args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
+            args.extend(["--threshold".into(), s.threshold.to_string()]);
+            args.extend(["--window-ms".into(), d.window_ms.to_string()]);
+            args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
+        }
+    }
+    args.extend(["--epochs".into(), spec.epochs.to_string()]);
+    args.extend(["--seed".into(), spec.seed.to_string()]);
+    args.extend(["--splits-seed".into(), splits_seed.to_string()]);
+    if spec.sampling == Sampling::WITH_STOP {
+        args.push("--stop-samples".into());
+        if spec.phases.len() > 1 {
+            args.push("--train-on-stop".into());
+        }
+    }
+    args.extend(["--out".into(), dir.display().to_string()]);
+    args.push("--quiet".into());
+    jobs::command_line(&args)
+}
+
+/// The training jobs that can run now and are not finished, as `evtac train` command lines:
+/// the tuning runs, and once both tunings are finished, Experiments 1 and 2. Run them (in any
+/// order, in parallel), then run `evtac reproduce` again: it resumes from the finished jobs.
+/// Makes the splits (and needs the Experiment 1 dataset).
+pub fn export_jobs(
+    data: &Datasets,
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+    exe: &str,
+) -> Result<Vec<String>, Error> {
+    let models = out.join("models");
+    let ds1 = Dataset::open(&data.exp1)?;
+    ds1.splits(seed)?;
+    let mut lines = Vec::new();
+    let mut tuned = Vec::new();
+    for kind in [Kind::Static, Kind::Dynamic] {
+        let mut best: Option<(f64, ReprConfig)> = None;
+        let mut all_done = true;
+        for p in tuning::grid(plan, kind) {
+            let dir = tuning::run_dir(&models, kind, &p.config);
+            if exp1::finished(&dir) {
+                if let Ok(b) = evtac_learn::ModelBundle::load(&dir) {
+                    let v = b.config.metrics.validation.overall;
+                    if best.is_none_or(|(bv, _)| v < bv) {
+                        best = Some((v, p.config));
+                    }
+                }
+            } else {
+                all_done = false;
+                lines.push(train_command(
+                    exe,
+                    &data.exp1,
+                    &tuning::spec(p.config, plan, seed),
+                    seed,
+                    &dir,
+                ));
+            }
+        }
+        if all_done && let Some((_, c)) = best {
+            tuned.push(c);
+        }
+    }
+    if let [s, d] = tuned[..] {
+        let reprs = exp1::representations(s, d);
+        for j in exp1::jobs(&reprs, plan, seed, &models) {
+            if !exp1::finished(&j.dir) {
+                lines.push(train_command(exe, &data.exp1, &j.spec, seed, &j.dir));
+            }
+        }
+        if let Some(d2) = &data.exp2 {
+            Dataset::open(d2)?.splits(seed)?;
+            for j in exp2::jobs(&reprs, plan, seed, &models) {
+                if !exp1::finished(&j.dir) {
+                    lines.push(train_command(exe, d2, &j.spec, seed, &j.dir));
+                }
+            }
+        }
+    }
+    Ok(lines)
+}

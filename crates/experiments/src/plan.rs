@@ -1,0 +1,179 @@
+//! What a reproduction runs at each scale: the tuning grids, epochs, seeds and latency settings.
+//!
+//! `paper` is the paper's protocol (full grids, 100 epochs, ten seeds). `small` and `tiny` keep
+//! its structure with fewer runs so that `evtac reproduce --scale small` finishes in under 20
+//! minutes on a 2-core machine: the grid becomes a cross through the paper's chosen settings (one
+//! parameter varied while the other is fixed, as the paper's tuning figure shows), and epochs
+//! and seeds are fewer. The report states the plan it ran.
+
+use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use serde::{Deserialize, Serialize};
+
+/// The settings of one reproduction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// `tiny`, `small` or `paper`.
+    pub scale: String,
+    /// Static decay constants tried, ms.
+    pub static_taus_ms: Vec<f64>,
+    /// Static thresholds tried, event contributions.
+    pub static_thresholds: Vec<f32>,
+    /// Dynamic windows tried, ms.
+    pub dynamic_windows_ms: Vec<f64>,
+    /// Dynamic thresholds tried, event counts.
+    pub dynamic_thresholds: Vec<u32>,
+    /// Every combination (`true`, the paper) or a cross through the centers (`false`).
+    pub full_grid: bool,
+    /// The static (tau, threshold) the cross passes through.
+    pub static_center: (f64, f32),
+    /// The dynamic (window, threshold) the cross passes through.
+    pub dynamic_center: (f64, u32),
+    /// Epochs of each tuning run.
+    pub tuning_epochs: usize,
+    /// Epochs of the final runs (Experiments 1 and 2).
+    pub epochs: usize,
+    /// Seeds per representation in Experiment 1.
+    pub seeds: usize,
+    /// Seeds per (setting, representation) in Experiment 2.
+    pub exp2_seeds: usize,
+    /// Test trials used by the latency study (at most).
+    pub latency_trials: usize,
+    /// Sampling intervals of the latency study, ms.
+    pub latency_intervals_ms: Vec<u32>,
+}
+
+impl Plan {
+    /// The plan of a scale (`tiny`, `small`, `paper`), or `None` for another name.
+    pub fn for_scale(scale: &str) -> Option<Plan> {
+        let paper_center_static = (1000.0, 2.0);
+        let paper_center_dynamic = (640.0, 0);
+        match scale {
+            "paper" => Some(Plan {
+                scale: scale.into(),
+                static_taus_ms: vec![100.0, 250.0, 500.0, 750.0, 1000.0, 1500.0, 2000.0],
+                static_thresholds: vec![0.0, 1.0, 2.0, 3.0, 4.0],
+                dynamic_windows_ms: vec![10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0],
+                dynamic_thresholds: vec![0, 1, 2, 3, 4],
+                full_grid: true,
+                static_center: paper_center_static,
+                dynamic_center: paper_center_dynamic,
+                tuning_epochs: 100,
+                epochs: 100,
+                seeds: 10,
+                exp2_seeds: 10,
+                latency_trials: 150,
+                latency_intervals_ms: vec![1, 2, 5, 10],
+            }),
+            "small" => Some(Plan {
+                scale: scale.into(),
+                static_taus_ms: vec![100.0, 300.0, 1000.0, 2000.0],
+                static_thresholds: vec![0.0, 1.0, 2.0, 4.0],
+                dynamic_windows_ms: vec![40.0, 160.0, 640.0, 1280.0],
+                dynamic_thresholds: vec![0, 1, 2, 4],
+                full_grid: false,
+                static_center: paper_center_static,
+                dynamic_center: paper_center_dynamic,
+                tuning_epochs: 15,
+                epochs: 30,
+                seeds: 3,
+                exp2_seeds: 2,
+                latency_trials: 8,
+                latency_intervals_ms: vec![1, 2, 5, 10],
+            }),
+            "tiny" => Some(Plan {
+                scale: scale.into(),
+                static_taus_ms: vec![100.0, 1000.0],
+                static_thresholds: vec![0.0, 2.0],
+                dynamic_windows_ms: vec![80.0, 640.0],
+                dynamic_thresholds: vec![0, 2],
+                full_grid: false,
+                static_center: paper_center_static,
+                dynamic_center: paper_center_dynamic,
+                tuning_epochs: 2,
+                epochs: 3,
+                seeds: 2,
+                exp2_seeds: 2,
+                latency_trials: 2,
+                latency_intervals_ms: vec![1, 2, 5, 10],
+            }),
+            _ => None,
+        }
+    }
+
+    /// The static grid as (tau, threshold) pairs, in a fixed order.
+    pub fn static_grid(&self) -> Vec<(f64, f32)> {
+        grid(
+            &self.static_taus_ms,
+            &self.static_thresholds,
+            self.full_grid,
+            self.static_center,
+        )
+    }
+
+    /// The dynamic grid as (window, threshold) pairs, in a fixed order.
+    pub fn dynamic_grid(&self) -> Vec<(f64, u32)> {
+        grid(
+            &self.dynamic_windows_ms,
+            &self.dynamic_thresholds,
+            self.full_grid,
+            self.dynamic_center,
+        )
+    }
+}
+
+fn grid<T: Copy + PartialEq>(
+    times: &[f64],
+    thresholds: &[T],
+    full: bool,
+    center: (f64, T),
+) -> Vec<(f64, T)> {
+    let mut out = Vec::new();
+    for &t in times {
+        for &th in thresholds {
+            if full || th == center.1 || t == center.0 {
+                out.push((t, th));
+            }
+        }
+    }
+    // A cross always contains its center, even when the lists do not.
+    if !out.contains(&center) {
+        out.push(center);
+    }
+    out
+}
+
+/// The static config with the paper's other settings and `tau_ms`, `threshold`.
+pub fn static_config(tau_ms: f64, threshold: f32) -> ReprConfig {
+    ReprConfig::Static(StaticConfig {
+        tau_ms,
+        threshold,
+        ..StaticConfig::default()
+    })
+}
+
+/// The dynamic config with `window_ms` and `count_threshold`.
+pub fn dynamic_config(window_ms: f64, count_threshold: u32) -> ReprConfig {
+    ReprConfig::Dynamic(DynamicConfig {
+        window_ms,
+        count_threshold,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_grid_is_full_and_small_grid_is_a_cross() {
+        let paper = Plan::for_scale("paper").unwrap();
+        assert_eq!(paper.static_grid().len(), 7 * 5);
+        assert_eq!(paper.dynamic_grid().len(), 8 * 5);
+        let small = Plan::for_scale("small").unwrap();
+        let g = small.static_grid();
+        // 4 taus at threshold 2, plus 3 other thresholds at tau 1000.
+        assert_eq!(g.len(), 4 + 3);
+        assert!(g.contains(&(1000.0, 2.0)));
+        assert!(g.iter().all(|&(t, th)| t == 1000.0 || th == 2.0));
+        assert!(Plan::for_scale("huge").is_none());
+    }
+}

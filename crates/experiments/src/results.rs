@@ -1,0 +1,297 @@
+//! The numbers a reproduction produces, as one serde tree written to `OUT/results.json` and read
+//! by the report and the figures.
+
+use serde::{Deserialize, Serialize};
+
+/// Mean absolute errors in degrees: overall (mean of pitch and roll), pitch and roll.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Mae {
+    /// Mean of the pitch and roll MAE.
+    pub overall: f64,
+    /// Pitch MAE.
+    pub pitch: f64,
+    /// Roll MAE.
+    pub roll: f64,
+}
+
+impl Mae {
+    /// MAE of `pred` against `labels`, both rows of (pitch, roll); zeros when empty.
+    pub fn of(pred: &[[f32; 2]], labels: &[[f32; 2]]) -> Mae {
+        let n = pred.len().min(labels.len());
+        if n == 0 {
+            return Mae::default();
+        }
+        let (mut p, mut r) = (0.0f64, 0.0f64);
+        for (a, b) in pred.iter().zip(labels) {
+            p += (f64::from(a[0]) - f64::from(b[0])).abs();
+            r += (f64::from(a[1]) - f64::from(b[1])).abs();
+        }
+        let (p, r) = (p / n as f64, r / n as f64);
+        Mae {
+            overall: (p + r) / 2.0,
+            pitch: p,
+            roll: r,
+        }
+    }
+}
+
+/// Mean and sample standard deviation over repeated runs.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct MeanStd {
+    /// Mean.
+    pub mean: f64,
+    /// Sample standard deviation (n - 1; 0 for a single run).
+    pub std: f64,
+    /// Number of runs.
+    pub n: usize,
+}
+
+impl MeanStd {
+    /// Mean and sample standard deviation of `values`.
+    pub fn of(values: &[f64]) -> MeanStd {
+        let n = values.len();
+        if n == 0 {
+            return MeanStd::default();
+        }
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let var = if n > 1 {
+            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64
+        } else {
+            0.0
+        };
+        MeanStd {
+            mean,
+            std: var.sqrt(),
+            n,
+        }
+    }
+
+    /// `0.160 ± 0.004`.
+    pub fn display(&self) -> String {
+        format!("{:.3} ± {:.3}", self.mean, self.std)
+    }
+}
+
+/// [`MeanStd`] of the overall, pitch and roll MAE over runs.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct MaeStats {
+    /// Overall MAE.
+    pub overall: MeanStd,
+    /// Pitch MAE.
+    pub pitch: MeanStd,
+    /// Roll MAE.
+    pub roll: MeanStd,
+}
+
+impl MaeStats {
+    /// Statistics over `runs`.
+    pub fn of(runs: &[Mae]) -> MaeStats {
+        let col = |f: fn(&Mae) -> f64| MeanStd::of(&runs.iter().map(f).collect::<Vec<_>>());
+        MaeStats {
+            overall: col(|m| m.overall),
+            pitch: col(|m| m.pitch),
+            roll: col(|m| m.roll),
+        }
+    }
+}
+
+/// One training run of the grid search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TuningRun {
+    /// Decay tau (static) or window (dynamic) in ms.
+    pub time_ms: f64,
+    /// Binarization threshold (event contributions or counts).
+    pub threshold: f64,
+    /// Best validation MAE of the run.
+    pub val: Mae,
+}
+
+/// The grid search of one representation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Tuning {
+    /// `static` or `dynamic`.
+    pub repr: String,
+    /// Name of the time parameter (`tau_ms` or `window_ms`).
+    pub time_name: String,
+    /// Every run of the grid.
+    pub runs: Vec<TuningRun>,
+    /// The chosen time parameter (lowest validation MAE).
+    pub chosen_time_ms: f64,
+    /// The chosen threshold.
+    pub chosen_threshold: f64,
+    /// The representation config chosen, as the repr crate serializes it.
+    pub chosen_config: serde_json::Value,
+    /// The time parameter fixed along the threshold curve of the figure.
+    pub curve_time_ms: f64,
+    /// The threshold fixed along the time curve of the figure.
+    pub curve_threshold: f64,
+}
+
+/// Experiment 1 for one representation: ten seeds with the chosen settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Exp1Repr {
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// The representation config.
+    pub config: serde_json::Value,
+    /// Seeds trained.
+    pub seeds: Vec<u64>,
+    /// Test MAE per seed.
+    pub runs: Vec<Mae>,
+    /// Best validation MAE per seed.
+    pub val_runs: Vec<Mae>,
+    /// Test MAE statistics over seeds.
+    pub test: MaeStats,
+}
+
+/// Experiment 2 for one (training setting, representation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Exp2Cell {
+    /// `continuous-only`, `pause-motion` or `pause-motion-stop`.
+    pub setting: String,
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// Motion-phase test MAE per seed.
+    pub motion_runs: Vec<Mae>,
+    /// Stop-phase test MAE per seed.
+    pub stop_runs: Vec<Mae>,
+    /// Motion-phase statistics.
+    pub motion: MaeStats,
+    /// Stop-phase statistics.
+    pub stop: MaeStats,
+}
+
+/// Experiment 3: one condition value (a speed or a depth) for one representation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Exp3Point {
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// Speed in deg/s or depth in mm.
+    pub value: f64,
+    /// Whether the value was in the training set (`seen`) or interpolated (`unseen`).
+    pub seen: bool,
+    /// Number of trials at this value.
+    pub trials: usize,
+    /// MAE per Experiment 1 model (seed).
+    pub runs: Vec<Mae>,
+    /// Statistics over the models.
+    pub stats: MaeStats,
+}
+
+/// Latency of one (representation, sampling interval).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LatencyCell {
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// Sampling interval in ms.
+    pub interval_ms: u32,
+    /// Number of measured samples.
+    pub samples: usize,
+    /// Median end-to-end time in microseconds.
+    pub median_us: f64,
+    /// 99th percentile in microseconds.
+    pub p99_us: f64,
+    /// Maximum in microseconds.
+    pub max_us: f64,
+    /// Samples above the sampling interval.
+    pub over_interval: usize,
+    /// Samples above the paper's 10 ms bound.
+    pub over_10ms: usize,
+    /// The measured times in microseconds (kept for the figure).
+    pub times_us: Vec<f64>,
+}
+
+/// Where the reproduction's settings came from and how long it took.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    /// `tiny`, `small`, `paper` or `custom`.
+    pub scale: String,
+    /// Master seed.
+    pub seed: u64,
+    /// The plan (grids, epochs, seeds) as run.
+    pub plan: serde_json::Value,
+    /// Wall time per stage in seconds, in order.
+    pub stage_seconds: Vec<(String, f64)>,
+    /// Trials per dataset.
+    pub datasets: Vec<(String, usize)>,
+}
+
+/// Example curves of one pause trial (Experiment 2's figure).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ExampleTrial {
+    /// Trial name.
+    pub trial: String,
+    /// Stop interval in seconds from motion onset, if any.
+    pub stop_s: Option<(f64, f64)>,
+    /// Sample times in seconds from motion onset.
+    pub t_s: Vec<f64>,
+    /// Ground-truth (pitch, roll) at the sample times.
+    pub truth: Vec<[f32; 2]>,
+    /// Predictions per representation name.
+    pub predictions: Vec<(String, Vec<[f32; 2]>)>,
+}
+
+/// Binary frames for the contour overlays: two conditions per panel.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Overlay {
+    /// Panel title.
+    pub title: String,
+    /// Label of the first condition (red).
+    pub first_label: String,
+    /// Label of the second condition (orange).
+    pub second_label: String,
+    /// Frame width in pixels.
+    pub width: usize,
+    /// Frame height in pixels.
+    pub height: usize,
+    /// First binary frame (row-major, non-zero = set).
+    pub first: Vec<u8>,
+    /// Second binary frame.
+    pub second: Vec<u8>,
+}
+
+/// Everything a reproduction measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Results {
+    /// Settings and timings.
+    pub run: RunInfo,
+    /// Grid searches (static, dynamic).
+    pub tuning: Vec<Tuning>,
+    /// Experiment 1 per representation.
+    pub exp1: Vec<Exp1Repr>,
+    /// Experiment 2 per (setting, representation).
+    pub exp2: Vec<Exp2Cell>,
+    /// Experiment 3 per speed.
+    pub exp3_speed: Vec<Exp3Point>,
+    /// Experiment 3 per depth.
+    pub exp3_depth: Vec<Exp3Point>,
+    /// Latency per (representation, interval).
+    pub latency: Vec<LatencyCell>,
+    /// The Experiment 2 example trial.
+    pub example: Option<ExampleTrial>,
+    /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
+    #[serde(skip)]
+    pub overlays: Vec<Overlay>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mae_and_stats() {
+        let m = Mae::of(&[[1.0, 2.0], [3.0, 2.0]], &[[0.0, 0.0], [3.0, 4.0]]);
+        assert_eq!(
+            m,
+            Mae {
+                overall: 1.25,
+                pitch: 0.5,
+                roll: 2.0
+            }
+        );
+        let s = MeanStd::of(&[1.0, 2.0, 3.0]);
+        assert_eq!((s.mean, s.std, s.n), (2.0, 1.0, 3));
+        assert_eq!(s.display(), "2.000 ± 1.000");
+        assert_eq!(MeanStd::of(&[5.0]).std, 0.0);
+    }
+}

@@ -1,0 +1,171 @@
+//! Experiment 1's hyperparameter search: one training run per (decay tau x threshold) for the
+//! static representation and per (window x threshold) for the dynamic one, each selected at its
+//! best validation epoch; the setting with the lowest validation MAE is chosen.
+
+use crate::cache::FeatureCache;
+use crate::jobs::{self, Progress};
+use crate::plan::{self, Plan};
+use crate::results::{Mae, Tuning, TuningRun};
+use crate::sampling::{Phase, Sampling};
+use crate::splits::{Split, Splits};
+use crate::training::{self, Error, TrainSpec};
+use evtac_learn::ModelBundle;
+use evtac_repr::ReprConfig;
+use std::path::{Path, PathBuf};
+
+/// Which representation is tuned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Decay tau x threshold.
+    Static,
+    /// Window x threshold.
+    Dynamic,
+}
+
+impl Kind {
+    /// `static` or `dynamic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Static => "static",
+            Kind::Dynamic => "dynamic",
+        }
+    }
+}
+
+/// One grid point: its (time, threshold) and config.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridPoint {
+    /// Tau or window, ms.
+    pub time_ms: f64,
+    /// Threshold.
+    pub threshold: f64,
+    /// The config.
+    pub config: ReprConfig,
+}
+
+/// The grid of `kind` under `plan`.
+pub fn grid(plan: &Plan, kind: Kind) -> Vec<GridPoint> {
+    match kind {
+        Kind::Static => plan
+            .static_grid()
+            .into_iter()
+            .map(|(t, th)| GridPoint {
+                time_ms: t,
+                threshold: f64::from(th),
+                config: plan::static_config(t, th),
+            })
+            .collect(),
+        Kind::Dynamic => plan
+            .dynamic_grid()
+            .into_iter()
+            .map(|(t, th)| GridPoint {
+                time_ms: t,
+                threshold: f64::from(th),
+                config: plan::dynamic_config(t, th),
+            })
+            .collect(),
+    }
+}
+
+/// The folder of one tuning run.
+pub fn run_dir(out: &Path, kind: Kind, config: &ReprConfig) -> PathBuf {
+    out.join("tuning")
+        .join(kind.name())
+        .join(config.cache_key())
+}
+
+/// The training job of one grid point.
+pub fn spec(config: ReprConfig, plan: &Plan, seed: u64) -> TrainSpec {
+    TrainSpec {
+        repr: config,
+        seed,
+        epochs: plan.tuning_epochs,
+        sampling: Sampling::MOTION,
+        phases: vec![Phase::Motion],
+    }
+}
+
+/// Runs (or resumes) the grid search of `kind` and picks the setting with the lowest validation
+/// MAE. Runs go in parallel; finished runs (with `done`) are read back, not redone.
+pub fn tune(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    plan: &Plan,
+    kind: Kind,
+    seed: u64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Tuning, Error> {
+    let points = grid(plan, kind);
+    let ds = cache.dataset();
+    let trials = ds.trials(&[splits.get(Split::Train), splits.get(Split::Val)].concat())?;
+    let configs: Vec<ReprConfig> = points.iter().map(|p| p.config).collect();
+    progress.stage(
+        &format!("features ({} tuning)", kind.name()),
+        trials.len() as u64,
+    );
+    cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
+    progress.stage(&format!("tuning {}", kind.name()), points.len() as u64);
+    jobs::run_all(
+        &points,
+        |p| run_dir(out, kind, &p.config),
+        |p| {
+            training::train_job(
+                cache,
+                splits,
+                &spec(p.config, plan, seed),
+                &run_dir(out, kind, &p.config),
+                |_| {},
+            )
+            .map(|_| ())
+        },
+        || progress.advance(1),
+    )?;
+    let mut runs = Vec::new();
+    for p in &points {
+        let bundle = ModelBundle::load(&run_dir(out, kind, &p.config))?;
+        runs.push(TuningRun {
+            time_ms: p.time_ms,
+            threshold: p.threshold,
+            val: Mae::from(bundle.config.metrics.validation),
+        });
+    }
+    let best = runs
+        .iter()
+        .zip(&points)
+        .min_by(|a, b| a.0.val.overall.total_cmp(&b.0.val.overall))
+        .map(|(_, p)| p.clone())
+        .unwrap_or_else(|| points[0].clone());
+    Ok(Tuning {
+        repr: kind.name().into(),
+        time_name: match kind {
+            Kind::Static => "tau_ms".into(),
+            Kind::Dynamic => "window_ms".into(),
+        },
+        runs,
+        chosen_time_ms: best.time_ms,
+        chosen_threshold: best.threshold,
+        chosen_config: serde_json::to_value(best.config).unwrap_or(serde_json::Value::Null),
+        curve_time_ms: if plan.full_grid {
+            best.time_ms
+        } else {
+            match kind {
+                Kind::Static => plan.static_center.0,
+                Kind::Dynamic => plan.dynamic_center.0,
+            }
+        },
+        curve_threshold: if plan.full_grid {
+            best.threshold
+        } else {
+            match kind {
+                Kind::Static => f64::from(plan.static_center.1),
+                Kind::Dynamic => f64::from(plan.dynamic_center.1),
+            }
+        },
+    })
+}
+
+/// The chosen config of a finished tuning.
+pub fn chosen(t: &Tuning) -> Option<ReprConfig> {
+    serde_json::from_value(t.chosen_config.clone()).ok()
+}

@@ -1,0 +1,52 @@
+//! Interrupted runs resume from finished jobs.
+
+use crate::simulate;
+use evtac_experiments::cache::FeatureCache;
+use evtac_experiments::dataset::Dataset;
+use evtac_experiments::exp1;
+use evtac_experiments::jobs::{self, Quiet};
+use evtac_experiments::plan::{self, Plan};
+use evtac_learn::ModelBundle;
+use evtac_sim::Protocol;
+
+#[test]
+fn resumed_run_redoes_only_the_unfinished_job() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("exp1");
+    let out = dir.path().join("out");
+    simulate(&data, Protocol::Exp1, 6);
+    let ds = Dataset::open(&data).unwrap();
+    let splits = ds.splits(1).unwrap();
+    assert!(data.join("splits.json").is_file());
+    let cache = FeatureCache::new(&ds).unwrap();
+    let mut p = Plan::for_scale("tiny").unwrap();
+    p.epochs = 1;
+    p.seeds = 2;
+    let reprs = exp1::representations(
+        plan::static_config(1000.0, 2.0),
+        plan::dynamic_config(640.0, 0),
+    );
+    let list = exp1::jobs(&reprs[..1], &p, 5, &out);
+    assert_eq!(list.len(), 2);
+    exp1::train_all(&cache, &splits, &list, &Quiet).unwrap();
+    assert!(list.iter().all(|j| jobs::is_done(&j.dir)));
+    let weights = |j: &exp1::SeedJob| std::fs::read(j.dir.join("model.safetensors")).unwrap();
+    let before: Vec<Vec<u8>> = list.iter().map(weights).collect();
+    // "Interrupt" the second job: its marker and weights are gone, a stale file is left.
+    std::fs::remove_file(list[1].dir.join(jobs::DONE)).unwrap();
+    std::fs::write(list[1].dir.join("model.safetensors"), b"partial").unwrap();
+    let stamp = std::fs::metadata(list[0].dir.join("model.safetensors"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    exp1::train_all(&cache, &splits, &list, &Quiet).unwrap();
+    // The finished job was not touched; the unfinished one was redone, to the same bytes.
+    let stamp_after = std::fs::metadata(list[0].dir.join("model.safetensors"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(stamp, stamp_after);
+    assert!(jobs::is_done(&list[1].dir));
+    assert_eq!(weights(&list[1]), before[1]);
+    assert!(ModelBundle::load(&list[1].dir).is_ok());
+}
