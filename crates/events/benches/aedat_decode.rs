@@ -1,11 +1,13 @@
 //! AEDAT 4.0 decoding throughput (events/s), LZ4 and zstd, against the raw decompressors.
 //!
-//! Setup writes two files of 3 million synthetic events (640x480, ~1 Mev/s, seeded) with our
+//! Setup writes three files of 3 million synthetic events (640x480, ~1 Mev/s, seeded) with our
 //! writer into `$EVTAC_BENCH_DIR` (default: `<tmp>/evtac-aedat-bench`), where
 //! `benches/aedat_reference.py` times dv-processing and the `aedat` Python package on the same
 //! files. Groups:
-//! - `aedat_decode/{lz4,zstd}`: `AedatReader` over the file held in memory, all events.
-//! - `decompress_only/{lz4,zstd}`: lz4_flex / zstd alone on the same packet payloads (the floor).
+//! - `aedat_decode/{none,lz4,zstd}`: `AedatReader` over the file held in memory, all events
+//!   (`none` shows the cost of framing, verification and conversion alone).
+//! - `decompress_only/{lz4,zstd}`: the bare lz4_flex block decoder / zstd context alone on the same
+//!   packet payloads (the floor).
 
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -62,20 +64,21 @@ fn payloads(bytes: &[u8]) -> Vec<&[u8]> {
     out
 }
 
-/// Packet bytes fed to the reused LZ4 frame decoder.
-#[derive(Default)]
-struct Source {
-    bytes: Vec<u8>,
-    pos: usize,
-}
-
-impl std::io::Read for Source {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let rest = &self.bytes[self.pos..];
-        let n = rest.len().min(buf.len());
-        buf[..n].copy_from_slice(&rest[..n]);
-        self.pos += n;
-        Ok(n)
+/// The compressed blocks of an LZ4 frame as our writer makes it (no checksums, no content size;
+/// uncompressed blocks do not occur in these files).
+fn lz4_blocks(frame: &[u8]) -> Vec<&[u8]> {
+    let mut pos = 7;
+    let mut blocks = Vec::new();
+    loop {
+        let head = u32::from_le_bytes(frame[pos..pos + 4].try_into().expect("4 bytes"));
+        pos += 4;
+        if head == 0 {
+            return blocks;
+        }
+        assert_eq!(head & 0x8000_0000, 0, "uncompressed block");
+        let size = head as usize;
+        blocks.push(&frame[pos..pos + size]);
+        pos += size;
     }
 }
 
@@ -85,7 +88,11 @@ fn decode(c: &mut Criterion) {
     let dir = bench_dir();
     std::fs::create_dir_all(&dir).expect("bench dir");
     let mut files = Vec::new();
-    for (name, compression) in [("lz4", Compression::Lz4), ("zstd", Compression::Zstd)] {
+    for (name, compression) in [
+        ("none", Compression::None),
+        ("lz4", Compression::Lz4),
+        ("zstd", Compression::Zstd),
+    ] {
         let path = dir.join(format!("bench_{name}.aedat4"));
         let config = WriterConfig {
             resolution: res,
@@ -118,29 +125,39 @@ fn decode(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("decompress_only");
     g.throughput(Throughput::Elements(EVENTS as u64));
-    for (name, bytes) in &files {
+    // Uncompressed: nothing to decompress, so no floor to compare with.
+    for (name, bytes) in files.iter().filter(|(name, _)| *name != "none") {
         let packets = payloads(bytes);
+        let blocks: Vec<Vec<&[u8]>> = if *name == "lz4" {
+            packets.iter().map(|p| lz4_blocks(p)).collect()
+        } else {
+            Vec::new()
+        };
         let mut out = Vec::with_capacity(1 << 20);
-        // One LZ4 frame decoder for all packets (its window buffers reused), as the reader does.
-        let mut lz4 = lz4_flex::frame::FrameDecoder::new(Source::default());
         let mut zstd_ctx = zstd::bulk::Decompressor::new().expect("zstd context");
         g.bench_function(*name, |b| {
             b.iter(|| {
                 let mut total = 0usize;
-                for p in &packets {
-                    out.clear();
-                    if *name == "lz4" {
-                        use std::io::Read;
-                        let src = lz4.get_mut();
-                        src.bytes.clear();
-                        src.bytes.extend_from_slice(p);
-                        src.pos = 0;
-                        lz4.read_to_end(&mut out).expect("lz4");
-                    } else {
-                        out.reserve(1 << 20);
-                        zstd_ctx.decompress_to_buffer(*p, &mut out).expect("zstd");
+                if *name == "lz4" {
+                    // The bare block decoder over each frame's blocks: no frame parsing.
+                    out.resize(1 << 20, 0);
+                    for packet in &blocks {
+                        let mut len = 0;
+                        for block in packet {
+                            let (before, rest) = out.split_at_mut(len);
+                            let dict = &before[len.saturating_sub(1 << 16)..];
+                            len += lz4_flex::block::decompress_into_with_dict(block, rest, dict)
+                                .expect("lz4");
+                        }
+                        total += len;
                     }
-                    total += out.len();
+                } else {
+                    for p in &packets {
+                        out.clear();
+                        out.reserve(1 << 20);
+                        zstd_ctx.decompress_to_buffer(p, &mut out).expect("zstd");
+                        total += out.len();
+                    }
                 }
                 black_box(total)
             })

@@ -57,7 +57,7 @@ def main():
         decoders.append(("aedat", aedat_pkg))
     except ImportError:
         print("aedat (PyPI) not installed: skipped")
-    for name in ("lz4", "zstd"):
+    for name in ("none", "lz4", "zstd"):
         path = os.path.join(d, f"bench_{name}.aedat4")
         for label, make in decoders:
             try:

@@ -117,7 +117,7 @@ pub enum AedatError {
     },
     /// An event lies outside the stream's declared resolution (or has negative coordinates).
     #[error(
-        "event {index} of stream {stream_id} (packet at byte {offset}) at x={x}, y={y} is outside the declared {width}x{height}"
+        "event {index} of stream {stream_id} (packet at byte {offset}) at x={x}, y={y} is outside {width}x{height} (the declared resolution or the int16 range)"
     )]
     OutOfBounds {
         /// Index of the event within its stream, from 0.
@@ -130,9 +130,10 @@ pub enum AedatError {
         x: i32,
         /// The event's y as stored.
         y: i32,
-        /// Declared width (65536 when the stream declares none: only the `u16` range applies).
+        /// Declared width (32768 when the stream declares none: only the non-negative `int16`
+        /// range applies).
         width: u32,
-        /// Declared height (65536 when the stream declares none).
+        /// Declared height (32768 when the stream declares none).
         height: u32,
     },
     /// A timestamp is smaller than the one before it in the same stream.
