@@ -1,1 +1,52 @@
-//! Online contact-angle estimation from live or replayed event streams.
+//! Online contact-angle estimation from live or replayed event streams, with measured latency.
+//!
+//! A robot needs the contact angle while it moves. This crate runs a trained model (an
+//! `evtac-learn` model bundle: weights, representation settings, no-contact mask) on an event
+//! stream and emits `(pitch, roll)` at a fixed interval of event time, stamping each estimate
+//! with its processing latency.
+//!
+//! - [`input`]: where events come from: a recording replayed as fast as possible or at
+//!   recorded pace ([`input::Paced`]), a live DV network stream with reconnection and backoff,
+//!   standard input, or memory.
+//! - [`Estimator`]: the single-threaded core (crop, representation, MLP, latency stamp).
+//! - [`pipeline::run`]: ingestion and estimation on two threads with a bounded queue between.
+//! - [`Summary`]: estimates, median/P99/max latency, late estimates, dropped events.
+//!
+//! The exact definition of latency is in `docs/online.md`; in short, it runs from the moment the
+//! ingestion thread received the chunk that made an estimate's time final to the end of that
+//! estimate's forward pass.
+//!
+//! ```no_run
+//! use evtac_online::{Model, Estimator, input::SourceSpec, pipeline::{self, Output, PipelineConfig}};
+//! use std::ops::ControlFlow;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let model = Model::load("model/".as_ref())?;
+//! let spec: SourceSpec = "recording.aedat4".parse()?;
+//! let source = evtac_online::input::open(&spec, &Default::default())?;
+//! let estimator = model.estimator(source.resolution(None)?, 1000)?;
+//! let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
+//!     if let Output::Estimate(e) = out {
+//!         println!("{} {} {}", e.t_us, e.pitch_deg, e.roll_deg);
+//!     }
+//!     ControlFlow::Continue(())
+//! })?;
+//! println!("{summary}");
+//! # Ok(()) }
+//! ```
+
+mod backoff;
+mod estimator;
+pub mod input;
+mod latency;
+mod model;
+mod notice;
+pub mod pipeline;
+mod schedule;
+
+pub use backoff::Backoff;
+pub use estimator::{CROP_SIZE, Counters, Error as EstimatorError, Estimate, Estimator};
+pub use latency::{LatencyStats, Summary};
+pub use model::{Error as ModelError, Model};
+pub use notice::Notice;
+pub use schedule::{Error as ScheduleError, Schedule};

@@ -1,0 +1,120 @@
+//! Per-estimate latency at 1 ms intervals, for each representation, at a realistic event rate
+//! (300k events/s, a NeuroTac in contact) and at 10x that.
+//!
+//! Two measurements per case:
+//! - criterion, `estimate/<repr>/<rate>`: one iteration is one 1 ms packet of events handed to
+//!   the [`Estimator`] (crop, representation update, advance, pool, MLP): the processing cost
+//!   of one estimate on one core. The same iterations fill a latency histogram whose median, P99
+//!   and max are printed, with the count of estimates over 1 ms.
+//! - `pipeline/<repr>/<rate>`: 2 s of events replayed at recorded pace through the two-thread
+//!   pipeline in 1 ms slices; prints the run's summary (latency as defined in docs/online.md).
+//!
+//! Run: `nice cargo bench -p evtac-online --bench latency -- --warm-up-time 1 --measurement-time 3`
+
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use evtac_events::Event;
+use evtac_online::input::{MemorySource, Paced};
+use evtac_online::pipeline::{self, PipelineConfig};
+use evtac_online::{LatencyStats, Model};
+use std::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+const RATES: [(&str, f64); 2] = [("300k", 300_000.0), ("3M", 3_000_000.0)];
+const SPAN_US: i64 = 2_000_000;
+
+fn us(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e6
+}
+
+fn estimate(c: &mut Criterion) {
+    evtac_learn::flush_denormals();
+    let mut group = c.benchmark_group("estimate");
+    for (name, repr) in support::representations() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        support::seeded_bundle(dir.path(), 1, &repr, None);
+        let model = Model::load(dir.path()).expect("the bundle loads");
+        for (rate_name, rate) in RATES {
+            let events = support::Synthetic::new(1, rate, 1000, SPAN_US).collect();
+            // 1 ms packets, replayed in a loop with the clock moved on each lap.
+            let bounds: Vec<usize> = (0..=SPAN_US / 1000)
+                .map(|k| events.partition_point(|e: &Event| e.t < k * 1000))
+                .collect();
+            let mut estimator = model
+                .estimator(support::SENSOR, 1000)
+                .expect("the estimator builds");
+            let mut stats = LatencyStats::new(Duration::from_millis(1));
+            let mut packet =
+                Vec::with_capacity(bounds.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0));
+            let mut k = 0usize;
+            let mut lap = 0i64;
+            group.bench_function(format!("{name}/{rate_name}"), |b| {
+                b.iter_custom(|iters| {
+                    let mut total = Duration::ZERO;
+                    for _ in 0..iters {
+                        if k + 1 >= bounds.len() {
+                            k = 0;
+                            lap += 1;
+                        }
+                        packet.clear();
+                        packet.extend(events[bounds[k]..bounds[k + 1]].iter().map(|e| Event {
+                            t: e.t + lap * SPAN_US,
+                            ..*e
+                        }));
+                        k += 1;
+                        let arrival = Instant::now();
+                        estimator
+                            .process(&packet, None, arrival, &mut |e| stats.record(e.latency))
+                            .expect("the estimator accepts the packet");
+                        total += arrival.elapsed();
+                    }
+                    total
+                });
+            });
+            eprintln!(
+                "estimate/{name}/{rate_name}: {} estimates, median {:.1} us, P99 {:.1} us, \
+                 max {:.1} us, over 1 ms: {}",
+                stats.count(),
+                us(stats.quantile(0.5)),
+                us(stats.quantile(0.99)),
+                us(stats.max()),
+                stats.late()
+            );
+        }
+    }
+    group.finish();
+}
+
+fn paced_pipeline(_c: &mut Criterion) {
+    for (name, repr) in support::representations() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        support::seeded_bundle(dir.path(), 1, &repr, None);
+        let model = Model::load(dir.path()).expect("the bundle loads");
+        for (rate_name, rate) in RATES {
+            let events = support::Synthetic::new(2, rate, 1000, SPAN_US).collect();
+            let source = Paced::new(MemorySource::new(events, 1 << 16), 1000);
+            let estimator = model
+                .estimator(support::SENSOR, 1000)
+                .expect("the estimator builds");
+            let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |_| {
+                ControlFlow::Continue(())
+            })
+            .expect("the replay runs");
+            eprintln!(
+                "pipeline/{name}/{rate_name} (2 s at recorded pace): {} estimates, median {:.1} us, \
+                 P99 {:.1} us, max {:.1} us, late {}, dropped {}",
+                summary.estimates,
+                us(summary.median),
+                us(summary.p99),
+                us(summary.max),
+                summary.late,
+                summary.events_dropped
+            );
+        }
+    }
+}
+
+criterion_group!(benches, estimate, paced_pipeline);
+criterion_main!(benches);

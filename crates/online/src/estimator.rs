@@ -1,0 +1,208 @@
+//! The estimation core, single-threaded: events in, an estimate at every grid time out.
+//!
+//! [`Estimator`] is what the estimation thread runs, and also what an offline check or a
+//! benchmark can drive directly. Per chunk it crops events to the 240x240 region of interest,
+//! hands them to the representation, and for every grid time that the chunk makes final it
+//! advances the representation to that time, runs the MLP, and stamps the latency. Nothing on
+//! this path allocates once the buffers have grown to the largest chunk seen.
+
+use crate::latency::LatencyStats;
+use crate::schedule::{self, Schedule};
+use evtac_events::{Event, Resolution, Roi};
+use evtac_learn::Predictor;
+use evtac_repr::{FeatureExtractor, Mask, ReprConfig};
+use std::time::{Duration, Instant};
+
+/// Side of the square crop the paper's representations are built on.
+pub const CROP_SIZE: u16 = 240;
+
+/// Errors of this module.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The sensor is smaller than the 240x240 region of interest.
+    #[error("the sensor ({sensor}) is smaller than the {CROP_SIZE}x{CROP_SIZE} region of interest")]
+    SensorTooSmall {
+        /// The sensor resolution.
+        sensor: Resolution,
+    },
+    /// The estimate interval is invalid.
+    #[error(transparent)]
+    Schedule(#[from] schedule::Error),
+    /// The representation rejected its settings or its input (a bug in evtac when it happens
+    /// mid-stream: events are cropped and put in time order before they reach it).
+    #[error("representation: {0}")]
+    Representation(#[from] evtac_repr::ReprError),
+}
+
+/// One estimate of the contact angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The grid time the estimate is for: it reflects every event with `t <= t_us` and no other.
+    pub t_us: i64,
+    /// Pitch in degrees.
+    pub pitch_deg: f32,
+    /// Roll in degrees.
+    pub roll_deg: f32,
+    /// From the arrival of the chunk that made `t_us` final to the end of the forward pass (see
+    /// `docs/online.md`).
+    pub latency: Duration,
+}
+
+/// Counters kept by the estimator.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Events received (whole sensor).
+    pub events: u64,
+    /// Events inside the region of interest.
+    pub events_in_roi: u64,
+    /// Events skipped because they were older than one already received.
+    pub events_out_of_order: u64,
+    /// Event time of the first and the latest event.
+    pub span_us: Option<(i64, i64)>,
+}
+
+/// The single-threaded estimation core.
+pub struct Estimator {
+    extractor: FeatureExtractor,
+    predictor: Predictor,
+    roi: Roi,
+    schedule: Schedule,
+    /// Cropped events of the current chunk (reused).
+    crop: Vec<Event>,
+    /// Events older than this are out of order: the latest event time, or one past the last
+    /// estimate time (whichever is later).
+    floor: i64,
+    counters: Counters,
+    stats: LatencyStats,
+}
+
+impl std::fmt::Debug for Estimator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Estimator")
+            .field("roi", &self.roi)
+            .field("schedule", &self.schedule)
+            .field("counters", &self.counters)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Estimator {
+    /// An estimator for a sensor of `sensor` pixels, cropped to its centered 240x240 region,
+    /// with the model's representation, no-contact mask and predictor, estimating every
+    /// `interval_us` microseconds of event time.
+    pub fn new(
+        representation: &ReprConfig,
+        mask: Option<&Mask>,
+        predictor: Predictor,
+        sensor: Resolution,
+        interval_us: i64,
+    ) -> Result<Self, Error> {
+        let crop = Resolution::new(CROP_SIZE, CROP_SIZE);
+        let roi = Roi::centered(sensor, crop).ok_or(Error::SensorTooSmall { sensor })?;
+        let extractor = FeatureExtractor::new(std::slice::from_ref(representation), crop, mask)?;
+        let schedule = Schedule::new(interval_us)?;
+        let interval = Duration::from_micros(interval_us.unsigned_abs());
+        Ok(Self {
+            extractor,
+            predictor,
+            roi,
+            schedule,
+            crop: Vec::new(),
+            floor: i64::MIN,
+            counters: Counters::default(),
+            stats: LatencyStats::new(interval),
+        })
+    }
+
+    /// The crop applied to incoming events.
+    pub fn roi(&self) -> Roi {
+        self.roi
+    }
+
+    /// Latency statistics so far.
+    pub fn stats(&self) -> &LatencyStats {
+        &self.stats
+    }
+
+    /// Event counters so far.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// Takes one chunk of events (full-sensor coordinates, time order) that arrived at
+    /// `arrival`, and emits every estimate it makes final. `horizon`, when the source knows it,
+    /// says that every event with `t <= horizon` has been delivered.
+    pub fn process(
+        &mut self,
+        events: &[Event],
+        horizon: Option<i64>,
+        arrival: Instant,
+        emit: &mut impl FnMut(&Estimate),
+    ) -> Result<(), Error> {
+        self.crop.clear();
+        let mut first = None;
+        let mut latest = None;
+        for &e in events {
+            if e.t < self.floor {
+                self.counters.events_out_of_order += 1;
+                continue;
+            }
+            self.floor = e.t;
+            first.get_or_insert(e.t);
+            latest = Some(e.t);
+            if let Some(c) = self.roi.map(e) {
+                self.crop.push(c);
+            }
+        }
+        self.counters.events += events.len() as u64;
+        self.counters.events_in_roi += self.crop.len() as u64;
+        if let (Some(first), Some(last)) = (first, latest) {
+            // The first accepted event of the stream opens the grid.
+            self.schedule.start(first);
+            let first = self.counters.span_us.map_or(first, |(f, _)| f);
+            self.counters.span_us = Some((first, last));
+        }
+        self.extractor.push(&self.crop)?;
+        // An event at `t` proves that every event before `t` has arrived; one at `t` itself
+        // may still follow in the next chunk.
+        let proven = latest.map_or(i64::MIN, |t| t.saturating_sub(1));
+        let horizon = horizon.map_or(proven, |h| h.max(proven));
+        self.estimate_until(horizon, arrival, emit)
+    }
+
+    /// Ends the stream: emits the estimates up to the last event's time.
+    pub fn finish(
+        &mut self,
+        arrival: Instant,
+        emit: &mut impl FnMut(&Estimate),
+    ) -> Result<(), Error> {
+        match self.counters.span_us {
+            Some((_, last)) => self.estimate_until(last, arrival, emit),
+            None => Ok(()),
+        }
+    }
+
+    fn estimate_until(
+        &mut self,
+        horizon: i64,
+        arrival: Instant,
+        emit: &mut impl FnMut(&Estimate),
+    ) -> Result<(), Error> {
+        while let Some(t) = self.schedule.pop_due(horizon) {
+            self.extractor.advance_to(t)?;
+            let [pitch_deg, roll_deg] = self.predictor.predict_one(self.extractor.features(0));
+            let latency = arrival.elapsed();
+            self.stats.record(latency);
+            // Later events must not reach back before an estimate already made.
+            self.floor = self.floor.max(t.saturating_add(1));
+            emit(&Estimate {
+                t_us: t,
+                pitch_deg,
+                roll_deg,
+                latency,
+            });
+        }
+        Ok(())
+    }
+}

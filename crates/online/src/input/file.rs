@@ -1,0 +1,57 @@
+//! A recording on disk, streamed in the chunks its reader decodes (`evtac_events::open`).
+
+use super::{ChunkInfo, EventSource, InputError};
+use crate::Notice;
+use evtac_events::{Event, EventReader, Resolution};
+use std::path::Path;
+
+/// Streams the events of an AEDAT4, EVT 2.0/3.0, CSV or NPY file (IMU samples and triggers are
+/// skipped).
+#[derive(Debug)]
+pub struct FileSource {
+    reader: EventReader,
+    name: String,
+}
+
+impl FileSource {
+    /// Opens `path`; `sensor` declares the sensor size for formats that do not store it (CSV,
+    /// NPY) and must match the file's own otherwise.
+    pub fn open(path: &Path, sensor: Option<Resolution>) -> Result<Self, InputError> {
+        let name = path.display().to_string();
+        let events = |source| InputError::Events {
+            input: name.clone(),
+            source,
+        };
+        let mut reader = evtac_events::open(path).map_err(events)?;
+        if let Some(sensor) = sensor {
+            reader.set_resolution(sensor).map_err(events)?;
+        }
+        Ok(Self { reader, name })
+    }
+
+    /// The sensor size: the file's own, or the one declared.
+    pub fn resolution(&self) -> Option<Resolution> {
+        self.reader.resolution()
+    }
+}
+
+impl EventSource for FileSource {
+    fn next_chunk(
+        &mut self,
+        out: &mut Vec<Event>,
+        _notify: &mut dyn FnMut(Notice),
+    ) -> Result<Option<ChunkInfo>, InputError> {
+        out.clear();
+        let chunk = self
+            .reader
+            .next_chunk()
+            .map_err(|source| InputError::Events {
+                input: self.name.clone(),
+                source,
+            })?;
+        Ok(chunk.map(|c| {
+            out.extend_from_slice(c.events);
+            ChunkInfo::default()
+        }))
+    }
+}

@@ -1,0 +1,213 @@
+//! Latency accounting: an allocation-free histogram of per-estimate latencies, and the summary
+//! printed when a run ends.
+
+use hdrhistogram::Histogram;
+use std::time::Duration;
+
+/// Largest latency the histogram resolves (larger ones are recorded as this value).
+const MAX_TRACKED_NS: u64 = 60_000_000_000;
+
+/// Per-estimate latencies, in nanoseconds, with 3 significant digits.
+///
+/// The histogram's buckets are allocated once, up front, so recording never allocates; this is
+/// what lets the estimation thread run for hours with flat memory.
+#[derive(Debug, Clone)]
+pub struct LatencyStats {
+    histogram: Histogram<u64>,
+    interval: Duration,
+    late: u64,
+}
+
+impl LatencyStats {
+    /// Empty statistics; an estimate is *late* when its latency exceeds `interval`.
+    pub fn new(interval: Duration) -> Self {
+        // The bounds are constants that hdrhistogram accepts (low >= 1, high >= 2 * low,
+        // sigfig <= 5), so construction cannot fail.
+        let histogram = Histogram::new_with_bounds(1, MAX_TRACKED_NS, 3)
+            .unwrap_or_else(|_| unreachable!("constant histogram bounds are valid"));
+        Self {
+            histogram,
+            interval,
+            late: 0,
+        }
+    }
+
+    /// Records one estimate's latency.
+    #[inline]
+    pub fn record(&mut self, latency: Duration) {
+        let ns = u64::try_from(latency.as_nanos()).unwrap_or(u64::MAX);
+        self.histogram
+            .saturating_record(ns.clamp(1, MAX_TRACKED_NS));
+        if latency > self.interval {
+            self.late += 1;
+        }
+    }
+
+    /// Number of estimates recorded.
+    pub fn count(&self) -> u64 {
+        self.histogram.len()
+    }
+
+    /// Estimates whose latency exceeded the interval.
+    pub fn late(&self) -> u64 {
+        self.late
+    }
+
+    /// The latency at quantile `q` (0..=1), or zero without estimates.
+    pub fn quantile(&self, q: f64) -> Duration {
+        if self.histogram.is_empty() {
+            return Duration::ZERO;
+        }
+        Duration::from_nanos(self.histogram.value_at_quantile(q))
+    }
+
+    /// The largest latency recorded, or zero without estimates.
+    pub fn max(&self) -> Duration {
+        if self.histogram.is_empty() {
+            return Duration::ZERO;
+        }
+        Duration::from_nanos(self.histogram.max())
+    }
+
+    /// The underlying histogram (nanoseconds), e.g. for plotting a distribution.
+    pub fn histogram(&self) -> &Histogram<u64> {
+        &self.histogram
+    }
+}
+
+/// What a run did, reported when it ends.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// Estimates emitted.
+    pub estimates: u64,
+    /// Median latency.
+    pub median: Duration,
+    /// 99th-percentile latency.
+    pub p99: Duration,
+    /// Largest latency.
+    pub max: Duration,
+    /// Estimates whose latency exceeded the interval.
+    pub late: u64,
+    /// The interval between estimates.
+    pub interval: Duration,
+    /// Events received from the source (on the whole sensor).
+    pub events: u64,
+    /// Events inside the region of interest, fed to the representation.
+    pub events_in_roi: u64,
+    /// Events dropped because the estimator was behind (only with dropping enabled).
+    pub events_dropped: u64,
+    /// Events skipped because they were older than an event already received (a stream out of
+    /// time order, e.g. a camera restarted behind a reconnection).
+    pub events_out_of_order: u64,
+    /// Successful reconnections of a network input.
+    pub reconnects: u32,
+    /// Event time of the first and last event received, in microseconds.
+    pub span_us: Option<(i64, i64)>,
+    /// Wall-clock time from the first chunk to the end of the run.
+    pub wall: Duration,
+}
+
+impl Summary {
+    /// Fills the latency fields from `stats`; counters start at zero.
+    pub fn from_stats(stats: &LatencyStats) -> Self {
+        Self {
+            estimates: stats.count(),
+            median: stats.quantile(0.5),
+            p99: stats.quantile(0.99),
+            max: stats.max(),
+            late: stats.late(),
+            interval: stats.interval,
+            events: 0,
+            events_in_roi: 0,
+            events_dropped: 0,
+            events_out_of_order: 0,
+            reconnects: 0,
+            span_us: None,
+            wall: Duration::ZERO,
+        }
+    }
+}
+
+impl std::fmt::Display for Summary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let us = |d: Duration| d.as_secs_f64() * 1e6;
+        writeln!(
+            f,
+            "estimates: {} every {:.0} us",
+            self.estimates,
+            us(self.interval)
+        )?;
+        writeln!(
+            f,
+            "latency: median {:.1} us, P99 {:.1} us, max {:.1} us",
+            us(self.median),
+            us(self.p99),
+            us(self.max)
+        )?;
+        writeln!(
+            f,
+            "late (latency > interval): {} of {}",
+            self.late, self.estimates
+        )?;
+        writeln!(
+            f,
+            "events: {} received, {} in the region of interest, {} dropped, {} out of order",
+            self.events, self.events_in_roi, self.events_dropped, self.events_out_of_order
+        )?;
+        if let Some((first, last)) = self.span_us {
+            writeln!(
+                f,
+                "event time: {first} .. {last} us ({:.3} s)",
+                (last - first) as f64 * 1e-6
+            )?;
+        }
+        if self.reconnects > 0 {
+            writeln!(f, "reconnections: {}", self.reconnects)?;
+        }
+        write!(f, "wall time: {:.3} s", self.wall.as_secs_f64())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_and_late_counts() {
+        let mut s = LatencyStats::new(Duration::from_micros(1000));
+        assert_eq!(s.quantile(0.5), Duration::ZERO);
+        for us in 1..=100u64 {
+            s.record(Duration::from_micros(us * 20));
+        }
+        assert_eq!(s.count(), 100);
+        // 51..=100 * 20 us exceed 1000 us.
+        assert_eq!(s.late(), 50);
+        let median = s.quantile(0.5).as_secs_f64() * 1e6;
+        assert!((median - 1000.0).abs() <= 1.0, "{median}");
+        let max = s.max().as_secs_f64() * 1e6;
+        assert!((max - 2000.0).abs() <= 2.0, "{max}");
+        s.record(Duration::from_secs(3600));
+        assert_eq!(s.max(), Duration::from_nanos(s.histogram().max()));
+        assert!(s.max() >= Duration::from_secs(59));
+    }
+
+    #[test]
+    fn summary_prints_every_figure() {
+        let mut s = LatencyStats::new(Duration::from_millis(1));
+        s.record(Duration::from_micros(40));
+        let mut summary = Summary::from_stats(&s);
+        summary.events = 10;
+        summary.events_dropped = 0;
+        let text = summary.to_string();
+        for needle in [
+            "estimates: 1",
+            "median 40",
+            "P99 40",
+            "late",
+            "10 received",
+            "0 dropped",
+        ] {
+            assert!(text.contains(needle), "{needle:?} missing from:\n{text}");
+        }
+    }
+}

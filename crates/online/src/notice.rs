@@ -1,0 +1,87 @@
+//! Things worth telling the user while a run goes on: connections lost, retried, given up.
+//!
+//! The library never prints; the pipeline hands notices to its caller (the `evtac` binary prints
+//! them on stderr).
+
+use std::time::Duration;
+
+/// A change in the state of the input.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Notice {
+    /// Connected to a network input.
+    Connected {
+        /// The input, e.g. `tcp://127.0.0.1:7777`.
+        input: String,
+    },
+    /// A network input closed, failed or stalled; what arrived before is still estimated.
+    Lost {
+        /// The input.
+        input: String,
+        /// Why, e.g. "closed by the server" or "no data for 2.0 s".
+        reason: String,
+    },
+    /// About to retry a lost network input.
+    Retrying {
+        /// The input.
+        input: String,
+        /// 1-based attempt number.
+        attempt: u32,
+        /// Attempts allowed in a row.
+        attempts: u32,
+        /// The wait before this attempt.
+        delay: Duration,
+    },
+    /// A reconnection attempt failed.
+    AttemptFailed {
+        /// The input.
+        input: String,
+        /// 1-based attempt number.
+        attempt: u32,
+        /// Why it failed.
+        reason: String,
+    },
+    /// All reconnection attempts failed; the run ends after estimating what arrived.
+    GaveUp {
+        /// The input.
+        input: String,
+        /// Attempts made.
+        attempts: u32,
+    },
+    /// Events were dropped because the estimator was behind (only with dropping enabled).
+    Dropped {
+        /// Events dropped in this chunk.
+        events: usize,
+    },
+}
+
+impl std::fmt::Display for Notice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Connected { input } => write!(f, "connected to {input}"),
+            Self::Lost { input, reason } => write!(f, "lost {input}: {reason}"),
+            Self::Retrying {
+                input,
+                attempt,
+                attempts,
+                delay,
+            } => write!(
+                f,
+                "reconnecting to {input} in {:.1} s (attempt {attempt} of {attempts})",
+                delay.as_secs_f64()
+            ),
+            Self::AttemptFailed {
+                input,
+                attempt,
+                reason,
+            } => write!(f, "attempt {attempt} to reach {input} failed: {reason}"),
+            Self::GaveUp { input, attempts } => write!(
+                f,
+                "gave up on {input} after {attempts} reconnection attempts; ending the stream"
+            ),
+            Self::Dropped { events } => {
+                write!(f, "estimator behind: dropped {events} events")
+            }
+        }
+    }
+}

@@ -1,0 +1,310 @@
+//! The pipeline's behaviour around its input: reconnection after a drop, a stalled stream,
+//! dropping when asked, stopping early. A small DV network server on loopback (the bytes of an
+//! AEDAT4 file without its magic and data table: DV's network framing) stands in for a camera.
+
+use crate::support::{self, SENSOR, Synthetic};
+use evtac_events::Event;
+use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
+use evtac_online::input::{self, MemorySource, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::pipeline::{self, Output, PipelineConfig};
+use evtac_online::{Backoff, Estimate, Model, Notice};
+use std::io::Write;
+use std::net::TcpListener;
+use std::ops::ControlFlow;
+use std::time::Duration;
+
+/// A DV network stream of `events`: the stream header, then one byte range per packet.
+struct Stream {
+    header: Vec<u8>,
+    packets: Vec<Vec<u8>>,
+}
+
+fn network_stream(events: &[Event]) -> Stream {
+    let config = WriterConfig {
+        resolution: SENSOR,
+        source_name: "evtac-test".into(),
+        compression: Compression::None,
+    };
+    let mut writer = AedatWriter::new(Vec::new(), config).unwrap();
+    writer.write_events(events).unwrap();
+    let bytes = writer.finish().unwrap();
+    let mut reader = AedatReader::from_slice(&bytes).unwrap();
+    let mut offsets = Vec::new();
+    while let Some(chunk) = reader.next_chunk().unwrap() {
+        offsets.push(chunk.offset as usize);
+    }
+    offsets.push(reader.offset() as usize);
+    let magic = evtac_events::aedat::MAGIC.len();
+    Stream {
+        header: bytes[magic..offsets[0]].to_vec(),
+        packets: offsets
+            .windows(2)
+            .map(|w| bytes[w[0]..w[1]].to_vec())
+            .collect(),
+    }
+}
+
+fn model(dir: &std::path::Path) -> Model {
+    let (_, repr) = support::representations()[1];
+    support::seeded_bundle(dir, 3, &repr, None);
+    Model::load(dir).unwrap()
+}
+
+fn quick_network(attempts: u32, stall_ms: u64) -> NetworkOptions {
+    NetworkOptions {
+        backoff: Backoff {
+            initial: Duration::from_millis(20),
+            max: Duration::from_millis(100),
+            attempts,
+        },
+        connect_timeout: Duration::from_millis(500),
+        stall_timeout: Duration::from_millis(stall_ms),
+    }
+}
+
+/// Runs the pipeline on `tcp://127.0.0.1:port`; returns estimates, notices and the summary.
+fn run_tcp(
+    model: &Model,
+    port: u16,
+    network: NetworkOptions,
+) -> (Vec<Estimate>, Vec<Notice>, evtac_online::Summary) {
+    let mut notices = Vec::new();
+    let spec = SourceSpec::Tcp {
+        host: "127.0.0.1".into(),
+        port,
+    };
+    let options = OpenOptions {
+        network,
+        ..OpenOptions::default()
+    };
+    let opened = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap();
+    let estimator = model.estimator(opened.resolution.unwrap(), 1000).unwrap();
+    let mut estimates = Vec::new();
+    let summary = pipeline::run(
+        opened.source,
+        estimator,
+        &PipelineConfig::default(),
+        |out| {
+            match out {
+                Output::Estimate(e) => estimates.push(e),
+                Output::Notice(n) => notices.push(n),
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    (estimates, notices, summary)
+}
+
+/// Offline estimates of the same events, all in one chunk.
+fn reference(model: &Model, events: &[Event]) -> Vec<Estimate> {
+    let mut estimates = Vec::new();
+    let estimator = model.estimator(SENSOR, 1000).unwrap();
+    pipeline::run(
+        MemorySource::new(events.to_vec(), usize::MAX),
+        estimator,
+        &PipelineConfig::default(),
+        |out| {
+            if let Output::Estimate(e) = out {
+                estimates.push(e);
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    estimates
+}
+
+fn same_values(a: &[Estimate], b: &[Estimate]) {
+    assert_eq!(a.len(), b.len(), "number of estimates");
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(
+            (x.t_us, x.pitch_deg.to_bits(), x.roll_deg.to_bits()),
+            (y.t_us, y.pitch_deg.to_bits(), y.roll_deg.to_bits())
+        );
+    }
+}
+
+#[test]
+fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
+    let events = Synthetic::new(1, 300_000.0, 1000, 200_000).collect();
+    let stream = network_stream(&events);
+    let half = stream.packets.len() / 2;
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let server = std::thread::spawn(move || {
+        // First connection: the first half of the packets, then the server hangs up.
+        let (mut c, _) = listener.accept().unwrap();
+        c.write_all(&stream.header).unwrap();
+        for p in &stream.packets[..half] {
+            c.write_all(p).unwrap();
+        }
+        drop(c);
+        // The camera comes back: the second half, then the server goes away for good.
+        let (mut c, _) = listener.accept().unwrap();
+        c.write_all(&stream.header).unwrap();
+        for p in &stream.packets[half..] {
+            c.write_all(p).unwrap();
+        }
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let (estimates, notices, summary) = run_tcp(&model, port, quick_network(3, 2000));
+    server.join().unwrap();
+
+    assert_eq!(summary.reconnects, 1, "{notices:?}");
+    assert_eq!(summary.events, events.len() as u64);
+    assert!(
+        notices
+            .iter()
+            .any(|n| matches!(n, Notice::Lost { reason, .. } if reason.contains("closed"))),
+        "{notices:?}"
+    );
+    assert!(
+        notices
+            .iter()
+            .any(|n| matches!(n, Notice::GaveUp { attempts: 3, .. }))
+    );
+    same_values(&estimates, &reference(&model, &events));
+}
+
+#[test]
+fn a_stalled_stream_is_reported_and_reopened() {
+    let events = Synthetic::new(2, 300_000.0, 1000, 100_000).collect();
+    let stream = network_stream(&events);
+    let half = stream.packets.len() / 2;
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let server = std::thread::spawn(move || {
+        let (mut c, _) = listener.accept().unwrap();
+        c.write_all(&stream.header).unwrap();
+        for p in &stream.packets[..half] {
+            c.write_all(p).unwrap();
+        }
+        // Silent, connection open: the client must give up on it and reconnect.
+        let (mut c2, _) = listener.accept().unwrap();
+        drop(c);
+        c2.write_all(&stream.header).unwrap();
+        for p in &stream.packets[half..] {
+            c2.write_all(p).unwrap();
+        }
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let (estimates, notices, summary) = run_tcp(&model, port, quick_network(2, 200));
+    server.join().unwrap();
+    assert!(
+        notices
+            .iter()
+            .any(|n| matches!(n, Notice::Lost { reason, .. } if reason.contains("stalled"))),
+        "{notices:?}"
+    );
+    assert_eq!(summary.reconnects, 1);
+    same_values(&estimates, &reference(&model, &events));
+}
+
+#[test]
+fn an_unreachable_server_fails_with_a_clear_message() {
+    // Bind then close: nothing listens on the port now.
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let spec: SourceSpec = format!("tcp://127.0.0.1:{port}").parse().unwrap();
+    let options = OpenOptions {
+        network: quick_network(1, 200),
+        ..OpenOptions::default()
+    };
+    let mut notices = Vec::new();
+    let err = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains(&format!("tcp://127.0.0.1:{port}")), "{text}");
+    assert!(text.contains("2 attempts"), "{text}");
+    assert_eq!(
+        notices
+            .iter()
+            .filter(|n| matches!(n, Notice::AttemptFailed { .. }))
+            .count(),
+        2
+    );
+}
+
+#[test]
+fn stopping_early_and_dropping_when_behind() {
+    let events = Synthetic::new(3, 300_000.0, 1000, 300_000).collect::<Vec<_>>();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+
+    // The caller stops after 10 estimates: the run ends cleanly.
+    let mut seen = 0;
+    let summary = pipeline::run(
+        MemorySource::new(events.clone(), 512),
+        model.estimator(SENSOR, 1000).unwrap(),
+        &PipelineConfig::default(),
+        |out| {
+            if matches!(out, Output::Estimate(_)) {
+                seen += 1;
+            }
+            if seen == 10 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    )
+    .unwrap();
+    assert_eq!(seen, 10);
+    assert!(summary.estimates >= 10);
+
+    // A one-chunk queue and a slow consumer: with dropping, events are dropped and counted,
+    // never silently; without, none are.
+    for drop_when_behind in [false, true] {
+        let config = PipelineConfig {
+            queue_chunks: 1,
+            drop_when_behind,
+        };
+        let mut notices = 0;
+        let summary = pipeline::run(
+            MemorySource::new(events.clone(), 64),
+            model.estimator(SENSOR, 1000).unwrap(),
+            &config,
+            |out| {
+                match out {
+                    Output::Estimate(_) => std::thread::sleep(Duration::from_micros(200)),
+                    Output::Notice(Notice::Dropped { .. }) => notices += 1,
+                    Output::Notice(_) => {}
+                }
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        assert_eq!(summary.events, events.len() as u64);
+        if drop_when_behind {
+            assert!(summary.events_dropped > 0 && notices > 0, "{summary}");
+        } else {
+            assert_eq!(summary.events_dropped, 0);
+            assert_eq!(summary.estimates, reference(&model, &events).len() as u64);
+        }
+    }
+}
+
+#[test]
+fn out_of_order_events_are_skipped_and_counted() {
+    let mut events = Synthetic::new(4, 100_000.0, 1000, 20_000).collect::<Vec<_>>();
+    // A camera restarted behind a reconnection: its clock starts over.
+    let again: Vec<Event> = events.iter().take(100).copied().collect();
+    events.extend(again);
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let summary = pipeline::run(
+        MemorySource::new(events, 333),
+        model.estimator(SENSOR, 1000).unwrap(),
+        &PipelineConfig::default(),
+        |_| ControlFlow::Continue(()),
+    )
+    .unwrap();
+    assert_eq!(summary.events_out_of_order, 100);
+    // One estimate per millisecond of the first 20 ms, whatever came after.
+    assert!((19..=20).contains(&summary.estimates), "{summary}");
+}

@@ -1,0 +1,163 @@
+//! Shared by the integration tests and the benchmark: a seeded model bundle and a synthetic
+//! event stream of a chosen rate.
+
+#![allow(dead_code)]
+
+use evtac_events::{Event, Resolution};
+use evtac_learn::bundle::{BundleConfig, BundleMetrics, FORMAT_VERSION};
+use evtac_learn::{Mae, ModelBundle, Parameters, TrainConfig};
+use evtac_online::Notice;
+use evtac_online::input::{ChunkInfo, EventSource, InputError};
+use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::Path;
+
+/// The simulated sensor (DVXplorer).
+pub const SENSOR: Resolution = Resolution::new(640, 480);
+
+/// The three representations with the paper's settings.
+pub fn representations() -> [(&'static str, ReprConfig); 3] {
+    [
+        ("static", ReprConfig::Static(StaticConfig::default())),
+        ("dynamic", ReprConfig::Dynamic(DynamicConfig::default())),
+        ("combined", ReprConfig::default()),
+    ]
+}
+
+/// A model bundle with weights initialised from `seed` (untrained: the tests compare online and
+/// offline predictions, which needs varied outputs, not accurate ones), saved in `dir`.
+pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<ndarray::Array2<u8>>) {
+    let parameters = Parameters::init(seed);
+    let bundle = ModelBundle {
+        parameters,
+        config: BundleConfig {
+            format_version: FORMAT_VERSION,
+            architecture: vec![900, 256, 128, 64, 2],
+            training: TrainConfig {
+                seed,
+                ..TrainConfig::default()
+            },
+            representation: serde_json::json!({ "config": repr, "frame": "240x240" }),
+            metrics: BundleMetrics {
+                best_epoch: 0,
+                validation: Mae {
+                    overall: 0.0,
+                    pitch: 0.0,
+                    roll: 0.0,
+                },
+                evaluations: Default::default(),
+            },
+        },
+        mask,
+        history: Vec::new(),
+    };
+    bundle.save(dir).expect("the bundle is saved");
+}
+
+/// An endless, seeded stream of events at `rate` events per second of event time, shaped like
+/// a pressed NeuroTac: pins (dots on a hexagon-like grid within the centered crop) that fire
+/// while a contact patch sweeps across them, plus uniform background noise. Handed out in
+/// packets of `packet_us` microseconds of event time.
+pub struct Synthetic {
+    rng: ChaCha8Rng,
+    pins: Vec<(u16, u16)>,
+    rate: f64,
+    packet_us: i64,
+    t: i64,
+    end_us: i64,
+}
+
+impl Synthetic {
+    /// `duration_us` of events from time 0.
+    pub fn new(seed: u64, rate: f64, packet_us: i64, duration_us: i64) -> Self {
+        let mut pins = Vec::new();
+        for row in 0..14u16 {
+            for col in 0..14u16 {
+                let x = 200 + 8 + col * 16 + (row % 2) * 8;
+                let y = 120 + 8 + row * 16;
+                if x < 440 && y < 360 {
+                    pins.push((x, y));
+                }
+            }
+        }
+        Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            pins,
+            rate,
+            packet_us: packet_us.max(1),
+            t: 0,
+            end_us: duration_us,
+        }
+    }
+
+    /// Appends the events of `[t0, t1)` to `out`, in time order.
+    pub fn fill(&mut self, t0: i64, t1: i64, out: &mut Vec<Event>) {
+        let span = (t1 - t0) as f64;
+        let n = (self.rate * span * 1e-6).round() as usize;
+        let start = out.len();
+        // Contact patch centre sweeps in a circle with a 2 s period.
+        let phase = (t0 as f64) * 1e-6 * std::f64::consts::PI;
+        let (cx, cy) = (320.0 + 60.0 * phase.cos(), 240.0 + 60.0 * phase.sin());
+        for _ in 0..n {
+            let t = t0 + self.rng.random_range(0..(t1 - t0).max(1));
+            let (x, y) = if self.rng.random::<f32>() < 0.9 {
+                let (px, py) = self.pins[self.rng.random_range(0..self.pins.len())];
+                let near = ((f64::from(px) - cx).powi(2) + (f64::from(py) - cy).powi(2)).sqrt();
+                if near > 90.0 && self.rng.random::<f32>() < 0.8 {
+                    // Pins far from the contact fire rarely: move the event to the patch.
+                    (
+                        (cx as u16).wrapping_add(self.rng.random_range(0..16)),
+                        (cy as u16).wrapping_add(self.rng.random_range(0..16)),
+                    )
+                } else {
+                    (
+                        px + self.rng.random_range(0..3),
+                        py + self.rng.random_range(0..3),
+                    )
+                }
+            } else {
+                (
+                    self.rng.random_range(0..SENSOR.width),
+                    self.rng.random_range(0..SENSOR.height),
+                )
+            };
+            out.push(Event {
+                t,
+                x: x.min(SENSOR.width - 1),
+                y: y.min(SENSOR.height - 1),
+                polarity: self.rng.random(),
+            });
+        }
+        out[start..].sort_unstable_by_key(|e| e.t);
+    }
+
+    /// All events of the stream at once.
+    pub fn collect(mut self) -> Vec<Event> {
+        let mut out = Vec::new();
+        let mut t = 0;
+        while t < self.end_us {
+            let t1 = (t + self.packet_us).min(self.end_us);
+            self.fill(t, t1, &mut out);
+            t = t1;
+        }
+        out
+    }
+}
+
+impl EventSource for Synthetic {
+    fn next_chunk(
+        &mut self,
+        out: &mut Vec<Event>,
+        _notify: &mut dyn FnMut(Notice),
+    ) -> Result<Option<ChunkInfo>, InputError> {
+        out.clear();
+        if self.t >= self.end_us {
+            return Ok(None);
+        }
+        let t1 = (self.t + self.packet_us).min(self.end_us);
+        self.fill(self.t, t1, out);
+        self.t = t1;
+        Ok(Some(ChunkInfo::default()))
+    }
+}
