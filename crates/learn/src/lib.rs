@@ -1,1 +1,50 @@
-//! The MLP contact-angle regressor: model, training loop, checkpoints, prediction and metrics.
+//! The MLP contact-angle regressor of the paper: model, training loop, checkpoints, prediction
+//! and metrics.
+//!
+//! - [`model`]: the 900 -> 256 -> 128 -> 64 -> 2 ReLU MLP as a burn module ([`Mlp`]) and as plain
+//!   weights in PyTorch `nn.Linear` layout ([`Parameters`]), initialised as PyTorch does from a
+//!   seeded `ChaCha8Rng`.
+//! - [`data`]: in-memory [`FeatureSet`]s and the seeded epoch shuffling.
+//! - [`training`]: [`train`] with SmoothL1 (beta 1) and PyTorch-exact AdamW ([`adamw`]), batch
+//!   32, 100 epochs, validation MAE per epoch, best checkpoint kept.
+//! - [`bundle`]: the [`ModelBundle`] folder (`model.safetensors`, `config.json`, `mask.npy`,
+//!   `history.csv`).
+//! - [`predictor`]: allocation-free single-sample inference ([`Predictor`]).
+//! - [`metrics`]: MAE overall / pitch / roll.
+//! - [`ftz`]: [`flush_denormals`], to call on every thread that trains or infers.
+//!
+//! Training runs on burn's flex CPU backend with its SIMD kernels and rayon-parallel matrix
+//! products.
+//!
+//! ```no_run
+//! use evtac_learn::{FeatureSet, ModelBundle, TrainConfig, train};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let (train_set, val_set) = (FeatureSet::default(), FeatureSet::default());
+//! let cfg = TrainConfig { seed: 7, ..TrainConfig::default() };
+//! let trained = train(&train_set, &val_set, &cfg, |r| {
+//!     eprintln!("epoch {} loss {:.4} val MAE {:.3}", r.epoch, r.train_loss, r.val_mae)
+//! })?;
+//! let bundle = ModelBundle::from_trained(trained, cfg, serde_json::json!({"repr": "static"}), None);
+//! bundle.save("model".as_ref())?;
+//! let predictor = ModelBundle::load("model".as_ref())?.predictor()?;
+//! let [pitch, roll] = predictor.predict_one(&[0.0; 900]);
+//! # Ok(()) }
+//! ```
+
+pub mod adamw;
+pub mod bundle;
+pub mod data;
+pub mod ftz;
+pub mod metrics;
+pub mod model;
+pub mod predictor;
+pub mod training;
+
+pub use adamw::AdamWConfig;
+pub use bundle::{BundleConfig, BundleMetrics, ModelBundle};
+pub use data::FeatureSet;
+pub use ftz::flush_denormals;
+pub use metrics::{Mae, mae};
+pub use model::{INPUTS, Mlp, OUTPUTS, Parameters};
+pub use predictor::Predictor;
+pub use training::{EpochRecord, TrainConfig, Trained, Trainer, train};

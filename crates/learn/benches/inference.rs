@@ -1,0 +1,98 @@
+//! Single-sample inference latency: the hand-written [`Predictor`] against burn's forward pass on
+//! the same weights (the measurement behind the predictor's design), plus a tail-latency table
+//! (median, P99, P99.9) printed before criterion's runs.
+//!
+//! The PyTorch CPU reference is `benches/pytorch_baseline.py` (run in the same session).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use burn::tensor::{Device, Tensor, TensorData};
+use criterion::{Criterion, criterion_group, criterion_main};
+use evtac_learn::{Mlp, Parameters, Predictor};
+
+/// A sparse feature vector like a pooled binarised representation.
+fn sample(k: usize) -> Vec<f32> {
+    (0..900)
+        .map(|j| {
+            if (j * 7 + k).is_multiple_of(4) {
+                ((j + k) % 10) as f32 / 10.0
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Median, P99 and P99.9 in microseconds of `f` over `n` timed calls.
+fn percentiles(n: usize, mut f: impl FnMut(usize)) -> [f64; 3] {
+    let mut times: Vec<f64> = (0..n)
+        .map(|i| {
+            let t = Instant::now();
+            f(i);
+            t.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    let at = |q: f64| times[((n as f64 - 1.0) * q).round() as usize];
+    [at(0.5), at(0.99), at(0.999)]
+}
+
+fn bench(c: &mut Criterion) {
+    evtac_learn::flush_denormals();
+    let params = Parameters::init(0);
+    let predictor = Predictor::new(&params).expect("predictor");
+    let device = Device::flex();
+    let mlp = Mlp::from_parameters(&params, &device).expect("mlp");
+    let samples: Vec<Vec<f32>> = (0..64).map(sample).collect();
+    let burn_one = |x: &[f32]| {
+        let t = Tensor::<2>::from_data(TensorData::new(x.to_vec(), [1, 900]), &device);
+        let out = mlp
+            .forward(t)
+            .into_data()
+            .try_into_vec::<f32>()
+            .expect("f32");
+        [out[0], out[1]]
+    };
+
+    for (name, stats) in [
+        (
+            "hand-written",
+            percentiles(100_000, |i| {
+                black_box(predictor.predict_one(&samples[i % 64]));
+            }),
+        ),
+        (
+            "burn flex",
+            percentiles(20_000, |i| {
+                black_box(burn_one(&samples[i % 64]));
+            }),
+        ),
+    ] {
+        println!(
+            "single-sample latency, {name}: median {:.1} us, P99 {:.1} us, P99.9 {:.1} us",
+            stats[0], stats[1], stats[2]
+        );
+    }
+
+    let mut i = 0;
+    c.bench_function("predict_one/hand-written", |b| {
+        b.iter(|| {
+            i = (i + 1) % 64;
+            black_box(predictor.predict_one(black_box(&samples[i])))
+        })
+    });
+    c.bench_function("predict_one/burn-flex", |b| {
+        b.iter(|| {
+            i = (i + 1) % 64;
+            black_box(burn_one(black_box(&samples[i])))
+        })
+    });
+    let batch: Vec<f32> = samples.concat();
+    c.bench_function("predict/batch64/hand-written", |b| {
+        b.iter(|| black_box(predictor.predict(black_box(&batch)).expect("rows")))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,161 @@
+//! Fast CPU inference of a trained MLP, one sample or a batch at a time.
+//!
+//! The forward pass is written by hand here, from the same weights burn trains, because burn's
+//! per-call overhead dominates a single 900-feature sample: creating input tensors, dispatching
+//! eight operations and reading the result back allocates on every call and costs tens of
+//! microseconds before any arithmetic (measured in `benches/inference.rs`, which times both). The
+//! hand-written pass is allocation-free: activations live in fixed-size stack arrays and each
+//! layer is a sequence of `y += x[i] * W[i, :]` row updates over the transposed weight
+//! (`[in, out]`), which vectorises without horizontal sums and skips zero inputs outright (the
+//! masked, binarised representations are mostly zeros). Training stays on burn.
+
+use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
+
+/// Errors of this module.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The weights do not fit the architecture.
+    #[error(transparent)]
+    Model(#[from] model::Error),
+    /// A batch is not a whole number of 900-value rows.
+    #[error("{len} feature values is not a multiple of {INPUTS} (one row per sample)")]
+    RaggedFeatures {
+        /// Number of values given.
+        len: usize,
+    },
+}
+
+const H1: usize = LAYER_SIZES[1];
+const H2: usize = LAYER_SIZES[2];
+const H3: usize = LAYER_SIZES[3];
+
+/// One layer with its weight transposed to `[in, out]` row-major.
+#[derive(Debug, Clone)]
+struct Dense {
+    weight_t: Vec<f32>,
+    bias: Vec<f32>,
+}
+
+impl Dense {
+    /// `out = bias + sum_i x[i] * W[i, :]`, with optional ReLU. `out.len()` is the layer width.
+    #[inline]
+    fn forward(&self, x: &[f32], out: &mut [f32], relu: bool) {
+        let width = out.len();
+        out.copy_from_slice(&self.bias);
+        for (&xi, row) in x.iter().zip(self.weight_t.chunks_exact(width)) {
+            // Zero inputs contribute exactly zero (weights are finite, checked on load).
+            if xi != 0.0 {
+                for (o, &w) in out.iter_mut().zip(row) {
+                    *o += xi * w;
+                }
+            }
+        }
+        if relu {
+            for o in out.iter_mut() {
+                *o = o.max(0.0);
+            }
+        }
+    }
+}
+
+/// A trained model ready for inference. Cheap to clone; `Send + Sync`, so one predictor can be
+/// shared by reference across threads.
+///
+/// ```
+/// use evtac_learn::{Parameters, Predictor};
+/// let predictor = Predictor::new(&Parameters::init(0)).unwrap();
+/// let [pitch, roll] = predictor.predict_one(&[0.0; 900]);
+/// assert!(pitch.is_finite() && roll.is_finite());
+/// ```
+#[derive(Debug, Clone)]
+pub struct Predictor {
+    layers: [Dense; 4],
+}
+
+impl Predictor {
+    /// Prepares `params` (PyTorch layout) for inference and flushes subnormals on the calling
+    /// thread (call [`crate::flush_denormals`] yourself on other inference threads).
+    pub fn new(params: &Parameters) -> Result<Self, Error> {
+        params.validate()?;
+        crate::ftz::flush_denormals();
+        let dense = |i: usize| {
+            let (fan_in, fan_out) = (LAYER_SIZES[i], LAYER_SIZES[i + 1]);
+            Dense {
+                weight_t: model::transpose(&params.layers[i].weight, fan_out, fan_in),
+                bias: params.layers[i].bias.clone(),
+            }
+        };
+        Ok(Self {
+            layers: [dense(0), dense(1), dense(2), dense(3)],
+        })
+    }
+
+    /// (pitch, roll) in degrees for one sample of 900 features. Allocation-free.
+    ///
+    /// # Panics
+    ///
+    /// When `features.len() != 900`: feature vectors come from the representation code, so a
+    /// wrong length is a programming error (use [`Predictor::predict`] for data from files).
+    pub fn predict_one(&self, features: &[f32]) -> [f32; 2] {
+        assert_eq!(
+            features.len(),
+            INPUTS,
+            "predict_one needs {INPUTS} features"
+        );
+        let mut h1 = [0.0_f32; H1];
+        let mut h2 = [0.0_f32; H2];
+        let mut h3 = [0.0_f32; H3];
+        let mut out = [0.0_f32; OUTPUTS];
+        let [l0, l1, l2, l3] = &self.layers;
+        l0.forward(features, &mut h1, true);
+        l1.forward(&h1, &mut h2, true);
+        l2.forward(&h2, &mut h3, true);
+        l3.forward(&h3, &mut out, false);
+        out
+    }
+
+    /// (pitch, roll) for every row of `features` (n x 900, flat).
+    pub fn predict(&self, features: &[f32]) -> Result<Vec<[f32; 2]>, Error> {
+        if !features.len().is_multiple_of(INPUTS) {
+            return Err(Error::RaggedFeatures {
+                len: features.len(),
+            });
+        }
+        Ok(features
+            .chunks_exact(INPUTS)
+            .map(|row| self.predict_one(row))
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_f64_reference() {
+        let params = Parameters::init(11);
+        let p = Predictor::new(&params).expect("valid");
+        let x: Vec<f32> = (0..3 * INPUTS)
+            .map(|i| {
+                if i % 3 == 0 {
+                    0.0
+                } else {
+                    ((i * 7) % 13) as f32 / 13.0
+                }
+            })
+            .collect();
+        let got = p.predict(&x).expect("rows");
+        for (row, g) in x.chunks_exact(INPUTS).zip(&got) {
+            let r = params.forward_f64(row);
+            for k in 0..OUTPUTS {
+                assert!((f64::from(g[k]) - r[k]).abs() < 1e-4, "{g:?} vs {r:?}");
+            }
+        }
+        assert!(matches!(
+            p.predict(&x[1..]),
+            Err(Error::RaggedFeatures { .. })
+        ));
+    }
+}

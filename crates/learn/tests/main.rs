@@ -1,0 +1,5 @@
+//! Integration tests of `evtac-learn`: one binary, one module per concern.
+
+mod bundle;
+mod learns;
+mod pytorch;
