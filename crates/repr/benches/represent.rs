@@ -223,16 +223,19 @@ fn latency_table(events: &[Event], samples: &[i64]) {
         samples.len()
     );
     println!(
-        "| repr | impl | median (us) | P99 (us) | max (us) | throughput (Mevents/s) | speed-up |"
+        "| repr | impl | median (us) | P99 (us) | max (us) | throughput (Mevents/s) | speed-up (throughput) | speed-up (median) |"
     );
-    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for (name, row) in &rows {
         let base = baseline.iter().find(|(n, _)| n == name).map(|(_, r)| r);
         let ratio = base.map_or("-".into(), |b| {
             format!("{:.0}x", row.events_per_s / b.events_per_s)
         });
+        let median_ratio = base.map_or("-".into(), |b| {
+            format!("{:.0}x", b.median_us / row.median_us)
+        });
         println!(
-            "| {name} | evtac | {:.1} | {:.1} | {:.1} | {:.1} | {ratio} |",
+            "| {name} | evtac | {:.1} | {:.1} | {:.1} | {:.1} | {ratio} | {median_ratio} |",
             row.median_us,
             row.p99_us,
             row.max_us,
@@ -240,7 +243,7 @@ fn latency_table(events: &[Event], samples: &[i64]) {
         );
         if let Some(b) = base {
             println!(
-                "| {name} | Python (dv-processing / numpy) | {:.1} | {:.1} | {:.1} | {:.2} | 1x |",
+                "| {name} | Python (dv-processing / numpy) | {:.1} | {:.1} | {:.1} | {:.2} | 1x | 1x |",
                 b.median_us,
                 b.p99_us,
                 b.max_us,

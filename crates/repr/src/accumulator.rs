@@ -162,6 +162,13 @@ impl StaticAccumulator {
         *v
     }
 
+    /// Hints the cache to load pixel `pixel`'s state (an event for it is coming).
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, pixel: usize) {
+        crate::prefetch::prefetch(&self.potentials, pixel);
+        crate::prefetch::prefetch(&self.times, pixel);
+    }
+
     /// Synchronous decay (what dv-processing's `generateFrame` does first): when synchronous
     /// decay is on, decays every pixel to the latest event's time and moves its `T` there; a
     /// no-op for lazy decay or [`Decay::None`].

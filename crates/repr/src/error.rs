@@ -74,6 +74,18 @@ pub enum ReprError {
         /// Frame height.
         height: u16,
     },
+    /// `push_with_roi` got a crop whose size differs from the extractor's frame.
+    #[error("ROI is {roi_width}x{roi_height} but the extractor's frame is {width}x{height}")]
+    RoiSize {
+        /// ROI width.
+        roi_width: u16,
+        /// ROI height.
+        roi_height: u16,
+        /// Frame width.
+        width: u16,
+        /// Frame height.
+        height: u16,
+    },
     /// A buffer's length does not match the frame it describes.
     #[error("{what} has {len} values but a {width}x{height} frame needs {expected}")]
     BufferLength {

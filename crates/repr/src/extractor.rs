@@ -40,6 +40,10 @@ use crate::window::SlidingWindow;
 use evtac_events::{Event, Resolution, Roi};
 use std::collections::VecDeque;
 
+/// How many events ahead the per-pixel state is prefetched: far enough for the loads to land
+/// before the event is processed (about 30 ns of work per event), near enough to stay cached.
+const PREFETCH_AHEAD: usize = 12;
+
 struct AccSlot {
     params: AccumulatorParams,
     acc: StaticAccumulator,
@@ -335,9 +339,9 @@ impl FeatureExtractor {
     /// outside it are dropped). `roi.size` must be the frame size.
     pub fn push_with_roi(&mut self, events: &[Event], roi: &Roi) -> Result<(), ReprError> {
         if roi.size != self.resolution {
-            return Err(ReprError::MaskSize {
-                mask_width: roi.size.width,
-                mask_height: roi.size.height,
+            return Err(ReprError::RoiSize {
+                roi_width: roi.size.width,
+                roi_height: roi.size.height,
                 width: self.resolution.width,
                 height: self.resolution.height,
             });
@@ -381,7 +385,16 @@ impl FeatureExtractor {
             pending,
             ..
         } = self;
-        for e in pending.range(..n) {
+        for (i, e) in pending.range(..n).enumerate() {
+            if let Some(ahead) = pending.get(i + PREFETCH_AHEAD) {
+                let q = usize::from(ahead.y) * width + usize::from(ahead.x);
+                for slot in accs.iter() {
+                    slot.acc.prefetch(q);
+                }
+                for slot in windows.iter() {
+                    slot.window.prefetch(q);
+                }
+            }
             let p = usize::from(e.y) * width + usize::from(e.x);
             for slot in accs.iter_mut() {
                 let v = slot.acc.update(p, e.t, e.polarity);

@@ -51,6 +51,7 @@ mod error;
 pub mod extractor;
 pub mod mask;
 pub mod pool;
+mod prefetch;
 pub mod window;
 
 pub use accumulator::{FrameMap, StaticAccumulator};

@@ -54,6 +54,12 @@ impl SlidingWindow {
         *c
     }
 
+    /// Hints the cache to load pixel `pixel`'s count (an event for it is coming).
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, pixel: usize) {
+        crate::prefetch::prefetch(&self.counts, pixel);
+    }
+
     /// Moves the window's end to `t_k`: removes every event with `t <= t_k - window`, calling
     /// `on_expire(pixel, new_count)` for each.
     #[inline]

@@ -58,7 +58,10 @@ fn events_outside_the_frame_are_rejected_with_their_coordinates() {
         .unwrap();
     assert_eq!(fx.pending(), 1);
     let small = Roi::centered(Resolution::new(640, 480), Resolution::new(8, 8)).unwrap();
-    assert!(fx.push_with_roi(&[ev(3, 0, 0)], &small).is_err());
+    assert!(matches!(
+        fx.push_with_roi(&[ev(3, 0, 0)], &small),
+        Err(ReprError::RoiSize { roi_width: 8, .. })
+    ));
 }
 
 #[test]
