@@ -27,7 +27,8 @@ pub enum Compression {
     None,
     /// LZ4 frame format, fast setting.
     Lz4,
-    /// LZ4 frame format, high-compression setting (read-only here: the bytes are plain LZ4 frames).
+    /// LZ4 frame format, high-compression setting. The bytes are plain LZ4 frames; our writer
+    /// produces them with the fast compressor (lz4_flex has no high-compression mode).
     Lz4High,
     /// Zstandard, fast setting.
     Zstd,
