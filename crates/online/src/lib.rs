@@ -17,21 +17,24 @@
 //! estimate's forward pass.
 //!
 //! ```no_run
-//! use evtac_online::{Model, Estimator, input::SourceSpec, pipeline::{self, Output, PipelineConfig}};
+//! use evtac_online::input::{self, OpenOptions, SourceSpec};
+//! use evtac_online::pipeline::{self, Output, PipelineConfig};
+//! use evtac_online::Model;
 //! use std::ops::ControlFlow;
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let model = Model::load("model/".as_ref())?;
 //! let spec: SourceSpec = "recording.aedat4".parse()?;
-//! let source = evtac_online::input::open(&spec, &Default::default())?;
-//! let estimator = model.estimator(source.resolution(None)?, 1000)?;
-//! let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
+//! let opened = input::open(&spec, &OpenOptions::default(), &mut |notice| eprintln!("{notice}"))?;
+//! let sensor = opened.resolution.ok_or("the recording does not state its sensor size")?;
+//! let estimator = model.estimator(sensor, 1000)?;
+//! let summary = pipeline::run(opened.source, estimator, &PipelineConfig::default(), |out| {
 //!     if let Output::Estimate(e) = out {
 //!         println!("{} {} {}", e.t_us, e.pitch_deg, e.roll_deg);
 //!     }
 //!     ControlFlow::Continue(())
 //! })?;
-//! println!("{summary}");
+//! eprintln!("{summary}");
 //! # Ok(()) }
 //! ```
 

@@ -32,11 +32,11 @@ pub enum Notice {
         /// The wait before this attempt.
         delay: Duration,
     },
-    /// A reconnection attempt failed.
+    /// A connection attempt failed.
     AttemptFailed {
         /// The input.
         input: String,
-        /// 1-based attempt number.
+        /// 0 for the first connection, then the 1-based reconnection attempt.
         attempt: u32,
         /// Why it failed.
         reason: String,
@@ -70,6 +70,11 @@ impl std::fmt::Display for Notice {
                 "reconnecting to {input} in {:.1} s (attempt {attempt} of {attempts})",
                 delay.as_secs_f64()
             ),
+            Self::AttemptFailed {
+                input,
+                attempt,
+                reason,
+            } if *attempt == 0 => write!(f, "could not reach {input}: {reason}"),
             Self::AttemptFailed {
                 input,
                 attempt,

@@ -170,7 +170,9 @@ pub fn run<S: EventSource>(
     summary.events_in_roi = counters.events_in_roi;
     summary.events_dropped = ingested.dropped;
     summary.events_out_of_order = counters.events_out_of_order;
-    summary.reconnects = connections.saturating_sub(1);
+    // Sources connect before the run starts (see `input::open`): every connection during the
+    // run is a reconnection.
+    summary.reconnects = connections;
     summary.span_us = counters.span_us;
     summary.wall = ingested
         .first_arrival

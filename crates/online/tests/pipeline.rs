@@ -232,7 +232,7 @@ fn an_unreachable_server_fails_with_a_clear_message() {
 
 #[test]
 fn stopping_early_and_dropping_when_behind() {
-    let events = Synthetic::new(3, 300_000.0, 1000, 300_000).collect::<Vec<_>>();
+    let events: Vec<Event> = Synthetic::new(3, 300_000.0, 1000, 300_000).collect();
     let dir = tempfile::tempdir().unwrap();
     let model = model(dir.path());
 
@@ -291,7 +291,7 @@ fn stopping_early_and_dropping_when_behind() {
 
 #[test]
 fn out_of_order_events_are_skipped_and_counted() {
-    let mut events = Synthetic::new(4, 100_000.0, 1000, 20_000).collect::<Vec<_>>();
+    let mut events: Vec<Event> = Synthetic::new(4, 100_000.0, 1000, 20_000).collect();
     // A camera restarted behind a reconnection: its clock starts over.
     let again: Vec<Event> = events.iter().take(100).copied().collect();
     events.extend(again);

@@ -11,13 +11,25 @@ use evtac_repr::extract_features;
 use evtac_sim::{Protocol, Scale, SimParams, Simulator, plan};
 use std::ops::ControlFlow;
 
-/// The first trial of the tiny Experiment 1 plan, cut to its first `keep_us` after the motion
-/// starts (enough to exercise contact while keeping the test quick).
+/// Simulator settings for short trials: a 5 degree tilt instead of 20, half a second of
+/// no-contact recording (indentation, settling and holding as in the paper's protocol).
+fn short_params() -> SimParams {
+    let mut params = SimParams::default();
+    params.timeline.total_deg = 5.0;
+    params.timeline.no_contact_s = 0.5;
+    params
+}
+
+/// A fast, deep trial of the tiny Experiment 1 plan (about 1.8 s of events).
 fn simulated_trial() -> (Vec<Event>, evtac_sim::TrialRecording) {
-    let params = SimParams::default();
+    let params = short_params();
     let trials = plan(Protocol::Exp1, Scale::Tiny, 7, &params.timeline);
+    let spec = trials
+        .iter()
+        .find(|t| t.speed_deg_s == 10.0 && t.depth_mm == 3.0)
+        .unwrap_or(&trials[0]);
     let sim = Simulator::new(params, 7);
-    let recording = sim.simulate(&trials[0]);
+    let recording = sim.simulate(spec);
     (recording.events.clone(), recording)
 }
 
@@ -84,7 +96,7 @@ fn replayed_simulated_trial_matches_the_offline_pipeline_at_every_interval() {
     evtac_sim::dataset::write_recording(&file, &recording, SENSOR, Compression::Lz4).unwrap();
 
     // A no-contact mask from the simulator's rest recording, as training would use.
-    let rest = Simulator::new(SimParams::default(), 7).simulate_rest(3);
+    let rest = Simulator::new(short_params(), 7).simulate_rest(3);
     let crop = Resolution::new(240, 240);
     let roi = Roi::centered(SENSOR, crop).unwrap();
     let mut rest_cropped = Vec::new();

@@ -78,7 +78,9 @@ fn memory_stays_flat_and_estimates_do_not_allocate() {
     let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
         if let Output::Estimate(_) = out {
             estimates += 1;
-            if estimates >= warm_up && estimates % every == 0 && samples.len() < samples.capacity()
+            if estimates >= warm_up
+                && estimates.is_multiple_of(every)
+                && samples.len() < samples.capacity()
             {
                 samples.push((
                     estimates,

@@ -34,7 +34,10 @@ impl EventSource for MemorySource {
         if self.pos >= self.events.len() {
             return Ok(None);
         }
-        let end = (self.pos + self.chunk_len).min(self.events.len());
+        let end = self
+            .pos
+            .saturating_add(self.chunk_len)
+            .min(self.events.len());
         out.extend_from_slice(&self.events[self.pos..end]);
         self.pos = end;
         Ok(Some(ChunkInfo::default()))

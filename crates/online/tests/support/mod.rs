@@ -9,7 +9,7 @@ use evtac_learn::{Mae, ModelBundle, Parameters, TrainConfig};
 use evtac_online::Notice;
 use evtac_online::input::{ChunkInfo, EventSource, InputError};
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
-use rand::{Rng, SeedableRng};
+use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
