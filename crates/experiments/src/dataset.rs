@@ -7,7 +7,7 @@ use crate::splits::{self, Splits, Stratum};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_labels::geometry::Calibration;
-use evtac_labels::{LabelConfig, LabelSeries, TrialMotion, label_imu};
+use evtac_labels::{LabelConfig, LabelSeries};
 use evtac_repr::{Mask, ReprConfig};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -223,23 +223,11 @@ impl Dataset {
     /// Labels `meta` from its recording's IMU stream with the default label settings (what
     /// `evtac labels` does for one trial).
     fn compute_labels(&self, meta: &TrialMeta) -> Result<evtac_labels::TrialLabels, Error> {
-        let lab = |message: String| Error::Labels {
-            trial: meta.trial.clone(),
-            message,
-        };
-        let path = self.dir.join(&meta.file);
-        let rec = evtac_events::read_recording(&path).map_err(|source| Error::Recording {
-            path: path.clone(),
-            source,
-        })?;
-        let motion = TrialMotion::from_meta(meta).map_err(|e| lab(e.to_string()))?;
-        label_imu(
-            &rec.imu,
-            &motion,
-            &self.calibration,
-            &LabelConfig::default(),
-        )
-        .map_err(|e| lab(e.to_string()))
+        evtac_labels::label_trial(&self.dir, meta, &self.calibration, &LabelConfig::default())
+            .map_err(|e| Error::Labels {
+                trial: meta.trial.clone(),
+                message: e.to_string(),
+            })
     }
 
     /// The sample times of `meta` under `sampling`.

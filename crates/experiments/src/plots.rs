@@ -262,7 +262,7 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
         chart
             .configure_mesh()
             .disable_x_mesh()
-            .x_labels(3)
+            .x_labels(7)
             .x_label_formatter(&|x| {
                 let i = (x - 0.5).round();
                 if (x - 0.5 - i).abs() < 1e-6 && (0.0..3.0).contains(&i) {
@@ -430,7 +430,7 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
     let e = draw_err(path);
     let cols = 2usize;
     let rows = panels.len().div_ceil(cols);
-    let (cell_w, cell_h) = (520u32, 600u32);
+    let (cell_w, cell_h) = (540u32, 650u32);
     let root =
         BitMapBackend::new(path, (cell_w * cols as u32, cell_h * rows as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(&e)?;
