@@ -37,7 +37,7 @@ const CHUNK: usize = 1 << 14;
 pub enum CsvError {
     /// Reading or writing failed.
     #[error("I/O failed: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// The file has no header line.
     #[error("the file is empty (expected the header `{EVENT_HEADER}`)")]
     Empty,
@@ -58,13 +58,21 @@ pub enum CsvError {
         reason: String,
     },
     /// A parsed event is invalid (outside the sensor, or earlier than its predecessor).
-    #[error("{source} (read up to line {line})")]
+    #[error("{error} (read up to line {line})")]
     Event {
         /// What is wrong with it.
-        source: CheckError,
+        error: CheckError,
         /// One-based number of the last line read.
         line: u64,
     },
+}
+
+// Not `#[from]`: that would also make the I/O error the `source()`, and `{:#}` chains would
+// print its message twice (it is already part of ours).
+impl From<std::io::Error> for CsvError {
+    fn from(error: std::io::Error) -> Self {
+        Self::Io(error)
+    }
 }
 
 /// A streaming reader of `t,x,y,p` event CSV files.
@@ -213,7 +221,7 @@ impl<R: BufRead> CsvReader<R> {
         let line = self.line;
         self.check
             .check(&self.events)
-            .map_err(|source| CsvError::Event { source, line })?;
+            .map_err(|error| CsvError::Event { error, line })?;
         Ok((!self.events.is_empty()).then_some(self.events.as_slice()))
     }
 }

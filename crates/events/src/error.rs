@@ -1,6 +1,9 @@
 //! The crate-level error of the whole-file API ([`open`](crate::open),
 //! [`read_recording`](crate::read_recording), [`EventWriter`](crate::EventWriter)): each
 //! format's error, with the path of the file it concerns.
+//!
+//! Messages embed the inner error's message (so `{}` alone tells the whole story); the inner
+//! error is a public field rather than a `source()`, so that `{:#}` chains do not repeat it.
 
 use std::path::PathBuf;
 
@@ -16,12 +19,12 @@ use crate::{Format, Resolution};
 #[non_exhaustive]
 pub enum Error {
     /// The file could not be opened, created or inspected.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// The underlying error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// Neither the first bytes nor the extension identify a format evtac reads.
     #[error("{}: unknown event file format ({reason})", path.display())]
@@ -56,44 +59,44 @@ pub enum Error {
         found: Resolution,
     },
     /// An AEDAT4 file is broken.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Aedat {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: AedatError,
+        error: AedatError,
     },
     /// An EVT file is broken.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Evt {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: EvtError,
+        error: EvtError,
     },
     /// A CSV file is broken.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Csv {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: CsvError,
+        error: CsvError,
     },
     /// An NPY file is broken.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Npy {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: NpyError,
+        error: NpyError,
     },
     /// An event read from the file is invalid (outside the sensor, or earlier than its
     /// predecessor).
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Event {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: CheckError,
+        error: CheckError,
     },
 }

@@ -35,5 +35,7 @@ mod recording;
 mod types;
 
 pub use error::Error;
-pub use recording::{Chunk, EventReader, EventWriter, Format, Recording, open, read_recording};
+pub use recording::{
+    Chunk, EventReader, EventWriter, Events, Format, Recording, open, read_recording,
+};
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

@@ -42,7 +42,7 @@ const CHUNK: usize = 1 << 14;
 pub enum NpyError {
     /// Reading or writing failed.
     #[error("I/O failed: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// The file holds no bytes.
     #[error("the file is empty")]
     Empty,
@@ -118,7 +118,7 @@ pub enum NpyError {
         reason: String,
     },
     /// A decoded event is invalid (outside the sensor, or earlier than its predecessor).
-    #[error("{0}")]
+    #[error(transparent)]
     Event(#[from] CheckError),
     /// An event to write has a coordinate that `<i2` cannot hold.
     #[error("event {index} at (x={x}, y={y}) cannot be written: NPY coordinates must be <= 32767")]
@@ -130,6 +130,14 @@ pub enum NpyError {
         /// Its row.
         y: u16,
     },
+}
+
+// Not `#[from]`: that would also make the I/O error the `source()`, and `{:#}` chains would
+// print its message twice (it is already part of ours).
+impl From<std::io::Error> for NpyError {
+    fn from(error: std::io::Error) -> Self {
+        Self::Io(error)
+    }
 }
 
 /// Reads into `buf` until it is full or the source ends; returns the bytes read.

@@ -69,9 +69,9 @@ impl Format {
 
     /// Recognises the format of the file at `path`: by its first bytes, else by its extension.
     pub fn detect(path: &Path) -> Result<Self, Error> {
-        let io = |source| Error::Io {
+        let io = |error| Error::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         };
         let mut head = Vec::with_capacity(64);
         File::open(path)
@@ -92,9 +92,9 @@ impl Format {
                     EvtVersion::Evt2 => Self::Evt2,
                     EvtVersion::Evt3 => Self::Evt3,
                 }),
-                Err(source) => Err(Error::Evt {
+                Err(error) => Err(Error::Evt {
                     path: path.to_path_buf(),
-                    source,
+                    error,
                 }),
             };
         }
@@ -184,39 +184,39 @@ impl std::fmt::Debug for EventReader {
 pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
     let path = path.as_ref();
     let format = Format::detect(path)?;
-    let io = |source| Error::Io {
+    let io = |error| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     };
     let len = std::fs::metadata(path).map_err(io)?.len();
     let (inner, source) = match format {
         Format::Aedat4 => {
-            let r = AedatReader::open(path).map_err(|source| Error::Aedat {
+            let r = AedatReader::open(path).map_err(|error| Error::Aedat {
                 path: path.to_path_buf(),
-                source,
+                error,
             })?;
             let name = r.source().map(str::to_string);
             (Inner::Aedat(Box::new(r)), name)
         }
         Format::Evt2 | Format::Evt3 => {
-            let r = EvtReader::from_path(path).map_err(|source| Error::Evt {
+            let r = EvtReader::from_path(path).map_err(|error| Error::Evt {
                 path: path.to_path_buf(),
-                source,
+                error,
             })?;
             let name = r.header().source();
             (Inner::Evt(Box::new(r)), name)
         }
         Format::Csv => {
-            let r = CsvReader::from_path(path).map_err(|source| Error::Csv {
+            let r = CsvReader::from_path(path).map_err(|error| Error::Csv {
                 path: path.to_path_buf(),
-                source,
+                error,
             })?;
             (Inner::Csv(Box::new(r)), None)
         }
         Format::Npy => {
-            let r = NpyReader::from_path(path).map_err(|source| Error::Npy {
+            let r = NpyReader::from_path(path).map_err(|error| Error::Npy {
                 path: path.to_path_buf(),
-                source,
+                error,
             })?;
             (Inner::Npy(Box::new(r)), None)
         }
@@ -305,16 +305,16 @@ impl EventReader {
         let path = &self.path;
         match &mut self.inner {
             Inner::Aedat(r) => {
-                let chunk = r.next_chunk().map_err(|source| Error::Aedat {
+                let chunk = r.next_chunk().map_err(|error| Error::Aedat {
                     path: path.clone(),
-                    source,
+                    error,
                 })?;
                 let Some(chunk) = chunk else { return Ok(None) };
                 self.aedat_check
                     .check(chunk.events)
-                    .map_err(|source| Error::Event {
+                    .map_err(|error| Error::Event {
                         path: path.clone(),
-                        source,
+                        error,
                     })?;
                 Ok(Some(Chunk {
                     events: chunk.events,
@@ -331,9 +331,9 @@ impl EventReader {
                         triggers: c.triggers,
                     })
                 })
-                .map_err(|source| Error::Evt {
+                .map_err(|error| Error::Evt {
                     path: path.clone(),
-                    source,
+                    error,
                 }),
             Inner::Csv(r) => r
                 .next_chunk()
@@ -343,9 +343,9 @@ impl EventReader {
                         ..Chunk::default()
                     })
                 })
-                .map_err(|source| Error::Csv {
+                .map_err(|error| Error::Csv {
                     path: path.clone(),
-                    source,
+                    error,
                 }),
             Inner::Npy(r) => r
                 .next_chunk()
@@ -355,10 +355,21 @@ impl EventReader {
                         ..Chunk::default()
                     })
                 })
-                .map_err(|source| Error::Npy {
+                .map_err(|error| Error::Npy {
                     path: path.clone(),
-                    source,
+                    error,
                 }),
+        }
+    }
+
+    /// An iterator over the remaining events, one at a time (IMU samples and triggers are
+    /// skipped); it yields the first error and then ends.
+    pub fn into_events(self) -> Events {
+        Events {
+            reader: self,
+            buf: Vec::new(),
+            next: 0,
+            failed: false,
         }
     }
 
@@ -378,6 +389,42 @@ impl EventReader {
             imu,
             triggers,
         })
+    }
+}
+
+/// Iterator over the events of an [`EventReader`] (see [`EventReader::into_events`]).
+#[derive(Debug)]
+pub struct Events {
+    reader: EventReader,
+    buf: Vec<Event>,
+    next: usize,
+    failed: bool,
+}
+
+impl Iterator for Events {
+    type Item = Result<Event, Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while self.next == self.buf.len() {
+            if self.failed {
+                return None;
+            }
+            match self.reader.next_chunk() {
+                Ok(Some(chunk)) => {
+                    self.buf.clear();
+                    self.buf.extend_from_slice(chunk.events);
+                    self.next = 0;
+                }
+                Ok(None) => return None,
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
+                }
+            }
+        }
+        let event = self.buf[self.next];
+        self.next += 1;
+        Some(Ok(event))
     }
 }
 
@@ -447,19 +494,19 @@ impl EventWriter {
                 let resolution =
                     resolution.ok_or_else(|| Error::MissingResolution { path: path.clone() })?;
                 let config = WriterConfig::new(resolution, source_name.unwrap_or("evtac"));
-                let w = AedatWriter::create(&path, config).map_err(|source| Error::Aedat {
+                let w = AedatWriter::create(&path, config).map_err(|error| Error::Aedat {
                     path: path.clone(),
-                    source,
+                    error,
                 })?;
                 Sink::Aedat(Box::new(w))
             }
-            Format::Csv => Sink::Csv(CsvWriter::create(&path).map_err(|source| Error::Csv {
+            Format::Csv => Sink::Csv(CsvWriter::create(&path).map_err(|error| Error::Csv {
                 path: path.clone(),
-                source,
+                error,
             })?),
-            Format::Npy => Sink::Npy(NpyWriter::create(&path).map_err(|source| Error::Npy {
+            Format::Npy => Sink::Npy(NpyWriter::create(&path).map_err(|error| Error::Npy {
                 path: path.clone(),
-                source,
+                error,
             })?),
             Format::Evt2 | Format::Evt3 => {
                 return Err(Error::NotWritable { path, format });
@@ -482,17 +529,17 @@ impl EventWriter {
     pub fn write_events(&mut self, events: &[Event]) -> Result<(), Error> {
         let path = &self.path;
         match &mut self.sink {
-            Sink::Aedat(w) => w.write_events(events).map_err(|source| Error::Aedat {
+            Sink::Aedat(w) => w.write_events(events).map_err(|error| Error::Aedat {
                 path: path.clone(),
-                source,
+                error,
             }),
-            Sink::Csv(w) => w.write_events(events).map_err(|source| Error::Csv {
+            Sink::Csv(w) => w.write_events(events).map_err(|error| Error::Csv {
                 path: path.clone(),
-                source,
+                error,
             }),
-            Sink::Npy(w) => w.write_events(events).map_err(|source| Error::Npy {
+            Sink::Npy(w) => w.write_events(events).map_err(|error| Error::Npy {
                 path: path.clone(),
-                source,
+                error,
             }),
         }
     }
@@ -501,9 +548,9 @@ impl EventWriter {
     /// CSV and NPY event files have no place for them and ignore them.
     pub fn write_imu(&mut self, samples: &[ImuSample]) -> Result<(), Error> {
         match &mut self.sink {
-            Sink::Aedat(w) => w.write_imu(samples).map_err(|source| Error::Aedat {
+            Sink::Aedat(w) => w.write_imu(samples).map_err(|error| Error::Aedat {
                 path: self.path.clone(),
-                source,
+                error,
             }),
             Sink::Csv(_) | Sink::Npy(_) => Ok(()),
         }
@@ -516,15 +563,15 @@ impl EventWriter {
             Sink::Aedat(w) => w
                 .finish()
                 .map(drop)
-                .map_err(|source| Error::Aedat { path, source }),
+                .map_err(|error| Error::Aedat { path, error }),
             Sink::Csv(w) => w
                 .finish()
                 .map(drop)
-                .map_err(|source| Error::Csv { path, source }),
+                .map_err(|error| Error::Csv { path, error }),
             Sink::Npy(w) => w
                 .finish()
                 .map(drop)
-                .map_err(|source| Error::Npy { path, source }),
+                .map_err(|error| Error::Npy { path, error }),
         }
     }
 }

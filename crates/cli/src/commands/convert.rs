@@ -1,10 +1,114 @@
-//! `evtac convert`.
+//! `evtac convert`: any readable event file to AEDAT4, CSV or NPY (by the output's extension),
+//! optionally cropped to a centered region and with the IMU written to a CSV file.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use evtac_events::csv::ImuCsvWriter;
+use evtac_events::{EventWriter, Resolution, Roi};
 
 /// Arguments of `evtac convert`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// The recording to read (AEDAT4, EVT 2.0/3.0 raw, CSV or NPY).
+    pub input: PathBuf,
+    /// The file to write; its extension picks the format: .aedat4 (LZ4), .csv or .npy.
+    pub output: PathBuf,
+    /// Also write the IMU samples to this CSV file (t,ax,ay,az,gx,gy,gz,temperature).
+    #[arg(long, value_name = "IMU_OUT.csv")]
+    pub imu: Option<PathBuf>,
+    /// Sensor size WIDTHxHEIGHT; required for inputs that do not store it (CSV, NPY), and
+    /// checked against every event.
+    #[arg(long, value_name = "WxH")]
+    pub resolution: Option<Resolution>,
+    /// Keep only the centered WIDTHxHEIGHT region: events outside are dropped, coordinates are
+    /// shifted into it, and the output's resolution is the region's.
+    #[arg(long, value_name = "WxH")]
+    pub roi: Option<Resolution>,
+}
+
+/// What a conversion wrote.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Counts {
+    /// Events read.
+    pub events_in: u64,
+    /// Events written (after the crop).
+    pub events_out: u64,
+    /// IMU samples read.
+    pub imu: u64,
+}
 
 /// Runs `evtac convert`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac convert is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let counts = convert(&args)?;
+    eprintln!(
+        "wrote {} of {} events to {}",
+        counts.events_out,
+        counts.events_in,
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Converts `args.input` to `args.output` as `evtac convert` does.
+pub fn convert(args: &Args) -> anyhow::Result<Counts> {
+    let mut reader = evtac_events::open(&args.input)?;
+    if let Some(resolution) = args.resolution {
+        reader.set_resolution(resolution)?;
+    }
+    let Some(sensor) = reader.resolution() else {
+        bail!(
+            "{} is {} and does not store the sensor size: pass --resolution WIDTHxHEIGHT",
+            args.input.display(),
+            reader.format()
+        );
+    };
+    let roi = match args.roi {
+        Some(size) => Roi::centered(sensor, size)
+            .with_context(|| format!("--roi {size} does not fit inside the {sensor} sensor"))?,
+        None => Roi::full(sensor),
+    };
+    let mut writer = EventWriter::create(&args.output, Some(roi.size), reader.source())?;
+    let mut imu_writer = match &args.imu {
+        Some(path) => Some((
+            ImuCsvWriter::create(path).with_context(|| format!("creating {}", path.display()))?,
+            path,
+        )),
+        None => None,
+    };
+    let bar = crate::progress::bytes(reader.file_len(), "converting");
+    let mut cropped = Vec::new();
+    let mut counts = Counts::default();
+    while let Some(chunk) = reader.next_chunk()? {
+        roi.crop_into(chunk.events, &mut cropped);
+        writer.write_events(&cropped)?;
+        writer.write_imu(chunk.imu)?;
+        if let Some((w, path)) = &mut imu_writer {
+            w.write_imu(chunk.imu)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+        counts.events_in += chunk.events.len() as u64;
+        counts.events_out += cropped.len() as u64;
+        counts.imu += chunk.imu.len() as u64;
+        bar.set_position(reader.position());
+    }
+    bar.finish_and_clear();
+    let stores_imu = writer.stores_imu();
+    writer.finish()?;
+    if let Some((w, path)) = imu_writer {
+        w.finish()
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if counts.imu > 0 && !stores_imu && args.imu.is_none() {
+        eprintln!(
+            "note: {} IMU samples were not written ({} files hold events only); use --imu FILE.csv",
+            counts.imu,
+            writer_format_name(&args.output)
+        );
+    }
+    Ok(counts)
+}
+
+fn writer_format_name(path: &std::path::Path) -> &'static str {
+    evtac_events::Format::for_writing(path).map_or("these", |f| f.name())
 }

@@ -4,7 +4,8 @@
 //! reused event and trigger buffers, carrying a word that straddles two reads over to the next.
 //! Timestamps and vector decoding follow Prophesee's own decoders (openeb), without time shifting,
 //! so the times are the camera's. Events outside the sensor and timestamps that go backwards
-//! are errors, as is a file that ends inside a word.
+//! are errors (where Prophesee's decoder silently drops rows beyond the sensor height), as is a
+//! file that ends inside a word.
 //!
 //! ```no_run
 //! use evtac_events::evt::EvtReader;
@@ -42,7 +43,7 @@ const MAX_HEADER: usize = 1 << 20;
 pub enum EvtError {
     /// Reading the source failed.
     #[error("read failed: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// The source holds no bytes at all.
     #[error("the file is empty")]
     Empty,
@@ -57,7 +58,7 @@ pub enum EvtError {
     },
     /// A header field is missing or malformed.
     #[error("bad header: {0}")]
-    Header(#[from] HeaderError),
+    Header(HeaderError),
     /// The data ends inside a word.
     #[error(
         "truncated: the file ends {got} byte(s) into a {word}-byte word at byte offset {offset}"
@@ -71,13 +72,21 @@ pub enum EvtError {
         word: usize,
     },
     /// A decoded event is invalid (outside the sensor, or earlier than its predecessor).
-    #[error("{source} (in the data chunk ending at byte offset {offset})")]
+    #[error("{error} (in the data chunk ending at byte offset {offset})")]
     Event {
         /// What is wrong with it.
-        source: CheckError,
+        error: CheckError,
         /// Offset of the end of the data decoded when the problem was found.
         offset: u64,
     },
+}
+
+// Not `#[from]`: that would also make the I/O error the `source()`, and `{:#}` chains would
+// print its message twice (it is already part of ours).
+impl From<std::io::Error> for EvtError {
+    fn from(error: std::io::Error) -> Self {
+        Self::Io(error)
+    }
 }
 
 /// One decoded chunk: views into the reader's reused buffers.
@@ -188,7 +197,7 @@ impl<R: Read> EvtReader<R> {
         if pos == 0 {
             return Err(EvtError::NoHeader);
         }
-        let header = header::parse_fields(fields, pos as u64)?;
+        let header = header::parse_fields(fields, pos as u64).map_err(EvtError::Header)?;
         let decoder = match header.version {
             EvtVersion::Evt2 => Decoder::Evt2(evt2::Evt2Decoder::default()),
             EvtVersion::Evt3 => Decoder::Evt3(evt3::Evt3Decoder::default()),
@@ -250,7 +259,7 @@ impl<R: Read> EvtReader<R> {
                 let offset = self.offset;
                 self.check
                     .check(&self.events)
-                    .map_err(|source| EvtError::Event { source, offset })?;
+                    .map_err(|error| EvtError::Event { error, offset })?;
                 if !self.events.is_empty() || !self.triggers.is_empty() {
                     return Ok(Some(EvtChunk {
                         events: &self.events,

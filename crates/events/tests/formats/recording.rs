@@ -68,6 +68,9 @@ fn prophesee_fixtures_through_the_whole_file_api() {
     }
     assert_eq!(n, 219_596);
     assert_eq!(reader.position(), reader.file_len());
+    // The plain iterator gives the same events.
+    let iterated: Result<Vec<_>, _> = open(&evt3).unwrap().into_events().collect();
+    assert_eq!(iterated.unwrap().len(), 219_596);
     // A declared resolution must agree with the one the header implies.
     let mut reader = open(&evt3).unwrap();
     assert!(matches!(
