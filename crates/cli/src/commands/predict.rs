@@ -1,10 +1,61 @@
-//! `evtac predict`.
+//! `evtac predict`: (pitch, roll) for every row of a features NPY with a trained model bundle.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use evtac_learn::{INPUTS, ModelBundle};
+use ndarray::{Array2, ArrayD};
+use ndarray_npy::ReadNpyError;
 
 /// Arguments of `evtac predict`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Model bundle folder written by `evtac train` (model.safetensors, config.json, ...).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Features as an N x 900 float32 NPY (one pooled 30 x 30 representation per row).
+    #[arg(long)]
+    pub features: PathBuf,
+    /// Output NPY: N x 2 float32, pitch and roll in degrees.
+    #[arg(long)]
+    pub output: PathBuf,
+}
 
 /// Runs `evtac predict`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac predict is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    evtac_learn::flush_denormals();
+    let bundle = ModelBundle::load(&args.model)
+        .with_context(|| format!("loading the model bundle {}", args.model.display()))?;
+    let predictor = bundle.predictor()?;
+    let features = read_features(&args.features)?;
+    let predictions = predictor.predict(&features)?;
+    let out = Array2::from_shape_vec(
+        (predictions.len(), 2),
+        predictions.iter().flatten().copied().collect(),
+    )?;
+    ndarray_npy::write_npy(&args.output, &out)
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    Ok(())
+}
+
+/// Reads an N x 900 float32 NPY into a flat row-major buffer, with errors naming the file and
+/// what its header says.
+fn read_features(path: &std::path::Path) -> anyhow::Result<Vec<f32>> {
+    let array: ArrayD<f32> = match ndarray_npy::read_npy(path) {
+        Ok(a) => a,
+        Err(ReadNpyError::WrongDescriptor(descr)) => bail!(
+            "{}: features must be float32 ('<f4'), the file holds {descr}",
+            path.display()
+        ),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+    };
+    let shape = array.shape().to_vec();
+    if shape.len() != 2 || shape[1] != INPUTS {
+        bail!(
+            "{}: features must have shape (N, {INPUTS}), the file has {shape:?}",
+            path.display()
+        );
+    }
+    // `iter()` walks in logical (row-major) order even for Fortran-ordered files.
+    Ok(array.iter().copied().collect())
 }
