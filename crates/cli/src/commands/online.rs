@@ -1,10 +1,174 @@
-//! `evtac online`.
+//! `evtac online`: a trained model on a live or replayed event stream, one estimate per
+//! interval of event time, with latency figures.
+
+use anyhow::Context;
+use evtac_events::Resolution;
+use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::pipeline::{self, Output, PipelineConfig};
+use evtac_online::{Backoff, Model};
+use std::io::Write;
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 /// Arguments of `evtac online`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Model bundle folder (from `evtac train`): weights, representation settings, mask.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Event source: a recording (AEDAT4, EVT 2.0/3.0, CSV, NPY), a live DV network stream
+    /// `tcp://HOST:PORT`, or `-` for standard input (AEDAT4 or CSV).
+    #[arg(long)]
+    pub input: String,
+    /// Interval between estimates, in milliseconds of event time.
+    #[arg(long, default_value_t = 1.0)]
+    pub interval_ms: f64,
+    /// Replay a recording at its recorded pace instead of as fast as possible.
+    #[arg(long)]
+    pub realtime: bool,
+    /// Length of the slices a `--realtime` replay releases at once, in microseconds.
+    #[arg(long, default_value_t = 1000)]
+    pub slice_us: i64,
+    /// CSV file for the estimates (`t_us,pitch_deg,roll_deg,latency_us`); standard output when
+    /// absent.
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    /// Sensor size `WIDTHxHEIGHT` for inputs that do not state it (CSV, NPY).
+    #[arg(long)]
+    pub sensor: Option<Resolution>,
+    /// Chunks the queue between ingestion and estimation holds.
+    #[arg(long, default_value_t = 64)]
+    pub queue_chunks: usize,
+    /// Drop incoming chunks while the estimator is behind instead of waiting (counted in the
+    /// summary).
+    #[arg(long)]
+    pub drop_when_behind: bool,
+    /// Reconnection attempts in a row for a network input before the run ends.
+    #[arg(long, default_value_t = 8)]
+    pub reconnect_attempts: u32,
+    /// First reconnection delay in milliseconds (doubling up to `--reconnect-max-ms`).
+    #[arg(long, default_value_t = 100)]
+    pub reconnect_initial_ms: u64,
+    /// Longest reconnection delay in milliseconds.
+    #[arg(long, default_value_t = 5000)]
+    pub reconnect_max_ms: u64,
+    /// Seconds without data after which a network stream counts as stalled and is reopened.
+    #[arg(long, default_value_t = 2.0)]
+    pub stall_timeout_s: f64,
+    /// Stop after this many seconds of wall-clock time (checked at each estimate).
+    #[arg(long)]
+    pub max_duration_s: Option<f64>,
+}
+
+fn seconds(what: &str, s: f64) -> anyhow::Result<Duration> {
+    Duration::try_from_secs_f64(s)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .with_context(|| format!("{what} must be a positive number of seconds (got {s})"))
+}
 
 /// Runs `evtac online`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac online is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let interval_us = (args.interval_ms * 1000.0).round();
+    if !(1.0..=3.6e9).contains(&interval_us) {
+        anyhow::bail!(
+            "--interval-ms must be from 0.001 to 3600000 (got {})",
+            args.interval_ms
+        );
+    }
+    let interval_us = interval_us as i64;
+    let spec: SourceSpec = args.input.parse()?;
+    let model = Model::load(&args.model)?;
+    let options = OpenOptions {
+        realtime: args.realtime,
+        slice_us: args.slice_us,
+        sensor: args.sensor,
+        network: NetworkOptions {
+            backoff: Backoff {
+                initial: Duration::from_millis(args.reconnect_initial_ms),
+                max: Duration::from_millis(args.reconnect_max_ms.max(args.reconnect_initial_ms)),
+                attempts: args.reconnect_attempts,
+            },
+            stall_timeout: seconds("--stall-timeout-s", args.stall_timeout_s)?,
+            ..NetworkOptions::default()
+        },
+    };
+    let max_duration = args
+        .max_duration_s
+        .map(|s| seconds("--max-duration-s", s))
+        .transpose()?;
+    let say = |what: &dyn std::fmt::Display| eprintln!("evtac online: {what}");
+    let opened = input::open(&spec, &options, &mut |n| say(&n))
+        .with_context(|| format!("opening {spec}"))?;
+    let sensor = opened.resolution.with_context(|| {
+        format!("{spec} does not state the sensor size: give it with --sensor WIDTHxHEIGHT")
+    })?;
+    let estimator = model
+        .estimator(sensor, interval_us)
+        .with_context(|| format!("setting up the estimator for {}", args.model.display()))?;
+
+    let to_stdout = args.output.is_none();
+    let mut out: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(std::io::BufWriter::new(
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
+        )),
+        None => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
+    };
+    writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
+    let started = Instant::now();
+    let mut write_error = None;
+    let result = pipeline::run(
+        opened.source,
+        estimator,
+        &PipelineConfig {
+            queue_chunks: args.queue_chunks,
+            drop_when_behind: args.drop_when_behind,
+        },
+        |output| {
+            match output {
+                Output::Estimate(e) => {
+                    let written = writeln!(
+                        out,
+                        "{},{},{},{:.3}",
+                        e.t_us,
+                        e.pitch_deg,
+                        e.roll_deg,
+                        e.latency.as_secs_f64() * 1e6
+                    )
+                    // A live consumer reading standard output wants each row as it happens.
+                    .and_then(|()| if to_stdout { out.flush() } else { Ok(()) });
+                    if let Err(e) = written {
+                        write_error = Some(e);
+                        return ControlFlow::Break(());
+                    }
+                }
+                Output::Notice(n) => say(&n),
+            }
+            if max_duration.is_some_and(|d| started.elapsed() >= d) {
+                return ControlFlow::Break(());
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    let flushed = out.flush();
+    drop(out);
+    let summary = match result {
+        Ok(summary) => summary,
+        Err(pipeline::Error::Input { source, summary }) => {
+            eprintln!("{summary}");
+            return Err(source).with_context(|| format!("reading {spec}"));
+        }
+        Err(pipeline::Error::Estimator { source, summary }) => {
+            eprintln!("{summary}");
+            return Err(source).context("estimating");
+        }
+        Err(e) => return Err(e.into()),
+    };
+    eprintln!("{summary}");
+    if let Some(e) = write_error {
+        return Err(e).context("writing the estimates");
+    }
+    flushed.context("writing the estimates")?;
+    Ok(())
 }
