@@ -3,5 +3,6 @@
 mod dataset;
 mod degenerate;
 mod pipeline;
+mod real;
 mod simulated;
 mod synthetic;
