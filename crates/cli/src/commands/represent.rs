@@ -1,10 +1,374 @@
-//! `evtac represent`.
+//! `evtac represent`: static, dynamic or combined binary frames, potentials or pooled features of
+//! a recording at the sample times listed in a text file, written as NPY.
+//!
+//! Events are cropped to the ROI (default: the centered 240x240 crop of the paper) and fed once,
+//! in time order, to `evtac_repr::FeatureExtractor`. `--mask` takes either an `.npy` mask (uint8
+//! or bool, `height x width` of the crop, non-zero = masked) or a no-contact recording, which is
+//! cropped the same way and run through the same static accumulator settings
+//! (`evtac_repr::Mask::from_no_contact`: pixels whose 8-bit frame value differs from the neutral
+//! level at the end of the recording).
+
+use anyhow::{Context, bail, ensure};
+use evtac_events::{Event, Resolution, Roi};
+use evtac_repr::{
+    Comparison, Decay, DynamicConfig, FeatureExtractor, Mask, Polarity, ReprConfig, StaticConfig,
+    ThresholdSpace,
+};
+use ndarray::{Array2, Array3};
+use std::path::{Path, PathBuf};
+
+/// Which representation to build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Repr {
+    /// Exponential-decay accumulator (dv-processing compatible), masked and thresholded.
+    Static,
+    /// Sliding-window event count, thresholded.
+    Dynamic,
+    /// Pixel-wise OR of the static and dynamic binary frames.
+    Combined,
+}
+
+/// What to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum What {
+    /// Binary frames: uint8 N x H x W, 0 or 1.
+    Frames,
+    /// 8x8 mean-pooled features: float32 N x (H/8 * W/8), 900 for 240x240.
+    Features,
+    /// The static accumulator's potentials: float32 N x H x W (static and combined only).
+    Potential,
+}
+
+/// Threshold space of the static representation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Space {
+    /// On the float32 potential.
+    Potential,
+    /// On dv-processing's 8-bit `generateFrame` values.
+    U8,
+}
+
+/// Comparison against the static threshold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Cmp {
+    /// Strictly greater.
+    Gt,
+    /// Greater or equal.
+    Ge,
+}
+
+/// Polarity handling of the static representation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PolarityArg {
+    /// ON adds eta, OFF subtracts it.
+    Signed,
+    /// Every event adds eta.
+    Ignore,
+}
+
+/// Decay function of the static representation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DecayArg {
+    /// Exponential decay with time constant tau (the paper's).
+    Exponential,
+    /// Linear decay by one unit of potential per tau.
+    Linear,
+    /// No decay.
+    None,
+}
 
 /// Arguments of `evtac represent`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// The event recording (AEDAT4, EVT2/EVT3 raw, CSV or NPY).
+    pub events: PathBuf,
+    /// Text file of sample times t_k in microseconds, one per line, non-decreasing (blank lines
+    /// and lines starting with `#` are skipped).
+    #[arg(long)]
+    pub samples: PathBuf,
+    /// Representation to build.
+    #[arg(long, value_enum, default_value = "combined")]
+    pub repr: Repr,
+    /// What to write: binary frames, pooled features or static potentials.
+    #[arg(long, value_enum, default_value = "features")]
+    pub what: What,
+    /// Output NPY file.
+    #[arg(long, short)]
+    pub output: PathBuf,
+    /// Sensor resolution WIDTHxHEIGHT (needed when the file does not say; overrides it).
+    #[arg(long)]
+    pub resolution: Option<Resolution>,
+    /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
+    #[arg(long)]
+    pub roi: Option<String>,
+    /// No-contact mask: an `.npy` mask (non-zero = masked, crop-sized) or a no-contact recording
+    /// run through the same static settings.
+    #[arg(long)]
+    pub mask: Option<PathBuf>,
+    /// Static: decay function [default: exponential].
+    #[arg(long, value_enum)]
+    pub decay: Option<DecayArg>,
+    /// Static: decay time constant in milliseconds [default: 1000].
+    #[arg(long)]
+    pub tau_ms: Option<f64>,
+    /// Static: event contribution eta [default: 0.15].
+    #[arg(long)]
+    pub eta: Option<f32>,
+    /// Static: threshold in event contributions; set when value > threshold x eta [default: 2].
+    #[arg(long)]
+    pub threshold: Option<f32>,
+    /// Static: where the threshold applies [default: potential].
+    #[arg(long, value_enum)]
+    pub threshold_space: Option<Space>,
+    /// Static: comparison against the threshold [default: gt].
+    #[arg(long, value_enum)]
+    pub cmp: Option<Cmp>,
+    /// Static: lower clamp of the potential [default: 0].
+    #[arg(long, allow_hyphen_values = true)]
+    pub min_potential: Option<f32>,
+    /// Static: upper clamp of the potential [default: 1].
+    #[arg(long, allow_hyphen_values = true)]
+    pub max_potential: Option<f32>,
+    /// Static: neutral potential, the decay target [default: 0].
+    #[arg(long, allow_hyphen_values = true)]
+    pub neutral_potential: Option<f32>,
+    /// Static: polarity handling [default: signed].
+    #[arg(long, value_enum)]
+    pub polarity: Option<PolarityArg>,
+    /// Static: dv-processing's synchronous decay (every pixel decays at each sample).
+    #[arg(long)]
+    pub synchronous_decay: bool,
+    /// Dynamic: window length in milliseconds [default: 640].
+    #[arg(long)]
+    pub window_ms: Option<f64>,
+    /// Dynamic: set when the window's event count is > this [default: 0].
+    #[arg(long)]
+    pub count_threshold: Option<u32>,
+}
+
+impl Args {
+    fn static_config(&self) -> StaticConfig {
+        let d = StaticConfig::default();
+        StaticConfig {
+            decay: match self.decay {
+                Some(DecayArg::Exponential) => Decay::Exponential,
+                Some(DecayArg::Linear) => Decay::Linear,
+                Some(DecayArg::None) => Decay::None,
+                None => d.decay,
+            },
+            tau_ms: self.tau_ms.unwrap_or(d.tau_ms),
+            eta: self.eta.unwrap_or(d.eta),
+            min_potential: self.min_potential.unwrap_or(d.min_potential),
+            max_potential: self.max_potential.unwrap_or(d.max_potential),
+            neutral_potential: self.neutral_potential.unwrap_or(d.neutral_potential),
+            polarity: match self.polarity {
+                Some(PolarityArg::Signed) => Polarity::Signed,
+                Some(PolarityArg::Ignore) => Polarity::Ignore,
+                None => d.polarity,
+            },
+            synchronous_decay: self.synchronous_decay,
+            threshold: self.threshold.unwrap_or(d.threshold),
+            threshold_space: match self.threshold_space {
+                Some(Space::Potential) => ThresholdSpace::Potential,
+                Some(Space::U8) => ThresholdSpace::U8,
+                None => d.threshold_space,
+            },
+            comparison: match self.cmp {
+                Some(Cmp::Gt) => Comparison::Gt,
+                Some(Cmp::Ge) => Comparison::Ge,
+                None => d.comparison,
+            },
+        }
+    }
+
+    fn dynamic_config(&self) -> DynamicConfig {
+        let d = DynamicConfig::default();
+        DynamicConfig {
+            window_ms: self.window_ms.unwrap_or(d.window_ms),
+            count_threshold: self.count_threshold.unwrap_or(d.count_threshold),
+        }
+    }
+
+    fn config(&self) -> ReprConfig {
+        match self.repr {
+            Repr::Static => ReprConfig::Static(self.static_config()),
+            Repr::Dynamic => ReprConfig::Dynamic(self.dynamic_config()),
+            Repr::Combined => ReprConfig::Combined {
+                static_part: self.static_config(),
+                dynamic_part: self.dynamic_config(),
+            },
+        }
+    }
+}
 
 /// Runs `evtac represent`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("evtac represent is being built")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let config = args.config();
+    config.validate()?;
+    if args.what == What::Potential && config.static_part().is_none() {
+        bail!("--what potential needs --repr static or combined (dynamic has no potential)");
+    }
+    let samples = read_samples(&args.samples)?;
+
+    let (sensor, events) = read_events(&args.events, args.resolution)?;
+    let roi = parse_roi(args.roi.as_deref(), sensor)?;
+    let mut cropped = Vec::new();
+    roi.crop_into(&events, &mut cropped);
+    drop(events);
+    let frame = roi.size;
+
+    let mask = match &args.mask {
+        None => None,
+        Some(path) => Some(read_mask(path, &args, &config, frame)?),
+    };
+
+    let mut fx = FeatureExtractor::new(&[config], frame, mask.as_ref())?;
+    let (n, h, w) = (
+        samples.len(),
+        usize::from(frame.height),
+        usize::from(frame.width),
+    );
+    let per_sample = match args.what {
+        What::Features => fx.feature_len(),
+        What::Frames | What::Potential => h * w,
+    };
+    let mut bytes = Vec::new();
+    let mut floats = Vec::new();
+    match args.what {
+        What::Frames => bytes.reserve(n * per_sample),
+        What::Features | What::Potential => floats.reserve(n * per_sample),
+    }
+    let bar = crate::progress::bar(n as u64, "represent");
+    fx.run(&cropped, &samples, |_, fx| {
+        match args.what {
+            What::Frames => bytes.extend_from_slice(fx.frame(0)),
+            What::Features => floats.extend_from_slice(fx.features(0)),
+            What::Potential => floats.extend_from_slice(fx.potentials(0).unwrap_or_default()),
+        }
+        bar.inc(1);
+    })
+    .with_context(|| {
+        format!(
+            "building {} at the sample times of {} from {} (event indices count cropped events)",
+            config.cache_key(),
+            args.samples.display(),
+            args.events.display()
+        )
+    })?;
+    bar.finish_and_clear();
+
+    let out = &args.output;
+    let written = match args.what {
+        What::Frames => ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, h, w), bytes)?),
+        What::Potential => ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?),
+        What::Features => {
+            ndarray_npy::write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)
+        }
+    };
+    written.with_context(|| format!("writing {}", out.display()))?;
+    eprintln!(
+        "wrote {} samples of {} ({} events in the {} crop) to {}",
+        n,
+        config.cache_key(),
+        cropped.len(),
+        frame,
+        out.display()
+    );
+    Ok(())
+}
+
+/// Reads a recording and its sensor resolution (`--resolution` wins over the file's).
+fn read_events(
+    path: &Path,
+    resolution: Option<Resolution>,
+) -> anyhow::Result<(Resolution, Vec<Event>)> {
+    let rec = evtac_events::read_recording(path)
+        .with_context(|| format!("reading events from {}", path.display()))?;
+    let sensor = resolution.or(rec.resolution).with_context(|| {
+        format!(
+            "{} does not state its sensor resolution: pass --resolution WIDTHxHEIGHT",
+            path.display()
+        )
+    })?;
+    Ok((sensor, rec.events))
+}
+
+fn parse_roi(roi: Option<&str>, sensor: Resolution) -> anyhow::Result<Roi> {
+    match roi.map(str::trim) {
+        Some(s) if s.eq_ignore_ascii_case("none") => Ok(Roi::full(sensor)),
+        other => {
+            let size: Resolution = other
+                .unwrap_or("240x240")
+                .parse()
+                .map_err(|e: String| anyhow::anyhow!("--roi: {e}"))?;
+            Roi::centered(sensor, size)
+                .with_context(|| format!("--roi {size} does not fit inside the {sensor} sensor"))
+        }
+    }
+}
+
+fn read_samples(path: &Path) -> anyhow::Result<Vec<i64>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading sample times from {}", path.display()))?;
+    let mut samples = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let t: i64 = line.parse().with_context(|| {
+            format!(
+                "{} line {}: `{line}` is not a time in whole microseconds",
+                path.display(),
+                i + 1
+            )
+        })?;
+        if let Some(&prev) = samples.last() {
+            ensure!(
+                t >= prev,
+                "{} line {}: sample time {t} us is before the previous one ({prev} us)",
+                path.display(),
+                i + 1
+            );
+        }
+        samples.push(t);
+    }
+    Ok(samples)
+}
+
+fn read_mask(
+    path: &Path,
+    args: &Args,
+    config: &ReprConfig,
+    frame: Resolution,
+) -> anyhow::Result<Mask> {
+    let is_npy = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    if is_npy {
+        let pixels: Array2<u8> = match ndarray_npy::read_npy(path) {
+            Ok(a) => a,
+            Err(_) => ndarray_npy::read_npy::<_, Array2<bool>>(path)
+                .with_context(|| format!("reading {} as a uint8 or bool 2-D mask", path.display()))?
+                .mapv(u8::from),
+        };
+        let (h, w) = pixels.dim();
+        ensure!(
+            (h, w) == (usize::from(frame.height), usize::from(frame.width)),
+            "mask {} is {w}x{h} but the crop is {frame}",
+            path.display()
+        );
+        let flat: Vec<u8> = pixels.iter().copied().collect();
+        return Ok(Mask::from_pixels(frame, &flat)?);
+    }
+    let Some(static_config) = config.static_part() else {
+        bail!("--mask applies to the static part: it needs --repr static or combined");
+    };
+    let (sensor, events) = read_events(path, args.resolution)
+        .with_context(|| format!("reading the no-contact recording {}", path.display()))?;
+    let roi = parse_roi(args.roi.as_deref(), sensor)?;
+    let mut cropped = Vec::new();
+    roi.crop_into(&events, &mut cropped);
+    Mask::from_no_contact(frame, static_config, &cropped)
+        .with_context(|| format!("building the no-contact mask from {}", path.display()))
 }
