@@ -1,1 +1,179 @@
 //! Tests of `evtac online`.
+
+use crate::common::{evtac, run_ok};
+use evtac_learn::bundle::{BundleConfig, BundleMetrics, FORMAT_VERSION};
+use evtac_learn::{Mae, ModelBundle, Parameters, TrainConfig};
+use evtac_repr::ReprConfig;
+use std::io::Write;
+use std::path::Path;
+use std::process::Stdio;
+
+/// An untrained bundle (weights from a seed) with the default representation.
+fn bundle(dir: &Path) {
+    let bundle = ModelBundle {
+        parameters: Parameters::init(4),
+        config: BundleConfig {
+            format_version: FORMAT_VERSION,
+            architecture: vec![900, 256, 128, 64, 2],
+            training: TrainConfig::default(),
+            representation: serde_json::to_value(ReprConfig::default()).unwrap(),
+            metrics: BundleMetrics {
+                best_epoch: 0,
+                validation: Mae {
+                    overall: 0.0,
+                    pitch: 0.0,
+                    roll: 0.0,
+                },
+                evaluations: Default::default(),
+            },
+        },
+        mask: None,
+        history: Vec::new(),
+    };
+    bundle.save(dir).unwrap();
+}
+
+/// 50 ms of events around the sensor's centre, as `t,x,y,p` CSV.
+fn csv_events() -> String {
+    let mut csv = String::from("t,x,y,p\n");
+    for i in 0..20_000i64 {
+        let t = 1_000_000 + i * 50_000 / 20_000;
+        let x = 220 + (i * 7919 % 200);
+        let y = 140 + (i * 104_729 % 200);
+        csv.push_str(&format!("{t},{x},{y},{}\n", i % 3 == 0));
+    }
+    csv.replace("true", "1").replace("false", "0")
+}
+
+fn rows(csv: &str) -> Vec<Vec<String>> {
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn replays_a_csv_file_and_standard_input_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    let out = dir.path().join("estimates.csv");
+    let run = run_ok(&[
+        "online",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        events.to_str().unwrap(),
+        "--sensor",
+        "640x480",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("t_us,pitch_deg,roll_deg,latency_us\n"));
+    let file_rows = rows(&text);
+    // 1,000,000 .. 1,049,997 us: estimates at every millisecond from 1,000,000 to 1,049,000.
+    assert_eq!(file_rows.len(), 50, "{stderr}");
+    for (k, row) in file_rows.iter().enumerate() {
+        assert_eq!(row.len(), 4);
+        assert_eq!(row[0], (1_000_000 + 1000 * k as i64).to_string());
+        assert!(row[3].parse::<f64>().unwrap() >= 0.0);
+    }
+    assert!(stderr.contains("estimates: 50 every 1000 us"), "{stderr}");
+    assert!(stderr.contains("20000 received"), "{stderr}");
+    assert!(stderr.contains("0 dropped"), "{stderr}");
+
+    // The same events on standard input give the same estimates.
+    let mut child = evtac()
+        .args(["online", "--model", model.to_str().unwrap(), "--input", "-"])
+        .args(["--sensor", "640x480", "--interval-ms", "1"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(csv_events().as_bytes())
+        .unwrap();
+    let piped = child.wait_with_output().unwrap();
+    assert!(
+        piped.status.success(),
+        "{}",
+        String::from_utf8_lossy(&piped.stderr)
+    );
+    let stdin_rows = rows(&String::from_utf8_lossy(&piped.stdout));
+    let values = |r: &[Vec<String>]| -> Vec<[String; 3]> {
+        r.iter()
+            .map(|r| [r[0].clone(), r[1].clone(), r[2].clone()])
+            .collect()
+    };
+    assert_eq!(values(&stdin_rows), values(&file_rows));
+}
+
+#[test]
+fn bad_inputs_fail_with_clear_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    let fail = |args: &[&str]| {
+        let out = evtac().args(args).output().unwrap();
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let m = model.to_str().unwrap();
+    let e = events.to_str().unwrap();
+    let msg = fail(&["online", "--model", m, "--input", "tcp://localhost"]);
+    assert!(msg.contains("tcp://HOST:PORT"), "{msg}");
+    let msg = fail(&["online", "--model", m, "--input", e]);
+    assert!(msg.contains("--sensor"), "{msg}");
+    let msg = fail(&[
+        "online",
+        "--model",
+        m,
+        "--input",
+        e,
+        "--sensor",
+        "640x480",
+        "--interval-ms",
+        "0",
+    ]);
+    assert!(msg.contains("--interval-ms"), "{msg}");
+    let msg = fail(&[
+        "online",
+        "--model",
+        dir.path().to_str().unwrap(),
+        "--input",
+        e,
+    ]);
+    assert!(
+        msg.contains("model.safetensors") || msg.contains("model bundle"),
+        "{msg}"
+    );
+    // Nothing listens on the port: bounded retries, then a message naming the input.
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let input = format!("tcp://127.0.0.1:{port}");
+    let msg = fail(&[
+        "online",
+        "--model",
+        m,
+        "--input",
+        &input,
+        "--reconnect-attempts",
+        "1",
+        "--reconnect-initial-ms",
+        "10",
+    ]);
+    assert!(msg.contains(&input) && msg.contains("attempt"), "{msg}");
+}
