@@ -1,1 +1,90 @@
-//! Tests of `evtac labels`.
+//! Tests of `evtac labels`: a simulated Experiment 2 dataset labelled end to end, and the errors
+//! that name the broken trial.
+
+use std::path::Path;
+
+use evtac_events::manifest::Manifest;
+
+use crate::common::{evtac, run_ok};
+
+/// Simulates two Experiment 2 trials (each with a stop) into `out`.
+fn simulate(out: &Path) {
+    run_ok(&[
+        "simulate",
+        "--protocol",
+        "exp2",
+        "--scale",
+        "tiny",
+        "--seed",
+        "11",
+        "--out",
+        out.to_str().unwrap(),
+        "--jobs",
+        "2",
+        "--limit",
+        "2",
+    ]);
+}
+
+#[test]
+fn labels_a_simulated_dataset() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("ds");
+    simulate(&ds);
+    let ds_s = ds.to_str().unwrap();
+
+    let out = run_ok(&["labels", ds_s]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("labelled 2 trials"), "{text}");
+    assert!(text.contains("stop check"), "{text}");
+    assert!(text.contains("labels vs ground truth"), "{text}");
+
+    let out = run_ok(&["labels", ds_s, "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let trials = json["trials"].as_array().unwrap();
+    assert_eq!(trials.len(), 2);
+    for t in trials {
+        let name = t["trial"].as_str().unwrap();
+        let rms = t["truth"]["rms_deg"].as_f64().unwrap();
+        assert!(
+            rms <= 0.05,
+            "{name}: RMS {rms} deg against the simulator's truth"
+        );
+        let stop = t["stop"]["error_deg"].as_f64().unwrap();
+        assert!(stop.abs() <= 0.05, "{name}: stop error {stop} deg");
+        let csv = std::fs::read_to_string(ds.join("labels").join(format!("{name}.csv"))).unwrap();
+        assert!(csv.starts_with("t_us,theta_deg,pitch_deg,roll_deg\n"));
+    }
+    let stop = &json["stop_error_deg"];
+    assert_eq!(stop["n"], 2);
+    assert!(stop["mean"].as_f64().unwrap().abs() <= 0.02, "{stop}");
+}
+
+#[test]
+fn errors_name_the_trial_and_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("ds");
+    simulate(&ds);
+    // Move the second trial's onset to the very start: no stationary segment is left.
+    let mut manifest = Manifest::read(&ds).unwrap();
+    manifest.trials[1].motion_start_us = 30_000;
+    manifest.write(&ds).unwrap();
+    let out = evtac()
+        .args(["labels", ds.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("trial `t0001`: no stationary segment before motion onset"),
+        "{err}"
+    );
+
+    let out = evtac()
+        .args(["labels", dir.path().join("nowhere").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("trials.csv"), "{err}");
+}

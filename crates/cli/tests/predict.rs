@@ -41,7 +41,7 @@ h = np.load(sys.argv[2]).astype(np.float64)
 for i in range(4):
     h = h @ w[f"layers.{i}.weight"].astype(np.float64).T + w[f"layers.{i}.bias"]
     h = np.maximum(h, 0.0) if i < 3 else h
-print(" ".join(repr(v) for v in h.ravel()))
+print(" ".join(repr(float(v)) for v in h.ravel()))
 "#;
 
 #[test]
@@ -95,7 +95,8 @@ fn rejects_wrong_dtype_and_shape_clearly() {
     let dir = tempfile::tempdir().expect("tmp");
     let model = dir.path().join("model");
     write_bundle(&model);
-    let cases: [(&str, Box<dyn Fn(&std::path::Path)>, &str); 2] = [
+    type WriteInput = Box<dyn Fn(&std::path::Path)>;
+    let cases: [(&str, WriteInput, &str); 2] = [
         (
             "f64.npy",
             Box::new(|p| ndarray_npy::write_npy(p, &features(2).mapv(f64::from)).expect("write")),

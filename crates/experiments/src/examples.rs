@@ -86,11 +86,11 @@ fn closest(values: impl Iterator<Item = f64>, target: f64) -> Option<f64> {
 }
 
 /// A pair of trials differing only in one condition, in the same direction.
-fn pair<'a>(
-    trials: &'a [TrialMeta],
+fn pair(
+    trials: &[TrialMeta],
     fixed: impl Fn(&TrialMeta) -> bool,
     varied: impl Fn(&TrialMeta) -> f64,
-) -> Option<(&'a TrialMeta, &'a TrialMeta)> {
+) -> Option<(&TrialMeta, &TrialMeta)> {
     let pool: Vec<&TrialMeta> = trials
         .iter()
         .filter(|t| fixed(t) && t.stop_start_us.is_none())

@@ -70,10 +70,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     std::fs::rename(&tmp, path)
 }
 
-/// A sibling temporary path for `path` (same folder, so a rename is atomic).
+/// A sibling temporary path for `path` (same folder, so a rename is atomic), unique to this call:
+/// parallel jobs may write the same cache file at once (e.g. two seeds needing the same
+/// features), and each must rename its own complete copy rather than race on one shared name.
 pub fn tmp_path(path: &Path) -> PathBuf {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".tmp{}", std::process::id()));
+    name.push(format!(".tmp{}-{n}", std::process::id()));
     path.with_file_name(name)
 }
 

@@ -7,9 +7,12 @@ use crate::results::{Exp3Point, MaeStats, Results};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// A mean and a standard deviation, in degrees.
+pub type MeanStd = (f64, f64);
+
 /// The paper's Table (Experiment 1, test MAE in degrees, mean ± std over ten runs):
-/// (name, overall, pitch, roll) as (mean, std).
-pub const PAPER_TABLE: [(&str, (f64, f64), (f64, f64), (f64, f64)); 3] = [
+/// (name, overall, pitch, roll).
+pub const PAPER_TABLE: [(&str, MeanStd, MeanStd, MeanStd); 3] = [
     ("Static", (0.160, 0.004), (0.158, 0.005), (0.163, 0.008)),
     ("Dynamic", (0.186, 0.007), (0.183, 0.007), (0.189, 0.010)),
     ("Combined", (0.173, 0.006), (0.169, 0.008), (0.177, 0.006)),
