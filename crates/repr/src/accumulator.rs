@@ -112,27 +112,7 @@ impl StaticAccumulator {
     /// Adds events (coordinates inside the frame, times non-decreasing and not before earlier
     /// events). On error nothing of the slice is applied.
     pub fn accumulate(&mut self, events: &[Event]) -> Result<(), ReprError> {
-        let mut previous = self.highest_time;
-        for (index, e) in events.iter().enumerate() {
-            if !self.resolution.contains(e.x, e.y) {
-                return Err(ReprError::EventOutOfFrame {
-                    index,
-                    t: e.t,
-                    x: e.x,
-                    y: e.y,
-                    width: self.resolution.width,
-                    height: self.resolution.height,
-                });
-            }
-            if e.t < previous {
-                return Err(ReprError::EventOutOfOrder {
-                    index,
-                    t: e.t,
-                    previous,
-                });
-            }
-            previous = e.t;
-        }
+        crate::check::check_events(events, Some(self.resolution), Some(self.highest_time))?;
         let width = usize::from(self.resolution.width);
         for e in events {
             self.update(usize::from(e.y) * width + usize::from(e.x), e.t, e.polarity);

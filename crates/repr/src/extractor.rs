@@ -307,30 +307,8 @@ impl FeatureExtractor {
     /// Queues events in crop coordinates, in time order (also after earlier pushes). The whole
     /// chunk is checked first: on error nothing is queued.
     pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
-        let mut previous = self.last_pushed;
-        for (index, e) in events.iter().enumerate() {
-            if !self.resolution.contains(e.x, e.y) {
-                return Err(ReprError::EventOutOfFrame {
-                    index,
-                    t: e.t,
-                    x: e.x,
-                    y: e.y,
-                    width: self.resolution.width,
-                    height: self.resolution.height,
-                });
-            }
-            if let Some(p) = previous
-                && e.t < p
-            {
-                return Err(ReprError::EventOutOfOrder {
-                    index,
-                    t: e.t,
-                    previous: p,
-                });
-            }
-            previous = Some(e.t);
-        }
-        self.last_pushed = previous;
+        self.last_pushed =
+            crate::check::check_events(events, Some(self.resolution), self.last_pushed)?;
         self.pending.extend(events);
         Ok(())
     }
@@ -346,20 +324,7 @@ impl FeatureExtractor {
                 height: self.resolution.height,
             });
         }
-        let mut previous = self.last_pushed;
-        for (index, e) in events.iter().enumerate() {
-            if let Some(p) = previous
-                && e.t < p
-            {
-                return Err(ReprError::EventOutOfOrder {
-                    index,
-                    t: e.t,
-                    previous: p,
-                });
-            }
-            previous = Some(e.t);
-        }
-        self.last_pushed = previous;
+        self.last_pushed = crate::check::check_events(events, None, self.last_pushed)?;
         self.pending
             .extend(events.iter().filter_map(|&e| roi.map(e)));
         Ok(())

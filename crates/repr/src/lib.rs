@@ -45,6 +45,7 @@
 //! ```
 
 pub mod accumulator;
+mod check;
 pub mod combine;
 pub mod config;
 mod error;
