@@ -177,3 +177,54 @@ fn bad_inputs_fail_with_clear_messages() {
     ]);
     assert!(msg.contains(&input) && msg.contains("attempt"), "{msg}");
 }
+
+#[test]
+fn ctrl_c_ends_a_live_run_with_its_summary() {
+    use std::io::{BufRead, BufReader};
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let mut child = evtac()
+        .args(["online", "--model", model.to_str().unwrap(), "--input", "-"])
+        .args(["--sensor", "640x480"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Events go in, and standard input stays open: a live producer that has gone quiet.
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(csv_events().as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    let mut estimates = 0;
+    while estimates < 10 {
+        line.clear();
+        assert!(
+            stdout.read_line(&mut line).unwrap() > 0,
+            "stdout ended early"
+        );
+        if line.starts_with(|c: char| c.is_ascii_digit()) {
+            estimates += 1;
+        }
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stdout, &mut rest).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(stderr.contains("stopping"), "{stderr}");
+    // The summary counts every estimate written.
+    let total = estimates + rest.lines().count();
+    assert!(
+        stderr.contains(&format!("estimates: {total} every 1000 us")),
+        "{total}: {stderr}"
+    );
+    drop(stdin);
+}

@@ -9,8 +9,9 @@
 //!
 //! MXCSR is per thread: call [`flush_denormals`] at the start of every thread that trains or
 //! infers. [`crate::train`] and [`crate::Predictor::new`] call it themselves for the calling
-//! thread, and training also sets it on every thread of rayon's global pool (burn's flex backend
-//! runs its large matrix products there when its `rayon` feature is on).
+//! thread, and training also sets it on every thread of rayon's global pool (where the
+//! experiments run their training jobs, and where burn's flex backend would run its matrix
+//! products if its `rayon` feature were on).
 
 /// MXCSR bit 15: flush-to-zero (subnormal results become zero).
 #[cfg(target_arch = "x86_64")]

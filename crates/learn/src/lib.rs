@@ -13,8 +13,10 @@
 //! - [`metrics`]: MAE overall / pitch / roll.
 //! - [`ftz`]: [`flush_denormals`], to call on every thread that trains or infers.
 //!
-//! Training runs on burn's flex CPU backend with its SIMD kernels and rayon-parallel matrix
-//! products.
+//! Training runs on burn's flex CPU backend with its SIMD kernels, one thread per training run
+//! (parallelism comes from running several runs side by side). A binary that trains should use
+//! mimalloc, as `evtac` does: with glibc's malloc each step's megabyte tensors are returned to
+//! the kernel and faulted back in, which made steps 2.5x slower here.
 //!
 //! ```no_run
 //! use evtac_learn::{FeatureSet, ModelBundle, TrainConfig, train};

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::adamw::{AdamW, AdamWConfig};
 use crate::data::{FeatureSet, Shuffler};
 use crate::metrics::{self, Mae};
-use crate::model::{self, INPUTS, Mlp, OUTPUTS, Parameters};
+use crate::model::{self, INPUTS, LAYER_SIZES, Mlp, OUTPUTS, Parameters, transpose};
 
 /// Samples per forward pass when predicting for validation (bounds the activation memory).
 const EVAL_CHUNK: usize = 4096;
@@ -265,12 +265,17 @@ pub fn train(
 }
 
 /// A model being trained: burn parameters on the flex CPU backend plus the AdamW state.
+///
+/// The weights live twice: as burn parameters for the forward and backward passes, and as host
+/// vectors that AdamW updates in place and uploads after each step.
 #[derive(Debug)]
 pub struct Trainer {
     mlp: Mlp,
     optimizer: AdamW,
     loss: HuberLoss,
     device: Device,
+    /// Per layer: weight (burn's `[in, out]` layout) and bias, as updated by AdamW.
+    values: Vec<[Vec<f32>; 2]>,
 }
 
 impl Trainer {
@@ -282,8 +287,16 @@ impl Trainer {
         crate::ftz::flush_denormals();
         crate::ftz::flush_denormals_in_rayon_pool();
         let device = Device::flex().autodiff();
+        let mlp = Mlp::from_parameters(params, &device)?;
+        let values = params
+            .layers
+            .iter()
+            .zip(LAYER_SIZES.windows(2))
+            .map(|(p, w)| [transpose(&p.weight, w[1], w[0]), p.bias.clone()])
+            .collect();
         Ok(Self {
-            mlp: Mlp::from_parameters(params, &device)?,
+            mlp,
+            values,
             optimizer: AdamW::new(cfg.optimizer),
             // SmoothL1 with threshold beta equals Huber with delta beta divided by beta; for the
             // paper's beta = 1 they coincide. Other betas are rescaled in `step`.
@@ -328,18 +341,33 @@ impl Trainer {
             .copied()
             .unwrap_or(f32::NAN);
         let s = self.optimizer.begin_step();
-        for (i, linear) in self.mlp.layers.iter_mut().enumerate() {
-            let w = linear.weight.val();
-            if let Some(g) = w.grad(&grads) {
-                let new = self.optimizer.update_matrix(&s, i, w.inner(), g);
-                linear.weight = Param::from_tensor(new.autodiff());
+        for (i, (linear, [weight, bias])) in
+            self.mlp.layers.iter_mut().zip(&mut self.values).enumerate()
+        {
+            let shape = [LAYER_SIZES[i], LAYER_SIZES[i + 1]];
+            if let Some(g) = linear.weight.val().grad(&grads) {
+                let g = g.into_data();
+                let g = g
+                    .as_slice::<f32>()
+                    .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
+                self.optimizer.update(&s, 2 * i, weight, g);
+                linear.weight = Param::from_tensor(Tensor::from_data(
+                    TensorData::new(weight.clone(), shape),
+                    &self.device,
+                ));
             }
-            if let Some(bias) = linear.bias.as_mut() {
-                let b = bias.val();
-                if let Some(g) = b.grad(&grads) {
-                    let new = self.optimizer.update_vector(&s, i, b.inner(), g);
-                    *bias = Param::from_tensor(new.autodiff());
-                }
+            if let Some(param) = linear.bias.as_mut()
+                && let Some(g) = param.val().grad(&grads)
+            {
+                let g = g.into_data();
+                let g = g
+                    .as_slice::<f32>()
+                    .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
+                self.optimizer.update(&s, 2 * i + 1, bias, g);
+                *param = Param::from_tensor(Tensor::from_data(
+                    TensorData::new(bias.clone(), [shape[1]]),
+                    &self.device,
+                ));
             }
         }
         Ok(value)

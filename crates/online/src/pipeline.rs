@@ -16,9 +16,11 @@ use crate::estimator::{Error as EstimatorError, Estimate, Estimator};
 use crate::input::{EventSource, InputError};
 use crate::latency::Summary;
 use crate::notice::Notice;
-use crossbeam_channel::{Receiver, Sender, TrySendError, bounded};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError, bounded};
 use evtac_events::Event;
 use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 /// Settings of the pipeline.
@@ -90,11 +92,11 @@ enum Msg {
     End(Instant),
 }
 
-/// Counts kept by the ingestion thread.
+/// Counts kept by the ingestion thread, shared so that a stop can read them without joining it.
 #[derive(Debug, Default)]
 struct Ingested {
-    dropped: u64,
-    first_arrival: Option<Instant>,
+    dropped: AtomicU64,
+    first_arrival: OnceLock<Instant>,
 }
 
 /// Shortest time between two "dropped" notices, so that a slow consumer is told without being
@@ -108,10 +110,35 @@ const OUTPUT_QUEUE: usize = 4096;
 /// returns [`ControlFlow::Break`], or the input fails; returns the run's summary.
 ///
 /// `on_output` runs on the calling thread and receives every estimate and notice in order.
-pub fn run<S: EventSource>(
+pub fn run<S: EventSource + 'static>(
     source: S,
     estimator: Estimator,
     config: &PipelineConfig,
+    on_output: impl FnMut(Output) -> ControlFlow<()>,
+) -> Result<Summary, Error> {
+    run_until(
+        source,
+        estimator,
+        config,
+        &AtomicBool::new(false),
+        on_output,
+    )
+}
+
+/// How often the threads look at the stop flag while they wait for data.
+const STOP_POLL: Duration = Duration::from_millis(20);
+
+/// As [`run`], and also stops soon after `stop` becomes true (for example from a Ctrl-C
+/// handler), still returning the summary of everything estimated so far.
+///
+/// A source may block in a read that nothing can interrupt (standard input with no data); the
+/// ingestion thread is then left behind, detached, and ends with the process, so that stopping
+/// never waits on the input.
+pub fn run_until<S: EventSource + 'static>(
+    source: S,
+    estimator: Estimator,
+    config: &PipelineConfig,
+    stop: &AtomicBool,
     mut on_output: impl FnMut(Output) -> ControlFlow<()>,
 ) -> Result<Summary, Error> {
     let capacity = config.queue_chunks.max(1);
@@ -126,22 +153,44 @@ pub fn run<S: EventSource>(
     let (out_tx, out_rx) = bounded::<Output>(OUTPUT_QUEUE);
     let drop_when_behind = config.drop_when_behind;
     let started = Instant::now();
+    let ingested = Arc::new(Ingested::default());
+    // Not scoped: a stop must not wait for a read that may never return (see above).
+    let ingest = std::thread::Builder::new()
+        .name("evtac-ingest".into())
+        .spawn({
+            let ingested = Arc::clone(&ingested);
+            move || ingest(source, msg_tx, pool_rx, drop_when_behind, &ingested)
+        })
+        .map_err(|_| Error::Panicked {
+            thread: "ingestion",
+        })?;
 
-    let (ingested, estimator, connections) = std::thread::scope(|scope| {
-        let ingest = std::thread::Builder::new()
-            .name("evtac-ingest".into())
-            .spawn_scoped(scope, move || {
-                ingest(source, msg_tx, pool_rx, drop_when_behind)
-            });
+    // Set when the caller is done before the stream is: tells the estimation thread to end
+    // even while no chunk arrives.
+    let quit = AtomicBool::new(false);
+    let (estimator, connections) = std::thread::scope(|scope| {
+        let quit = &quit;
         let estimate = std::thread::Builder::new()
             .name("evtac-estimate".into())
-            .spawn_scoped(scope, move || estimate(estimator, msg_rx, pool_tx, out_tx));
+            .spawn_scoped(scope, move || {
+                estimate(estimator, msg_rx, pool_tx, out_tx, [stop, quit])
+            });
         let mut connections = 0u32;
-        for output in &out_rx {
+        loop {
+            if stop.load(Ordering::Relaxed) {
+                quit.store(true, Ordering::Relaxed);
+                break;
+            }
+            let output = match out_rx.recv_timeout(STOP_POLL) {
+                Ok(output) => output,
+                Err(RecvTimeoutError::Timeout) => continue,
+                Err(RecvTimeoutError::Disconnected) => break,
+            };
             if let Output::Notice(Notice::Connected { .. }) = &output {
                 connections += 1;
             }
             if on_output(output).is_break() {
+                quit.store(true, Ordering::Relaxed);
                 break;
             }
         }
@@ -154,21 +203,25 @@ pub fn run<S: EventSource>(
             .ok_or(Error::Panicked {
                 thread: "estimation",
             });
-        let ingested = ingest
-            .ok()
-            .and_then(|h| h.join().ok())
-            .ok_or(Error::Panicked {
-                thread: "ingestion",
-            });
-        (ingested, estimator, connections)
+        (estimator, connections)
     });
     let (estimator, estimator_failure) = estimator?;
-    let (ingested, failure) = ingested?;
+    // The ingestion thread has ended or is about to (its queue is closed) unless it is blocked
+    // in a read; only a caller that quit early leaves it behind.
+    let ended_early = quit.load(Ordering::Relaxed) || stop.load(Ordering::Relaxed);
+    let failure = if ended_early && !ingest.is_finished() {
+        None
+    } else {
+        ingest.join().map_err(|_| Error::Panicked {
+            thread: "ingestion",
+        })?
+    };
     let counters = estimator.counters();
+    let dropped = ingested.dropped.load(Ordering::Relaxed);
     let mut summary = Summary::from_stats(estimator.stats());
-    summary.events = counters.events + ingested.dropped;
+    summary.events = counters.events + dropped;
     summary.events_in_roi = counters.events_in_roi;
-    summary.events_dropped = ingested.dropped;
+    summary.events_dropped = dropped;
     summary.events_out_of_order = counters.events_out_of_order;
     // Sources connect before the run starts (see `input::open`): every connection during the
     // run is a reconnection.
@@ -176,6 +229,7 @@ pub fn run<S: EventSource>(
     summary.span_us = counters.span_us;
     summary.wall = ingested
         .first_arrival
+        .get()
         .map_or_else(|| started.elapsed(), |t| t.elapsed());
     if let Some(source) = estimator_failure {
         return Err(Error::Estimator {
@@ -198,8 +252,8 @@ fn ingest<S: EventSource>(
     tx: Sender<Msg>,
     pool: Receiver<Vec<Event>>,
     drop_when_behind: bool,
-) -> (Ingested, Option<InputError>) {
-    let mut ingested = Ingested::default();
+    ingested: &Ingested,
+) -> Option<InputError> {
     let mut last_drop_notice: Option<Instant> = None;
     let mut dropped_since_notice = 0usize;
     // The buffer of a dropped chunk, kept for the next one.
@@ -219,11 +273,11 @@ fn ingest<S: EventSource>(
             Ok(None) => break,
             Err(e) => {
                 let _ = tx.send(Msg::End(Instant::now()));
-                return (ingested, Some(e));
+                return Some(e);
             }
         };
         let arrival = Instant::now();
-        ingested.first_arrival.get_or_insert(arrival);
+        let _ = ingested.first_arrival.set(arrival);
         let msg = Msg::Chunk {
             events,
             horizon: info.horizon,
@@ -233,7 +287,9 @@ fn ingest<S: EventSource>(
             match tx.try_send(msg) {
                 Ok(()) => {}
                 Err(TrySendError::Full(Msg::Chunk { events, .. })) => {
-                    ingested.dropped += events.len() as u64;
+                    ingested
+                        .dropped
+                        .fetch_add(events.len() as u64, Ordering::Relaxed);
                     dropped_since_notice += events.len();
                     spare = Some(events);
                     if last_drop_notice.is_none_or(|t| t.elapsed() >= DROP_NOTICE_EVERY) {
@@ -243,14 +299,14 @@ fn ingest<S: EventSource>(
                         }));
                     }
                 }
-                Err(_) => return (ingested, None),
+                Err(_) => return None,
             }
         } else if tx.send(msg).is_err() {
-            return (ingested, None);
+            return None;
         }
     }
     let _ = tx.send(Msg::End(Instant::now()));
-    (ingested, None)
+    None
 }
 
 /// The estimation thread: turns queued chunks into estimates.
@@ -259,6 +315,7 @@ fn estimate(
     rx: Receiver<Msg>,
     pool: Sender<Vec<Event>>,
     out: Sender<Output>,
+    stop: [&AtomicBool; 2],
 ) -> (Estimator, Option<EstimatorError>) {
     evtac_learn::flush_denormals();
     let mut failure = None;
@@ -269,7 +326,12 @@ fn estimate(
             stopped.set(true);
         }
     };
-    for msg in &rx {
+    while !stop.iter().any(|s| s.load(Ordering::Relaxed)) {
+        let msg = match rx.recv_timeout(STOP_POLL) {
+            Ok(msg) => msg,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => break,
+        };
         match msg {
             Msg::Chunk {
                 events,

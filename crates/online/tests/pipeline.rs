@@ -1,16 +1,19 @@
 //! The pipeline's behaviour around its input: reconnection after a drop, a stalled stream,
-//! dropping when asked, stopping early. A small DV network server on loopback (the bytes of an
+//! dropping when asked, stopping early (also while the input blocks). A small DV network server on loopback (the bytes of an
 //! AEDAT4 file without its magic and data table: DV's network framing) stands in for a camera.
 
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_events::Event;
 use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
-use evtac_online::input::{self, MemorySource, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::input::{
+    self, EventSource, MemorySource, NetworkOptions, OpenOptions, SourceSpec,
+};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::{Backoff, Estimate, Model, Notice};
 use std::io::Write;
 use std::net::TcpListener;
 use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// A DV network stream of `events`: the stream header, then one byte range per packet.
@@ -307,4 +310,85 @@ fn out_of_order_events_are_skipped_and_counted() {
     assert_eq!(summary.events_out_of_order, 100);
     // One estimate per millisecond of the first 20 ms, whatever came after.
     assert!((19..=20).contains(&summary.estimates), "{summary}");
+}
+
+/// Delivers `events` in chunks, then blocks for good, as standard input does when its producer
+/// goes quiet.
+struct ThenSilence {
+    inner: MemorySource,
+}
+
+impl EventSource for ThenSilence {
+    fn next_chunk(
+        &mut self,
+        out: &mut Vec<Event>,
+        notify: &mut dyn FnMut(Notice),
+    ) -> Result<Option<input::ChunkInfo>, input::InputError> {
+        match self.inner.next_chunk(out, notify)? {
+            Some(info) => Ok(Some(info)),
+            None => loop {
+                std::thread::park();
+            },
+        }
+    }
+}
+
+#[test]
+fn a_stop_ends_the_run_with_its_summary_while_the_input_blocks() {
+    let events: Vec<Event> = Synthetic::new(5, 100_000.0, 1000, 30_000).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let silent = || ThenSilence {
+        inner: MemorySource::new(events.clone(), 1000),
+    };
+
+    // A stop flag raised from another thread (as the Ctrl-C handler does) once the stream has
+    // gone quiet.
+    let stop = AtomicBool::new(false);
+    let mut seen = 0u64;
+    let summary = std::thread::scope(|scope| {
+        let run = scope.spawn(|| {
+            pipeline::run_until(
+                silent(),
+                model.estimator(SENSOR, 1000).unwrap(),
+                &PipelineConfig::default(),
+                &stop,
+                |out| {
+                    if matches!(out, Output::Estimate(_)) {
+                        seen += 1;
+                    }
+                    ControlFlow::Continue(())
+                },
+            )
+        });
+        std::thread::sleep(Duration::from_millis(300));
+        stop.store(true, Ordering::Relaxed);
+        run.join().unwrap().unwrap()
+    });
+    // Every estimate the events allow (the last interval or two need a later event to close
+    // them, which never comes).
+    assert!((27..=30).contains(&seen), "{seen}");
+    assert_eq!(summary.estimates, seen);
+    assert_eq!(summary.events, events.len() as u64);
+
+    // A caller that breaks off while the input blocks is not held up either.
+    let mut seen = 0u64;
+    let summary = pipeline::run(
+        silent(),
+        model.estimator(SENSOR, 1000).unwrap(),
+        &PipelineConfig::default(),
+        |out| {
+            if matches!(out, Output::Estimate(_)) {
+                seen += 1;
+            }
+            if seen == 20 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    )
+    .unwrap();
+    assert_eq!(seen, 20);
+    assert!(summary.estimates >= 20);
 }

@@ -54,7 +54,7 @@ fn offline(model: &Model, events: &[Event], times: &[i64]) -> Vec<[f32; 2]> {
         .collect()
 }
 
-fn run_online(model: &Model, source: impl input::EventSource) -> Vec<Estimate> {
+fn run_online(model: &Model, source: impl input::EventSource + 'static) -> Vec<Estimate> {
     let estimator = model.estimator(SENSOR, 1000).unwrap();
     let mut estimates = Vec::new();
     let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |out| {

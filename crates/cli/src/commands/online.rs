@@ -9,6 +9,8 @@ use evtac_online::{Backoff, Model};
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Arguments of `evtac online`.
@@ -68,6 +70,22 @@ fn seconds(what: &str, s: f64) -> anyhow::Result<Duration> {
         .with_context(|| format!("{what} must be a positive number of seconds (got {s})"))
 }
 
+/// A flag that the first Ctrl-C (or SIGTERM) sets, so that the run ends with its summary; a
+/// second one ends the process at once.
+fn stop_on_interrupt() -> anyhow::Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            // 128 + SIGINT, as a shell reports a process ended by Ctrl-C.
+            std::process::exit(130);
+        }
+        eprintln!("evtac online: stopping (press Ctrl-C again to quit at once)");
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(stop)
+}
+
 /// Runs `evtac online`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let interval_us = (args.interval_ms * 1000.0).round();
@@ -116,15 +134,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
     };
     writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
+    let stop = stop_on_interrupt()?;
     let started = Instant::now();
     let mut write_error = None;
-    let result = pipeline::run(
+    let result = pipeline::run_until(
         opened.source,
         estimator,
         &PipelineConfig {
             queue_chunks: args.queue_chunks,
             drop_when_behind: args.drop_when_behind,
         },
+        &stop,
         |output| {
             match output {
                 Output::Estimate(e) => {
