@@ -5,7 +5,7 @@ use std::io::{self, BufRead, BufReader, Read};
 use std::path::Path;
 
 use evtac_events::aedat::{
-    AedatChunk, AedatError, AedatReader, AedatWriter, Compression, StreamKind, WriterConfig,
+    AedatChunk, AedatError, AedatReader, AedatWriter, Compression, MAGIC, StreamKind, WriterConfig,
 };
 use evtac_events::{Event, ImuSample, Resolution, Trigger};
 use proptest::prelude::*;
@@ -527,6 +527,25 @@ fn empty_and_wrong_magic_are_errors() {
         Err(AedatError::TruncatedHeader { offset: 10, .. })
     ));
     assert!(AedatReader::network(&b""[..]).is_err());
+}
+
+/// Flatbuffers shorter than a size prefix, root offset and identifier: errors, not the panic
+/// inside flatbuffers' identifier check that the `aedat` fuzz target found.
+#[test]
+fn flatbuffers_too_short_for_an_identifier_are_errors() {
+    // The fuzzer's input: a network stream whose IOHeader has a zero size prefix.
+    assert!(AedatReader::network(&[0u8, 0, 0, 0][..]).is_err());
+    let mut file = MAGIC.to_vec();
+    file.extend_from_slice(&[0, 0, 0, 0]);
+    assert!(AedatReader::from_slice(&file).is_err());
+    // An uncompressed packet whose flatbuffer declares zero bytes.
+    let mut bytes = small_file(Compression::None);
+    let whole = decode(AedatReader::from_slice(&bytes).unwrap()).unwrap();
+    let (_, off) = whole.packets[1];
+    let payload = off as usize + 8;
+    bytes[payload..payload + 4].copy_from_slice(&0u32.to_le_bytes());
+    let err = decode(AedatReader::from_slice(&bytes).unwrap()).unwrap_err();
+    assert!(err.to_string().contains("identifier"), "{err}");
 }
 
 #[test]

@@ -14,6 +14,11 @@ use std::sync::OnceLock;
 /// The embedded font (DejaVu Sans, Bitstream Vera license).
 static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 /// The font family name figures use.
+///
+/// Every text size in this file is even: plotters 0.3.7's ab_glyph renderer places each glyph
+/// at `(size / 2 + top) as i32`, which truncates toward zero, so at odd sizes glyphs above and
+/// below that line round in opposite directions and a decimal point sits a pixel above the
+/// digits' baseline.
 const FAMILY: &str = "sans-serif";
 
 /// Colors of the three representations, used in every figure.
@@ -72,6 +77,17 @@ fn repr_color(name: &str) -> RGBColor {
         "Static" => REPR_COLORS[0],
         "Dynamic" => REPR_COLORS[1],
         _ => REPR_COLORS[2],
+    }
+}
+
+/// A tick label: at most three decimals, without trailing zeros (`5.5`, `100`, `0.25`).
+fn tick(v: &f64) -> String {
+    let text = format!("{v:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
     }
 }
 
@@ -195,9 +211,10 @@ pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
             .configure_mesh()
             .x_desc(&c.x_desc)
             .y_desc("validation MAE (deg)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .y_label_formatter(&|v| format!("{v:.3}"))
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
             .draw()
             .map_err(&e)?;
         chart
@@ -272,9 +289,9 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
                 }
             })
             .y_desc("test MAE (deg)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .y_label_formatter(&|v| format!("{v:.2}"))
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
+            .y_label_formatter(&tick)
             .draw()
             .map_err(&e)?;
         for (si, (key, label)) in settings.iter().enumerate() {
@@ -316,7 +333,7 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 15))
+            .label_font((FAMILY, 16))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -359,8 +376,10 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
             .configure_mesh()
             .x_desc("time from motion onset (s)")
             .y_desc(format!("{} (deg)", what.to_lowercase()))
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
             .draw()
             .map_err(&e)?;
         if let Some((a, b)) = ex.stop_s {
@@ -408,7 +427,7 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FAMILY, 15))
+            .label_font((FAMILY, 16))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -488,7 +507,7 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
                 .draw(&Rectangle::new([(30, y - 8), (48, y + 8)], BLACK))
                 .map_err(&e)?;
             legend_area
-                .draw(&Text::new(label.to_string(), (58, y - 9), (FAMILY, 17)))
+                .draw(&Text::new(label.to_string(), (58, y - 9), (FAMILY, 18)))
                 .map_err(&e)?;
         }
     }
@@ -540,9 +559,9 @@ pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Res
             .configure_mesh()
             .x_desc(desc)
             .y_desc("test MAE (deg)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .y_label_formatter(&|v| format!("{v:.3}"))
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
+            .y_label_formatter(&tick)
             .draw()
             .map_err(&e)?;
         for name in ["Static", "Dynamic", "Combined"] {
@@ -594,7 +613,7 @@ pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Res
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 15))
+            .label_font((FAMILY, 16))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -664,8 +683,9 @@ pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
             })
             .x_desc("sampling interval")
             .y_desc("end-to-end time (us)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
+            .y_label_formatter(&tick)
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
             .draw()
             .map_err(&e)?;
         chart

@@ -172,7 +172,7 @@ impl AedatHeader {
             offset,
             reason,
         };
-        if !flatbuffers::buffer_has_identifier(buf, schema::IO_HEADER_IDENTIFIER, true) {
+        if !super::has_identifier(buf, schema::IO_HEADER_IDENTIFIER) {
             return Err(bad("missing file identifier \"IOHE\"".into()));
         }
         let root = schema::size_prefixed_root_as_io_header(buf).map_err(|e| bad(e.to_string()))?;

@@ -50,6 +50,16 @@ pub use header::{AedatHeader, Compression, MAGIC, StreamInfo, StreamKind, parse_
 pub use reader::{AedatChunk, AedatReader, Events};
 pub use writer::{AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, WriterConfig};
 
+/// Whether the size-prefixed flatbuffer `buf` carries `identifier`. flatbuffers'
+/// `buffer_has_identifier` asserts (panics) on a buffer too short to hold a prefix, a root
+/// offset and an identifier, so the length is checked here first (found by the `aedat` fuzz
+/// target).
+pub(crate) fn has_identifier(buf: &[u8], identifier: &str) -> bool {
+    const PREFIX_ROOT_AND_IDENTIFIER: usize = 4 + 4 + 4;
+    buf.len() >= PREFIX_ROOT_AND_IDENTIFIER
+        && flatbuffers::buffer_has_identifier(buf, identifier, true)
+}
+
 /// Decodes `data` completely, as a file and as a network stream, discarding the results: the
 /// entry point of the `aedat` cargo-fuzz target. It must never panic, whatever the bytes.
 #[doc(hidden)]

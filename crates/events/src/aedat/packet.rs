@@ -60,7 +60,7 @@ fn checked<'a, T>(
             payload.len() - 4
         )));
     };
-    if !flatbuffers::buffer_has_identifier(body, identifier, true) {
+    if !super::has_identifier(body, identifier) {
         return Err(bad(format!("missing file identifier {identifier:?}")));
     }
     root(body).map_err(|e| bad(e.to_string()))
