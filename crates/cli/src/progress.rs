@@ -1,6 +1,6 @@
 //! Progress bars on stderr, shown only when stderr is a terminal (so logs and CI stay clean).
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 
 /// A progress bar over `len` units of `unit` (e.g. "bytes", "trials"), hidden when stderr is not
@@ -30,4 +30,13 @@ pub fn bytes(len: u64, message: &str) -> ProgressBar {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar
+}
+
+/// A group of bars drawn together on stderr, hidden when stderr is not a terminal.
+pub fn multi() -> MultiProgress {
+    if std::io::stderr().is_terminal() {
+        MultiProgress::new()
+    } else {
+        MultiProgress::with_draw_target(ProgressDrawTarget::hidden())
+    }
 }

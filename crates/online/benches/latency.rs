@@ -92,18 +92,23 @@ fn paced_pipeline(_c: &mut Criterion) {
         let dir = tempfile::tempdir().expect("a temporary folder");
         support::seeded_bundle(dir.path(), 1, &repr, None);
         let model = Model::load(dir.path()).expect("the bundle loads");
-        for (rate_name, rate) in RATES {
+        for ((rate_name, rate), busy_poll) in
+            RATES.into_iter().flat_map(|r| [(r, false), (r, true)])
+        {
             let events = support::Synthetic::new(2, rate, 1000, SPAN_US).collect();
             let source = Paced::new(MemorySource::new(events, 1 << 16), 1000);
             let estimator = model
                 .estimator(support::SENSOR, 1000)
                 .expect("the estimator builds");
-            let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |_| {
-                ControlFlow::Continue(())
-            })
-            .expect("the replay runs");
+            let config = PipelineConfig {
+                busy_poll,
+                ..PipelineConfig::default()
+            };
+            let summary = pipeline::run(source, estimator, &config, |_| ControlFlow::Continue(()))
+                .expect("the replay runs");
+            let mode = if busy_poll { "busy-poll" } else { "sleeping" };
             eprintln!(
-                "pipeline/{name}/{rate_name} (2 s at recorded pace): {} estimates, median {:.1} us, \
+                "pipeline/{name}/{rate_name}/{mode} (2 s at recorded pace): {} estimates, median {:.1} us, \
                  P99 {:.1} us, max {:.1} us, late {}, dropped {}",
                 summary.estimates,
                 us(summary.median),

@@ -16,7 +16,7 @@ use crate::estimator::{Error as EstimatorError, Estimate, Estimator};
 use crate::input::{EventSource, InputError};
 use crate::latency::Summary;
 use crate::notice::Notice;
-use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError, bounded};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TryRecvError, TrySendError, bounded};
 use evtac_events::Event;
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -30,14 +30,20 @@ pub struct PipelineConfig {
     pub queue_chunks: usize,
     /// Drop a chunk when the queue is full instead of waiting for the estimator.
     pub drop_when_behind: bool,
+    /// Let the estimation thread spin on the queue instead of sleeping until a chunk comes:
+    /// it then occupies a core all the time, and no chunk waits for the thread to be woken
+    /// (tens to hundreds of microseconds on a busy or virtualised machine).
+    pub busy_poll: bool,
 }
 
 impl Default for PipelineConfig {
-    /// 64 chunks (a DV stream sends a few hundred packets per second), never drop.
+    /// 64 chunks (a DV stream sends a few hundred packets per second), never drop, sleep while
+    /// idle.
     fn default() -> Self {
         Self {
             queue_chunks: 64,
             drop_when_behind: false,
+            busy_poll: false,
         }
     }
 }
@@ -152,6 +158,7 @@ pub fn run_until<S: EventSource + 'static>(
     }
     let (out_tx, out_rx) = bounded::<Output>(OUTPUT_QUEUE);
     let drop_when_behind = config.drop_when_behind;
+    let busy_poll = config.busy_poll;
     let started = Instant::now();
     let ingested = Arc::new(Ingested::default());
     // Not scoped: a stop must not wait for a read that may never return (see above).
@@ -173,7 +180,7 @@ pub fn run_until<S: EventSource + 'static>(
         let estimate = std::thread::Builder::new()
             .name("evtac-estimate".into())
             .spawn_scoped(scope, move || {
-                estimate(estimator, msg_rx, pool_tx, out_tx, [stop, quit])
+                estimate(estimator, msg_rx, pool_tx, out_tx, [stop, quit], busy_poll)
             });
         let mut connections = 0u32;
         loop {
@@ -316,6 +323,7 @@ fn estimate(
     pool: Sender<Vec<Event>>,
     out: Sender<Output>,
     stop: [&AtomicBool; 2],
+    busy_poll: bool,
 ) -> (Estimator, Option<EstimatorError>) {
     evtac_learn::flush_denormals();
     let mut failure = None;
@@ -327,10 +335,21 @@ fn estimate(
         }
     };
     while !stop.iter().any(|s| s.load(Ordering::Relaxed)) {
-        let msg = match rx.recv_timeout(STOP_POLL) {
-            Ok(msg) => msg,
-            Err(RecvTimeoutError::Timeout) => continue,
-            Err(RecvTimeoutError::Disconnected) => break,
+        let msg = if busy_poll {
+            match rx.try_recv() {
+                Ok(msg) => msg,
+                Err(TryRecvError::Empty) => {
+                    std::hint::spin_loop();
+                    continue;
+                }
+                Err(TryRecvError::Disconnected) => break,
+            }
+        } else {
+            match rx.recv_timeout(STOP_POLL) {
+                Ok(msg) => msg,
+                Err(RecvTimeoutError::Timeout) => continue,
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
         };
         match msg {
             Msg::Chunk {

@@ -266,6 +266,7 @@ fn stopping_early_and_dropping_when_behind() {
         let config = PipelineConfig {
             queue_chunks: 1,
             drop_when_behind,
+            ..PipelineConfig::default()
         };
         let mut notices = 0;
         let summary = pipeline::run(
@@ -391,4 +392,30 @@ fn a_stop_ends_the_run_with_its_summary_while_the_input_blocks() {
     .unwrap();
     assert_eq!(seen, 20);
     assert!(summary.estimates >= 20);
+}
+
+#[test]
+fn busy_polling_gives_the_same_estimates() {
+    let events: Vec<Event> = Synthetic::new(6, 300_000.0, 1000, 40_000).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let mut estimates = Vec::new();
+    let config = PipelineConfig {
+        busy_poll: true,
+        ..PipelineConfig::default()
+    };
+    let summary = pipeline::run(
+        MemorySource::new(events.clone(), 700),
+        model.estimator(SENSOR, 1000).unwrap(),
+        &config,
+        |out| {
+            if let Output::Estimate(e) = out {
+                estimates.push(e);
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    same_values(&estimates, &reference(&model, &events));
+    assert_eq!(summary.estimates, estimates.len() as u64);
 }

@@ -46,6 +46,11 @@ pub struct Args {
     /// summary).
     #[arg(long)]
     pub drop_when_behind: bool,
+    /// Keep the estimation thread spinning on the queue instead of sleeping between chunks: it
+    /// occupies a core, and estimates no longer wait for the thread to wake (lower latency
+    /// tails, see docs/online.md).
+    #[arg(long)]
+    pub busy_poll: bool,
     /// Reconnection attempts in a row for a network input before the run ends.
     #[arg(long, default_value_t = 8)]
     pub reconnect_attempts: u32,
@@ -143,6 +148,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         &PipelineConfig {
             queue_chunks: args.queue_chunks,
             drop_when_behind: args.drop_when_behind,
+            busy_poll: args.busy_poll,
         },
         &stop,
         |output| {

@@ -43,10 +43,20 @@ pub struct Args {
     pub jobs: Option<usize>,
 }
 
-/// Progress bars for library stages.
-#[derive(Default)]
+/// Progress bars for library stages: one bar per stage, replaced when the next starts, plus any
+/// bars added with [`Bars::add`] (drawn together, hidden when stderr is not a terminal).
 pub struct Bars {
+    multi: indicatif::MultiProgress,
     bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+}
+
+impl Default for Bars {
+    fn default() -> Self {
+        Self {
+            multi: crate::progress::multi(),
+            bar: std::sync::Mutex::new(None),
+        }
+    }
 }
 
 impl Progress for Bars {
@@ -54,8 +64,9 @@ impl Progress for Bars {
         if let Ok(mut b) = self.bar.lock() {
             if let Some(old) = b.take() {
                 old.finish_and_clear();
+                self.multi.remove(&old);
             }
-            *b = Some(crate::progress::bar(total, name));
+            *b = Some(self.multi.add(crate::progress::bar(total, name)));
         }
     }
     fn advance(&self, n: u64) {
@@ -66,23 +77,24 @@ impl Progress for Bars {
         }
     }
     fn message(&self, text: &str) {
-        if let Ok(b) = self.bar.lock() {
-            match b.as_ref() {
-                Some(b) => b.suspend(|| eprintln!("{text}")),
-                None => eprintln!("{text}"),
-            }
-        }
+        self.multi.suspend(|| eprintln!("{text}"));
     }
 }
 
 impl Bars {
-    /// Clears the current bar.
+    /// Draws `bar` with the stage bars (e.g. an overall one).
+    pub fn add(&self, bar: indicatif::ProgressBar) -> indicatif::ProgressBar {
+        self.multi.add(bar)
+    }
+
+    /// Clears the bars.
     pub fn finish(&self) {
         if let Ok(mut b) = self.bar.lock()
             && let Some(old) = b.take()
         {
             old.finish_and_clear();
         }
+        let _ = self.multi.clear();
     }
 }
 
