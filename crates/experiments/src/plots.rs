@@ -457,9 +457,9 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
     let red = RGBColor(230, 30, 30);
     let orange = RGBColor(255, 165, 0);
     for (area, p) in areas.iter().zip(panels) {
-        let titled = area.titled(&p.title, (FAMILY, 20)).map_err(&e)?;
-        let (legend_area, image_area) = titled.split_vertically(cell_h as i32 - 90);
-        let (legend_area, image_area) = (image_area, legend_area);
+        // The image, then its legend right below it, in the same titled area (a fixed split
+        // left the legend too little room, so it ran into the next row's title).
+        let image_area = area.titled(&p.title, (FAMILY, 20)).map_err(&e)?;
         let (w, h) = (p.width.max(1), p.height.max(1));
         let scale = ((cell_w as usize - 40) / w)
             .min((cell_h as usize - 130) / h)
@@ -499,14 +499,14 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
         .into_iter()
         .enumerate()
         {
-            let y = 18 + 22 * k as i32;
-            legend_area
+            let y = scale * h as i32 + 24 + 22 * k as i32;
+            image_area
                 .draw(&Rectangle::new([(30, y - 8), (48, y + 8)], color.filled()))
                 .map_err(&e)?;
-            legend_area
+            image_area
                 .draw(&Rectangle::new([(30, y - 8), (48, y + 8)], BLACK))
                 .map_err(&e)?;
-            legend_area
+            image_area
                 .draw(&Text::new(label.to_string(), (58, y - 9), (FAMILY, 18)))
                 .map_err(&e)?;
         }
@@ -561,6 +561,7 @@ pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Res
             .y_desc("test MAE (deg)")
             .label_style((FAMILY, 16))
             .axis_desc_style((FAMILY, 18))
+            .x_label_formatter(&tick)
             .y_label_formatter(&tick)
             .draw()
             .map_err(&e)?;
