@@ -9,6 +9,9 @@
 //! - `pipeline/<repr>/<rate>`: 2 s of events replayed at recorded pace through the two-thread
 //!   pipeline in 1 ms slices; prints the run's summary (latency as defined in docs/online.md).
 //!
+//! `EVTAC_BENCH_NO_PIPELINE=1` skips the pipeline runs (criterion's filter only selects among
+//! the first kind).
+//!
 //! Run: `nice cargo bench -p evtac-online --bench latency -- --warm-up-time 1 --measurement-time 3`
 
 #[path = "../tests/support/mod.rs"]
@@ -88,6 +91,9 @@ fn estimate(c: &mut Criterion) {
 }
 
 fn paced_pipeline(_c: &mut Criterion) {
+    if std::env::var_os("EVTAC_BENCH_NO_PIPELINE").is_some() {
+        return;
+    }
     for (name, repr) in support::representations() {
         let dir = tempfile::tempdir().expect("a temporary folder");
         support::seeded_bundle(dir.path(), 1, &repr, None);

@@ -31,7 +31,7 @@
 //!   calling `advance_to(t_k)` for exact results; output is then the same for any chunking.
 
 use crate::ReprError;
-use crate::accumulator::StaticAccumulator;
+use crate::accumulator::{BATCH, StaticAccumulator};
 use crate::combine::StaticThreshold;
 use crate::config::{AccumulatorParams, ReprConfig};
 use crate::mask::Mask;
@@ -39,10 +39,6 @@ use crate::pool::Pool8;
 use crate::window::SlidingWindow;
 use evtac_events::{Event, Resolution, Roi};
 use std::collections::VecDeque;
-
-/// How many events ahead the per-pixel state is prefetched: far enough for the loads to land
-/// before the event is processed (about 30 ns of work per event), near enough to stay cached.
-const PREFETCH_AHEAD: usize = 12;
 
 struct AccSlot {
     params: AccumulatorParams,
@@ -339,7 +335,7 @@ impl FeatureExtractor {
             return Err(ReprError::SampleTimeBackwards { t: t_k, previous });
         }
         let n = self.pending.partition_point(|e| e.t <= t_k);
-        let width = usize::from(self.resolution.width);
+        let width = u32::from(self.resolution.width);
         let Self {
             accs,
             windows,
@@ -350,43 +346,13 @@ impl FeatureExtractor {
             pending,
             ..
         } = self;
-        for (i, e) in pending.range(..n).enumerate() {
-            if let Some(ahead) = pending.get(i + PREFETCH_AHEAD) {
-                let q = usize::from(ahead.y) * width + usize::from(ahead.x);
-                for slot in accs.iter() {
-                    slot.acc.prefetch(q);
-                }
-                for slot in windows.iter() {
-                    slot.window.prefetch(q);
-                }
-            }
-            let p = usize::from(e.y) * width + usize::from(e.x);
-            for slot in accs.iter_mut() {
-                let v = slot.acc.update(p, e.t, e.polarity);
-                if slot.params.synchronous_decay {
-                    // Recomputed in full after the synchronous decay below.
-                    continue;
-                }
-                for &sp in &slot.planes {
-                    let plane = &mut splanes[sp];
-                    let on =
-                        plane.rule.is_set(v) && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
-                    if (plane.bits[p] != 0) != on {
-                        plane.bits[p] = u8::from(on);
-                        propagate(outputs, &splanes[sp].outputs, splanes, dplanes, p);
-                    }
-                }
-            }
-            for slot in windows.iter_mut() {
-                let count = slot.window.add(e.t, p as u32);
-                for &dp in &slot.planes {
-                    let plane = &mut dplanes[dp];
-                    let on = count > plane.count_threshold;
-                    if (plane.bits[p] != 0) != on {
-                        plane.bits[p] = u8::from(on);
-                        propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
-                    }
-                }
+        let (front, back) = pending.as_slices();
+        let in_front = n.min(front.len());
+        for events in [&front[..in_front], &back[..n - in_front]] {
+            for batch in events.chunks(BATCH) {
+                apply_batch(
+                    batch, width, accs, windows, splanes, dplanes, outputs, masks,
+                );
             }
         }
         pending.drain(..n);
@@ -575,6 +541,69 @@ fn shift_index(err: ReprError, offset: usize) -> ReprError {
             previous,
         },
         other => other,
+    }
+}
+
+/// Applies a batch of at most [`BATCH`] events (time order, inside the frame) to every
+/// accumulator and window, flipping plane pixels and their outputs. Within the batch all
+/// accumulators go first and the windows after: the outputs only depend on the planes' final
+/// bits, so the end state is the same as event by event.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn apply_batch(
+    batch: &[Event],
+    width: u32,
+    accs: &mut [AccSlot],
+    windows: &mut [WindowSlot],
+    splanes: &mut [StaticPlane],
+    dplanes: &mut [DynamicPlane],
+    outputs: &mut [Output],
+    masks: &[Mask],
+) {
+    let mut pixels = [0u32; BATCH];
+    let pixels = &mut pixels[..batch.len()];
+    for (p, e) in pixels.iter_mut().zip(batch) {
+        *p = u32::from(e.y) * width + u32::from(e.x);
+        // The whole batch's state is requested at once: the loads overlap.
+        for slot in accs.iter() {
+            slot.acc.prefetch(*p as usize);
+        }
+        for slot in windows.iter() {
+            slot.window.prefetch(*p as usize);
+        }
+    }
+    let mut values = [0f32; BATCH];
+    for slot in accs.iter_mut() {
+        slot.acc.update_batch(pixels, batch, &mut values);
+        if slot.params.synchronous_decay {
+            // Recomputed in full after the synchronous decay in `advance_to`.
+            continue;
+        }
+        for &sp in &slot.planes {
+            for (&p, &v) in pixels.iter().zip(&values) {
+                let p = p as usize;
+                let plane = &mut splanes[sp];
+                let on = plane.rule.is_set(v) && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
+                if (plane.bits[p] != 0) != on {
+                    plane.bits[p] = u8::from(on);
+                    propagate(outputs, &splanes[sp].outputs, splanes, dplanes, p);
+                }
+            }
+        }
+    }
+    for slot in windows.iter_mut() {
+        for (&p, e) in pixels.iter().zip(batch) {
+            let count = slot.window.add(e.t, p);
+            let p = p as usize;
+            for &dp in &slot.planes {
+                let plane = &mut dplanes[dp];
+                let on = count > plane.count_threshold;
+                if (plane.bits[p] != 0) != on {
+                    plane.bits[p] = u8::from(on);
+                    propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
+                }
+            }
+        }
     }
 }
 

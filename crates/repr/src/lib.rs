@@ -49,6 +49,7 @@ mod check;
 pub mod combine;
 pub mod config;
 mod error;
+pub mod expf;
 pub mod extractor;
 pub mod mask;
 pub mod pool;
