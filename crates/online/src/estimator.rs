@@ -2,7 +2,8 @@
 //!
 //! [`Estimator`] is what the estimation thread runs, and also what an offline check or a
 //! benchmark can drive directly. Per chunk it crops events to the 240x240 region of interest,
-//! hands them to the representation, and for every grid time that the chunk makes final it
+//! hands them to the representation and applies at once those that belong to the next grid
+//! time (`FeatureExtractor::prepare`); for every grid time that the chunk makes final it
 //! advances the representation to that time, runs the MLP, and stamps the latency. Nothing on
 //! this path allocates once the buffers have grown to the largest chunk seen.
 
@@ -164,6 +165,12 @@ impl Estimator {
             self.counters.span_us = Some((first, last));
         }
         self.extractor.push(&self.crop)?;
+        if let Some(next) = self.schedule.next() {
+            // Apply what belongs to the next estimate now: when a later chunk makes it final,
+            // only that chunk's events are left to do (a live stream arrives in many packets
+            // per interval).
+            self.extractor.prepare(next)?;
+        }
         // An event at `t` proves that every event before `t` has arrived; one at `t` itself
         // may still follow in the next chunk.
         let proven = latest.map_or(i64::MIN, |t| t.saturating_sub(1));

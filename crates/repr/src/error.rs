@@ -54,12 +54,12 @@ pub enum ReprError {
         /// The latest timestamp seen before it.
         previous: i64,
     },
-    /// Sample times must be non-decreasing.
-    #[error("sample time {t} us is before the previous sample time {previous} us")]
+    /// Sample times must be non-decreasing (also relative to prepared times).
+    #[error("sample time {t} us is before the previous sample (or prepared) time {previous} us")]
     SampleTimeBackwards {
         /// The sample time asked for.
         t: i64,
-        /// The previous sample time.
+        /// The previous sample (or prepared) time.
         previous: i64,
     },
     /// A mask's size differs from the frame it is applied to.

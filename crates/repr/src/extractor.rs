@@ -107,6 +107,9 @@ pub struct FeatureExtractor {
     pending: VecDeque<Event>,
     last_pushed: Option<i64>,
     sample_time: Option<i64>,
+    /// The latest time given to [`Self::prepare`] or [`Self::advance_to`]: events up to it
+    /// are applied, so no later sample may come before it.
+    prepared: Option<i64>,
 }
 
 impl std::fmt::Debug for FeatureExtractor {
@@ -177,6 +180,7 @@ impl FeatureExtractor {
             pending: VecDeque::new(),
             last_pushed: None,
             sample_time: None,
+            prepared: None,
         };
         let n = frame.pixels();
         for (i, (config, mask)) in configs.iter().zip(masks).enumerate() {
@@ -327,13 +331,54 @@ impl FeatureExtractor {
     }
 
     /// Applies every queued event with `t <= t_k`, moves the windows to end at `t_k`, and
-    /// updates every output. `t_k` must not be before the previous sample time.
+    /// updates every output. `t_k` must not be before the previous sample time (nor before a
+    /// time given to [`Self::prepare`]).
     pub fn advance_to(&mut self, t_k: i64) -> Result<(), ReprError> {
-        if let Some(previous) = self.sample_time
+        self.prepare(t_k)?;
+        self.refresh_static_planes(true);
+        self.sample_time = Some(t_k);
+        Ok(())
+    }
+
+    /// Does ahead of time the work that [`Self::advance_to`]`(t_next)` will do with the events
+    /// queued so far: applies those with `t <= t_next` and lets the windows drop what leaves
+    /// them by `t_next`. A live estimator calls it as events arrive, so that when `t_next`
+    /// becomes final only the latest events are left to apply. The sample that follows is the
+    /// same as without it (the end state does not depend on how the work was split); until
+    /// then, [`Self::features`] and [`Self::frame`] show the partly advanced state. `t_next`
+    /// must not be before the previous sample time or prepared time, and the next sample time
+    /// must not be before `t_next`.
+    ///
+    /// ```
+    /// use evtac_events::{Event, Resolution};
+    /// use evtac_repr::{FeatureExtractor, ReprConfig};
+    ///
+    /// let frame = Resolution::new(240, 240);
+    /// let events: Vec<Event> = (0..300)
+    ///     .map(|i| Event { t: i * 5, x: (i % 240) as u16, y: 7, polarity: true })
+    ///     .collect();
+    /// let (mut eager, mut lazy) = (
+    ///     FeatureExtractor::new(&[ReprConfig::default()], frame, None)?,
+    ///     FeatureExtractor::new(&[ReprConfig::default()], frame, None)?,
+    /// );
+    /// for chunk in events.chunks(50) {
+    ///     eager.push(chunk)?;
+    ///     eager.prepare(1_000)?; // applies what has arrived, up to the next sample
+    ///     lazy.push(chunk)?;
+    /// }
+    /// eager.advance_to(1_000)?;
+    /// lazy.advance_to(1_000)?;
+    /// assert_eq!(eager.features(0), lazy.features(0));
+    /// # Ok::<(), evtac_repr::ReprError>(())
+    /// ```
+    pub fn prepare(&mut self, t_next: i64) -> Result<(), ReprError> {
+        let t_k = t_next;
+        if let Some(previous) = self.prepared
             && t_k < previous
         {
             return Err(ReprError::SampleTimeBackwards { t: t_k, previous });
         }
+        self.prepared = Some(t_k);
         let n = self.pending.partition_point(|e| e.t <= t_k);
         let width = u32::from(self.resolution.width);
         let Self {
@@ -370,8 +415,6 @@ impl FeatureExtractor {
                 }
             });
         }
-        self.refresh_static_planes(true);
-        self.sample_time = Some(t_k);
         Ok(())
     }
 
@@ -470,6 +513,7 @@ impl FeatureExtractor {
         self.pending.clear();
         self.last_pushed = None;
         self.sample_time = None;
+        self.prepared = None;
         self.refresh_static_planes(false);
     }
 

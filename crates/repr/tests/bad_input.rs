@@ -131,3 +131,29 @@ fn bad_configs_frames_and_masks_are_rejected() {
         })
     ));
 }
+
+#[test]
+fn a_sample_before_a_prepared_time_is_an_error() {
+    let mut fx =
+        FeatureExtractor::new(&[ReprConfig::default()], Resolution::new(8, 8), None).unwrap();
+    fx.push(&[Event {
+        t: 5,
+        x: 1,
+        y: 1,
+        polarity: true,
+    }])
+    .unwrap();
+    fx.prepare(10).unwrap();
+    // The event at 5 is applied already: a sample at 4 would include it.
+    assert!(matches!(
+        fx.advance_to(4),
+        Err(ReprError::SampleTimeBackwards { t: 4, previous: 10 })
+    ));
+    assert!(fx.prepare(9).is_err());
+    fx.advance_to(10).unwrap();
+    assert_eq!(
+        fx.frame(0)[9],
+        1,
+        "the event is in the window of the default combined config"
+    );
+}

@@ -135,6 +135,7 @@ fn streamed(
     events: &[Event],
     samples: &[i64],
     cuts: &[usize],
+    eager: bool,
 ) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
     let mut fx = FeatureExtractor::new(configs, RES, Some(mask)).unwrap();
     let mut out = vec![Vec::new(); configs.len()];
@@ -149,6 +150,10 @@ fn streamed(
                 .unwrap_or(events.len());
             fx.push(&events[pushed..end]).unwrap();
             pushed = end;
+            if eager {
+                // What a live estimator does as each chunk arrives.
+                fx.prepare(t_k).unwrap();
+            }
         }
         fx.advance_to(t_k).unwrap();
         for (i, o) in out.iter_mut().enumerate() {
@@ -182,16 +187,19 @@ proptest! {
         let configs = configs();
         let expected = reference(&configs, &mask, &events, &samples);
         let cuts = random_batches(seed, events.len(), chunks);
-        let got = streamed(&configs, &mask, &events, &samples, &cuts);
+        let got = streamed(&configs, &mask, &events, &samples, &cuts, false);
         for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
             for (k, (g, e)) in g.iter().zip(e).enumerate() {
                 prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
                 prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
             }
         }
-        // One push of everything gives the same.
-        let whole = streamed(&configs, &mask, &events, &samples, &[]);
-        prop_assert_eq!(whole, got);
+        // One push of everything gives the same, and so does applying each chunk ahead of its
+        // sample as it arrives.
+        let whole = streamed(&configs, &mask, &events, &samples, &[], false);
+        prop_assert_eq!(&whole, &got);
+        let eager = streamed(&configs, &mask, &events, &samples, &cuts, true);
+        prop_assert_eq!(eager, got);
     }
 }
 
