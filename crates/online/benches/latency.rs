@@ -10,6 +10,8 @@
 //!   count of estimates over 1 ms.
 //! - `pipeline/<repr>/<rate>`: 2 s of events replayed at recorded pace through the two-thread
 //!   pipeline in 1 ms slices; prints the run's summary (latency as defined in docs/online.md).
+//!   Printed first: how often, and for how long, the machine itself held up a busy thread over
+//!   2 s (the floor under any latency tail measured on it).
 //!
 //! `EVTAC_BENCH_NO_PIPELINE=1` skips the pipeline runs (criterion's filter only selects among
 //! the first kind).
@@ -117,10 +119,35 @@ fn estimate(c: &mut Criterion) {
     group.finish();
 }
 
+/// The machine's own interruptions, for reading the pipeline's tail and late counts: a thread
+/// that does nothing but read the clock for 2 s, and the longest gaps between two reads (time
+/// the thread did not run: interrupts, other processes, on a VM the hypervisor).
+fn machine_stalls() {
+    let start = Instant::now();
+    let mut last = start;
+    let mut gaps = LatencyStats::new(Duration::from_millis(1));
+    while last - start < Duration::from_secs(2) {
+        let now = Instant::now();
+        let gap = now - last;
+        if gap > Duration::from_micros(20) {
+            gaps.record(gap);
+        }
+        last = now;
+    }
+    eprintln!(
+        "machine: a thread reading the clock for 2 s was held up {} times over 20 us, \
+         {} over 1 ms, longest {:.1} us",
+        gaps.count(),
+        gaps.late(),
+        us(gaps.max())
+    );
+}
+
 fn paced_pipeline(_c: &mut Criterion) {
     if std::env::var_os("EVTAC_BENCH_NO_PIPELINE").is_some() {
         return;
     }
+    machine_stalls();
     for (name, repr) in support::representations() {
         let dir = tempfile::tempdir().expect("a temporary folder");
         support::seeded_bundle(dir.path(), 1, &repr, None);

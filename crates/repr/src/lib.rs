@@ -51,6 +51,7 @@ pub mod config;
 mod error;
 pub mod expf;
 pub mod extractor;
+mod fifo;
 pub mod mask;
 pub mod pool;
 mod prefetch;

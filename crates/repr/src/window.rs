@@ -4,8 +4,8 @@
 //! it, from a FIFO of `(t, pixel)`: the window is never recounted, so a sample costs only the
 //! events that entered or left since the previous one.
 
+use crate::fifo::Fifo;
 use evtac_events::Resolution;
-use std::collections::VecDeque;
 
 /// Sliding-window event counter over one frame (both polarities).
 ///
@@ -23,7 +23,9 @@ use std::collections::VecDeque;
 pub struct SlidingWindow {
     window_us: i64,
     counts: Vec<u32>,
-    queue: VecDeque<(i64, u32)>,
+    /// `(t, pixel)` of every event in the window, oldest first (in blocks: a window of
+    /// millions of events grows without copying, see [`crate::fifo`]).
+    queue: Fifo<(i64, u32)>,
 }
 
 impl SlidingWindow {
@@ -32,7 +34,7 @@ impl SlidingWindow {
         Self {
             window_us,
             counts: vec![0; resolution.pixels()],
-            queue: VecDeque::new(),
+            queue: Fifo::new(),
         }
     }
 
@@ -65,15 +67,15 @@ impl SlidingWindow {
     #[inline]
     pub fn expire_through(&mut self, t_k: i64, mut on_expire: impl FnMut(u32, u32)) {
         let start = t_k.saturating_sub(self.window_us);
-        while let Some(&(t, pixel)) = self.queue.front() {
-            if t > start {
-                break;
-            }
-            self.queue.pop_front();
-            let c = &mut self.counts[pixel as usize];
-            *c -= 1;
-            on_expire(pixel, *c);
-        }
+        let counts = &mut self.counts;
+        self.queue.pop_while(
+            |&(t, _)| t <= start,
+            |(_, pixel)| {
+                let c = &mut counts[pixel as usize];
+                *c -= 1;
+                on_expire(pixel, *c);
+            },
+        );
     }
 
     /// The per-pixel counts, row-major.
@@ -88,7 +90,7 @@ impl SlidingWindow {
 
     /// Whether the window holds no event.
     pub fn is_empty(&self) -> bool {
-        self.queue.is_empty()
+        self.queue.len() == 0
     }
 
     /// Empties the window.
