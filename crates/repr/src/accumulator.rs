@@ -173,9 +173,7 @@ impl StaticAccumulator {
                 -p.eta
             };
             let n = p.neutral_potential;
-            *v = ((*v - n) * f + n + c)
-                .max(p.min_potential)
-                .min(p.max_potential);
+            *v = clamp((*v - n) * f + n + c, &p);
             *out = *v;
         }
         if let Some(last) = events.last() {
@@ -200,7 +198,7 @@ impl StaticAccumulator {
         } else {
             -p.eta
         };
-        *v = (*v + c).max(p.min_potential).min(p.max_potential);
+        *v = clamp(*v + c, p);
         self.highest_time = t;
         *v
     }
@@ -281,6 +279,24 @@ impl StaticAccumulator {
         self.potentials.fill(self.params.neutral_potential);
         self.times.fill(0);
         self.highest_time = 0;
+    }
+}
+
+/// dv-processing's clamp to `[min, max]`. Written as two comparisons rather than
+/// `max(min).min(max)`: the same result for every potential that can occur (never NaN, never
+/// -0: `x + c` with `c != 0` rounds an exact zero to +0), in fewer instructions than the
+/// NaN-aware `f32::max`/`f32::min`, and no panic on unvalidated parameters as `f32::clamp` would.
+#[inline(always)]
+fn clamp(v: f32, p: &AccumulatorParams) -> f32 {
+    let v = if v < p.min_potential {
+        p.min_potential
+    } else {
+        v
+    };
+    if v > p.max_potential {
+        p.max_potential
+    } else {
+        v
     }
 }
 

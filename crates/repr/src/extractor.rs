@@ -624,10 +624,15 @@ fn apply_batch(
             continue;
         }
         for &sp in &slot.planes {
-            for (&p, &v) in pixels.iter().zip(&values) {
+            // First every event's new bit (no branches on data), then the flips.
+            let (rule, mask) = (splanes[sp].rule, splanes[sp].mask.map(|m| &masks[m]));
+            let mut bits = [false; BATCH];
+            for ((on, &p), &v) in bits.iter_mut().zip(pixels.iter()).zip(&values) {
+                *on = rule.is_set(v) && !mask.is_some_and(|m| m.is_masked(p as usize));
+            }
+            for (&p, &on) in pixels.iter().zip(&bits) {
                 let p = p as usize;
                 let plane = &mut splanes[sp];
-                let on = plane.rule.is_set(v) && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
                 if (plane.bits[p] != 0) != on {
                     plane.bits[p] = u8::from(on);
                     propagate(outputs, &splanes[sp].outputs, splanes, dplanes, p);
@@ -662,11 +667,14 @@ fn propagate(
 ) {
     for &o in targets {
         let out = &mut outputs[o];
-        let on = match out.kind {
-            Kind::Static(s) => splanes[s].bits[p] != 0,
-            Kind::Dynamic(d) => dplanes[d].bits[p] != 0,
-            Kind::Combined(s, d) => splanes[s].bits[p] != 0 || dplanes[d].bits[p] != 0,
-        };
-        out.pool.set(p, on);
+        match out.kind {
+            // The output is the plane: it flipped too.
+            Kind::Static(s) => out.pool.flip(p, splanes[s].bits[p] != 0),
+            Kind::Dynamic(d) => out.pool.flip(p, dplanes[d].bits[p] != 0),
+            Kind::Combined(s, d) => {
+                out.pool
+                    .set(p, splanes[s].bits[p] != 0 || dplanes[d].bits[p] != 0);
+            }
+        }
     }
 }

@@ -71,10 +71,22 @@ impl Pool8 {
     /// When `pixel` is outside the frame.
     #[inline]
     pub fn set(&mut self, pixel: usize, on: bool) -> bool {
-        let bit = &mut self.bits[pixel];
-        if (*bit != 0) == on {
+        if (self.bits[pixel] != 0) == on {
             return false;
         }
+        self.flip(pixel, on);
+        true
+    }
+
+    /// Sets pixel `pixel`, which is known to be `!on`, to `on` (what [`Self::set`] does after
+    /// its check, for callers that already know the pixel flips).
+    ///
+    /// # Panics
+    /// When `pixel` is outside the frame; in debug builds also when the pixel is already `on`.
+    #[inline]
+    pub fn flip(&mut self, pixel: usize, on: bool) {
+        let bit = &mut self.bits[pixel];
+        debug_assert_ne!(*bit != 0, on, "Pool8::flip on a pixel that does not flip");
         *bit = u8::from(on);
         let cell = self.cell_of[pixel] as usize;
         let count = &mut self.counts[cell];
@@ -84,7 +96,6 @@ impl Pool8 {
             *count -= 1;
         }
         self.features[cell] = f32::from(*count) / 64.0;
-        true
     }
 
     /// Whether pixel `pixel` is set.
