@@ -7,7 +7,11 @@
 //! hand-written pass is allocation-free: activations live in fixed-size stack arrays and each
 //! layer is a sequence of `y += x[i] * W[i, :]` row updates over the transposed weight
 //! (`[in, out]`), 64 outputs at a time held in registers, which vectorises without horizontal
-//! sums and skips zero inputs outright (the masked, binarised representations are mostly
+//! sums and skips zero inputs outright. The weights of each 64-output block are stored together
+//! (`[block][in][64]`), so a block streams through one contiguous panel: next to the
+//! representation's state the first layer's 0.9 MB no longer stays in a 1 MB L2 cache, and a
+//! contiguous stream is what the prefetcher brings in from L3 fastest (dynamic estimate at
+//! 3M events/s: 53 -> 46 us median) (the masked, binarised representations are mostly
 //! zeros). It is compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time,
 //! with identical results on all three. Training stays on burn.
 
@@ -32,11 +36,26 @@ const H1: usize = LAYER_SIZES[1];
 const H2: usize = LAYER_SIZES[2];
 const H3: usize = LAYER_SIZES[3];
 
-/// One layer with its weight transposed to `[in, out]` row-major.
+/// One layer: its weight transposed to `[in, out]` row-major, then, when `out` is a multiple of
+/// [`BLOCK`], regrouped into panels `[out / BLOCK][in][BLOCK]`.
 #[derive(Debug, Clone)]
 struct Dense {
     weight_t: Vec<f32>,
     bias: Vec<f32>,
+}
+
+/// `[in, out]` to `[out / BLOCK][in][BLOCK]` when `out` is a multiple of [`BLOCK`] (else as is).
+fn into_panels(weight_t: Vec<f32>, fan_out: usize) -> Vec<f32> {
+    if !fan_out.is_multiple_of(BLOCK) {
+        return weight_t;
+    }
+    let mut panels = Vec::with_capacity(weight_t.len());
+    for b in 0..fan_out / BLOCK {
+        for row in weight_t.chunks_exact(fan_out) {
+            panels.extend_from_slice(&row[b * BLOCK..(b + 1) * BLOCK]);
+        }
+    }
+    panels
 }
 
 impl Dense {
@@ -51,7 +70,7 @@ impl Dense {
 /// each input.
 const BLOCK: usize = 64;
 
-/// `out = relu?(bias + x W)` with `W` as `[in, out]` rows, compiled for AVX-512 and AVX2 as
+/// `out = relu?(bias + x W)` with `W` laid out as in [`Dense`], compiled for AVX-512 and AVX2 as
 /// well as the baseline and picked at run time.
 ///
 /// Every output is still `bias` plus the products added in input order, with separate
@@ -62,14 +81,14 @@ fn dense_forward(weight_t: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], rel
     let width = out.len();
     out.copy_from_slice(bias);
     if width.is_multiple_of(BLOCK) {
-        for (b, out) in out.chunks_exact_mut(BLOCK).enumerate() {
+        let panels = weight_t.chunks_exact(x.len() * BLOCK);
+        for (out, panel) in out.chunks_exact_mut(BLOCK).zip(panels) {
             let mut acc = [0.0_f32; BLOCK];
             acc.copy_from_slice(out);
-            for (&xi, row) in x.iter().zip(weight_t.chunks_exact(width)) {
+            for (&xi, row) in x.iter().zip(panel.chunks_exact(BLOCK)) {
                 // Zero inputs contribute exactly zero (weights are finite, checked on load),
                 // and the masked, binarised representations are mostly zeros.
                 if xi != 0.0 {
-                    let row = &row[b * BLOCK..(b + 1) * BLOCK];
                     for (a, &w) in acc.iter_mut().zip(row) {
                         *a += xi * w;
                     }
@@ -116,7 +135,10 @@ impl Predictor {
         let dense = |i: usize| {
             let (fan_in, fan_out) = (LAYER_SIZES[i], LAYER_SIZES[i + 1]);
             Dense {
-                weight_t: model::transpose(&params.layers[i].weight, fan_out, fan_in),
+                weight_t: into_panels(
+                    model::transpose(&params.layers[i].weight, fan_out, fan_in),
+                    fan_out,
+                ),
                 bias: params.layers[i].bias.clone(),
             }
         };

@@ -406,10 +406,10 @@ impl FeatureExtractor {
             slot.window.expire_through(t_k, |pixel, count| {
                 let p = pixel as usize;
                 for &dp in planes {
-                    let plane = &mut dplanes[dp];
-                    let on = count > plane.count_threshold;
-                    if (plane.bits[p] != 0) != on {
-                        plane.bits[p] = u8::from(on);
+                    // One event fewer clears the pixel exactly when the count falls to the
+                    // threshold.
+                    if count == dplanes[dp].count_threshold {
+                        dplanes[dp].bits[p] = 0;
                         propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
                     }
                 }
@@ -645,10 +645,10 @@ fn apply_batch(
             let count = slot.window.add(e.t, p);
             let p = p as usize;
             for &dp in &slot.planes {
-                let plane = &mut dplanes[dp];
-                let on = count > plane.count_threshold;
-                if (plane.bits[p] != 0) != on {
-                    plane.bits[p] = u8::from(on);
+                // A plane pixel is `count > threshold`: one more event sets it exactly when
+                // the count passes the threshold (no need to read the bit).
+                if count - 1 == dplanes[dp].count_threshold {
+                    dplanes[dp].bits[p] = 1;
                     propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
                 }
             }
