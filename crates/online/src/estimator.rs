@@ -69,7 +69,7 @@ pub struct Estimator {
     predictor: Predictor,
     roi: Roi,
     schedule: Schedule,
-    /// Cropped events of the current chunk (reused).
+    /// Cropped events of the current chunk at its front (reused, never shrunk).
     crop: Vec<Event>,
     /// Events older than this are out of order: the latest event time, or one past the last
     /// estimate time (whichever is later).
@@ -141,7 +141,15 @@ impl Estimator {
         arrival: Instant,
         emit: &mut impl FnMut(&Estimate),
     ) -> Result<(), Error> {
-        self.crop.clear();
+        // Cropped without a branch per event (whether an event falls in the crop is as good as
+        // random to the branch predictor): every accepted event is written at `kept`, which
+        // only moves on for those inside. The buffer keeps its largest length, so no chunk
+        // pays for clearing it.
+        if self.crop.len() < events.len() {
+            self.crop.resize(events.len(), Event::default());
+        }
+        let Roi { x0, y0, size } = self.roi;
+        let mut kept = 0;
         let mut first = None;
         let mut latest = None;
         for &e in events {
@@ -152,19 +160,20 @@ impl Estimator {
             self.floor = e.t;
             first.get_or_insert(e.t);
             latest = Some(e.t);
-            if let Some(c) = self.roi.map(e) {
-                self.crop.push(c);
-            }
+            let (x, y) = (e.x.wrapping_sub(x0), e.y.wrapping_sub(y0));
+            self.crop[kept] = Event { x, y, ..e };
+            kept += usize::from((x < size.width) & (y < size.height));
         }
+        let crop = &self.crop[..kept];
         self.counters.events += events.len() as u64;
-        self.counters.events_in_roi += self.crop.len() as u64;
+        self.counters.events_in_roi += crop.len() as u64;
         if let (Some(first), Some(last)) = (first, latest) {
             // The first accepted event of the stream opens the grid.
             self.schedule.start(first);
             let first = self.counters.span_us.map_or(first, |(f, _)| f);
             self.counters.span_us = Some((first, last));
         }
-        self.extractor.push(&self.crop)?;
+        self.extractor.push(crop)?;
         if let Some(next) = self.schedule.next() {
             // Apply what belongs to the next estimate now: when a later chunk makes it final,
             // only that chunk's events are left to do (a live stream arrives in many packets
