@@ -17,6 +17,13 @@
 //! Synchronous-decay accumulators are the exception: dv-processing decays every pixel when a
 //! frame is read, so their planes are recomputed in full (`O(width x height)`) per sample.
 //!
+//! One shortcut, exact: a static plane that only feeds combined outputs whose dynamic part sets
+//! a pixel at its first event in the window (`count_threshold` 0, the paper's setting) is not
+//! thresholded per event. Every event enters the window, so right after it the output pixel is
+//! set whatever the static bit; the static bit only shows once the pixel's last event has left
+//! the window, and since the potential (lazy decay) has not changed since that event, it is
+//! computed then, from the potential, when the dynamic pixel clears.
+//!
 //! # Edge cases, documented
 //! - Before the first event, or for an empty stream, every output is the initial state:
 //!   potentials at the neutral potential, counts 0, thresholded as usual (all zero with the
@@ -57,6 +64,10 @@ struct StaticPlane {
     mask: Option<usize>,
     bits: Vec<u8>,
     outputs: Vec<usize>,
+    /// Only feeds combined outputs whose dynamic part sets a pixel at its first event: an
+    /// event then sets the output whatever the static bit, so the bit is not kept per event
+    /// but computed from the potential when the dynamic pixel clears (see the module docs).
+    lazy: bool,
 }
 
 struct DynamicPlane {
@@ -220,6 +231,7 @@ impl FeatureExtractor {
                         mask,
                         bits: vec![0; n],
                         outputs: Vec::new(),
+                        lazy: false,
                     },
                 );
                 if !fx.accs[acc].planes.contains(&plane) {
@@ -264,6 +276,13 @@ impl FeatureExtractor {
                 kind,
                 pool: Pool8::new(frame)?,
             });
+        }
+        for plane in &mut fx.splanes {
+            plane.lazy = !fx.accs[plane.acc].params.synchronous_decay
+                && plane.outputs.iter().all(|&o| match fx.outputs[o].kind {
+                    Kind::Combined(_, d) => fx.dplanes[d].count_threshold == 0,
+                    Kind::Static(_) | Kind::Dynamic(_) => false,
+                });
         }
         fx.refresh_static_planes(false);
         Ok(fx)
@@ -410,6 +429,17 @@ impl FeatureExtractor {
                     // threshold.
                     if count == dplanes[dp].count_threshold {
                         dplanes[dp].bits[p] = 0;
+                        for &o in &dplanes[dp].outputs {
+                            if let Kind::Combined(sp, _) = outputs[o].kind
+                                && splanes[sp].lazy
+                            {
+                                let plane = &mut splanes[sp];
+                                let v = accs[plane.acc].acc.potentials()[p];
+                                let on = plane.rule.is_set(v)
+                                    && !plane.mask.is_some_and(|m| masks[m].is_masked(p));
+                                plane.bits[p] = u8::from(on);
+                            }
+                        }
                         propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
                     }
                 }
@@ -624,6 +654,9 @@ fn apply_batch(
             continue;
         }
         for &sp in &slot.planes {
+            if splanes[sp].lazy {
+                continue;
+            }
             // First every event's new bit (no branches on data), then the flips.
             let (rule, mask) = (splanes[sp].rule, splanes[sp].mask.map(|m| &masks[m]));
             let mut bits = [false; BATCH];

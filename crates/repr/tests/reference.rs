@@ -52,6 +52,18 @@ fn configs() -> Vec<ReprConfig> {
             static_part: s,
             dynamic_part: d,
         },
+        // A static plane of its own under a count-threshold-0 window: the extractor then
+        // thresholds it only when the dynamic pixel clears (the lazy path).
+        ReprConfig::Combined {
+            static_part: StaticConfig {
+                threshold: 1.0,
+                ..s
+            },
+            dynamic_part: DynamicConfig {
+                window_ms: 0.04,
+                count_threshold: 0,
+            },
+        },
         ReprConfig::Combined {
             static_part: StaticConfig {
                 synchronous_decay: true,
