@@ -674,8 +674,9 @@ fn apply_batch(
         }
     }
     for slot in windows.iter_mut() {
-        for (&p, e) in pixels.iter().zip(batch) {
-            let count = slot.window.add(e.t, p);
+        let mut counts = [0u32; BATCH];
+        slot.window.add_batch(batch, pixels, &mut counts);
+        for (&p, &count) in pixels.iter().zip(&counts) {
             let p = p as usize;
             for &dp in &slot.planes {
                 // A plane pixel is `count > threshold`: one more event sets it exactly when

@@ -44,6 +44,15 @@ impl<T: Copy> Fifo<T> {
     /// Appends `item` at the back.
     #[inline]
     pub(crate) fn push_back(&mut self, item: T) {
+        self.make_room();
+        self.tail.push(item);
+        self.len += 1;
+    }
+
+    /// Makes sure the block being filled has room: a full one moves to the full blocks and a
+    /// spare (or new) block takes its place.
+    #[inline]
+    fn make_room(&mut self) {
         if self.tail.len() == BLOCK {
             let fresh = self
                 .spare
@@ -54,8 +63,18 @@ impl<T: Copy> Fifo<T> {
         } else if self.tail.capacity() == 0 {
             self.tail.reserve_exact(BLOCK);
         }
-        self.tail.push(item);
-        self.len += 1;
+    }
+
+    /// Appends every item of `items` at the back, a block at a time.
+    #[inline]
+    pub(crate) fn extend(&mut self, items: impl IntoIterator<Item = T>) {
+        let mut items = items.into_iter().peekable();
+        while items.peek().is_some() {
+            self.make_room();
+            let before = self.tail.len();
+            self.tail.extend(items.by_ref().take(BLOCK - before));
+            self.len += self.tail.len() - before;
+        }
     }
 
     /// Removes entries from the front while `take` accepts them, handing each to `on_pop`.
@@ -126,13 +145,19 @@ mod tests {
     }
 
     proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
         #[test]
-        fn behaves_like_a_vecdeque(ops in proptest::collection::vec(0u8..3, 0..30_000)) {
+        fn behaves_like_a_vecdeque(ops in proptest::collection::vec(0u8..3, 0..6_000)) {
             let mut fifo = Fifo::new();
             let mut reference = VecDeque::new();
             for (i, op) in ops.into_iter().enumerate() {
                 match op {
                     // Pushes outnumber pops, so the queue spans several blocks.
+                    0 if i % 7 == 0 => {
+                        fifo.extend(i..i + 2000);
+                        reference.extend(i..i + 2000);
+                    }
                     0 | 1 => {
                         fifo.push_back(i);
                         reference.push_back(i);

@@ -5,6 +5,7 @@
 //! events that entered or left since the previous one.
 
 use crate::fifo::Fifo;
+use evtac_events::Event;
 use evtac_events::Resolution;
 
 /// Sliding-window event counter over one frame (both polarities).
@@ -54,6 +55,22 @@ impl SlidingWindow {
         *c += 1;
         self.queue.push_back((t, pixel));
         *c
+    }
+
+    /// Adds a batch of events (time order; event `i` on pixel `pixels[i]`) and writes each
+    /// one's new count into `counts`: [`Self::add`] for each, with the queue extended once.
+    ///
+    /// # Panics
+    /// When a pixel is outside the frame, or `counts` or `pixels` is shorter than `events`.
+    #[inline]
+    pub(crate) fn add_batch(&mut self, events: &[Event], pixels: &[u32], counts: &mut [u32]) {
+        for ((&p, _), out) in pixels.iter().zip(events).zip(counts.iter_mut()) {
+            let c = &mut self.counts[p as usize];
+            *c += 1;
+            *out = *c;
+        }
+        self.queue
+            .extend(events.iter().zip(pixels).map(|(e, &p)| (e.t, p)));
     }
 
     /// Hints the cache to load pixel `pixel`'s count (an event for it is coming).
