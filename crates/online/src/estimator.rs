@@ -160,6 +160,8 @@ impl Estimator {
             self.floor = e.t;
             first.get_or_insert(e.t);
             latest = Some(e.t);
+            // Left of or above the crop wraps to past its size: the crop lies on a sensor of
+            // at most 65535 columns and rows, so `x0 + width` stays below 65536.
             let (x, y) = (e.x.wrapping_sub(x0), e.y.wrapping_sub(y0));
             self.crop[kept] = Event { x, y, ..e };
             kept += usize::from((x < size.width) & (y < size.height));
