@@ -2,8 +2,8 @@
 //!
 //! dv-processing decays a pixel with `expf(-dt / tau)`, which on Linux is glibc's `expf`
 //! (glibc 2.27 and later: the algorithm of Arm's optimized-routines). Calling it per event was
-//! a third of the static representation's cost at high event rates (an opaque call that the
-//! compiler can neither inline nor vectorize). This module computes the same function with the
+//! about a quarter of the static representation's cost at high event rates (an opaque call that
+//! the compiler can neither inline nor vectorize). This module computes the same function with the
 //! same double-precision operations in the same order, so the results are the same bits:
 //!
 //! ```text
@@ -19,7 +19,8 @@
 //! by one ulp on some inputs, see the design notes); `tests/expf.rs` compares every input this
 //! crate can produce with the platform's `expf` on linux-gnu.
 //!
-//! Special inputs (`|x| >= 88`, infinities, NaN) take glibc's slow path, reproduced too; off x86_64 the platform's `f32::exp` is used as before.
+//! Special inputs (`|x| >= 88`, infinities, NaN) take glibc's slow path, reproduced too; off
+//! x86_64 the platform's `f32::exp` is used as before.
 
 /// `32 / ln 2`.
 const INV_LN2_N: f64 = f64::from_bits(0x4047_1547_652b_82fe);
