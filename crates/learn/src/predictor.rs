@@ -7,12 +7,12 @@
 //! hand-written pass is allocation-free: activations live in fixed-size stack arrays and each
 //! layer is a sequence of `y += x[i] * W[i, :]` row updates over the transposed weight
 //! (`[in, out]`), 64 outputs at a time held in registers, which vectorises without horizontal
-//! sums and skips zero inputs outright. The weights of each 64-output block are stored together
-//! (`[block][in][64]`), so a block streams through one contiguous panel: next to the
-//! representation's state the first layer's 0.9 MB no longer stays in a 1 MB L2 cache, and a
-//! contiguous stream is what the prefetcher brings in from L3 fastest (dynamic estimate at
-//! 3M events/s: 53 -> 46 us median) (the masked, binarised representations are mostly
-//! zeros). It is compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time,
+//! sums and skips zero inputs outright (the masked, binarised representations are mostly
+//! zeros). The weights of each 64-output block are stored together (`[block][in][64]`), so a
+//! block streams through one contiguous panel: next to the representation's state the first
+//! layer's 0.9 MB no longer stays in a 1 MB L2 cache, and a contiguous stream is what the
+//! prefetcher brings in from L3 fastest (dynamic estimate at 3M events/s: 53 -> 46 us
+//! median). It is compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time,
 //! with identical results on all three. Training stays on burn.
 
 use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
@@ -40,7 +40,7 @@ const H3: usize = LAYER_SIZES[3];
 /// [`BLOCK`], regrouped into panels `[out / BLOCK][in][BLOCK]`.
 #[derive(Debug, Clone)]
 struct Dense {
-    weight_t: Vec<f32>,
+    weights: Vec<f32>,
     bias: Vec<f32>,
 }
 
@@ -61,7 +61,7 @@ fn into_panels(weight_t: Vec<f32>, fan_out: usize) -> Vec<f32> {
 impl Dense {
     #[inline]
     fn forward(&self, x: &[f32], out: &mut [f32], relu: bool) {
-        dense_forward(&self.weight_t, &self.bias, x, out, relu);
+        dense_forward(&self.weights, &self.bias, x, out, relu);
     }
 }
 
@@ -77,11 +77,11 @@ const BLOCK: usize = 64;
 /// multiplies and adds (no FMA), so all versions give bit-identical results: estimates do not
 /// depend on the CPU they ran on.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
-fn dense_forward(weight_t: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], relu: bool) {
+fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], relu: bool) {
     let width = out.len();
     out.copy_from_slice(bias);
     if width.is_multiple_of(BLOCK) {
-        let panels = weight_t.chunks_exact(x.len() * BLOCK);
+        let panels = weights.chunks_exact(x.len() * BLOCK);
         for (out, panel) in out.chunks_exact_mut(BLOCK).zip(panels) {
             let mut acc = [0.0_f32; BLOCK];
             acc.copy_from_slice(out);
@@ -97,7 +97,7 @@ fn dense_forward(weight_t: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], rel
             out.copy_from_slice(&acc);
         }
     } else {
-        for (&xi, row) in x.iter().zip(weight_t.chunks_exact(width)) {
+        for (&xi, row) in x.iter().zip(weights.chunks_exact(width)) {
             if xi != 0.0 {
                 for (o, &w) in out.iter_mut().zip(row) {
                     *o += xi * w;
@@ -135,7 +135,7 @@ impl Predictor {
         let dense = |i: usize| {
             let (fan_in, fan_out) = (LAYER_SIZES[i], LAYER_SIZES[i + 1]);
             Dense {
-                weight_t: into_panels(
+                weights: into_panels(
                     model::transpose(&params.layers[i].weight, fan_out, fan_in),
                     fan_out,
                 ),

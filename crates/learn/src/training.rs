@@ -11,7 +11,7 @@ use burn::nn::loss::{HuberLoss, HuberLossConfig, Reduction};
 use burn::tensor::{Device, Tensor, TensorData};
 use serde::{Deserialize, Serialize};
 
-use crate::adamw::{AdamW, AdamWConfig};
+use crate::adamw::{AdamW, AdamWConfig, StepScalars};
 use crate::data::{FeatureSet, Shuffler};
 use crate::metrics::{self, Mae};
 use crate::model::{self, INPUTS, LAYER_SIZES, Mlp, OUTPUTS, Parameters, transpose};
@@ -278,6 +278,27 @@ pub struct Trainer {
     values: Vec<[Vec<f32>; 2]>,
 }
 
+/// Applies AdamW to the host copy `host` of parameter tensor `index` from its gradient, and
+/// returns the updated values as a tensor of `shape` for the next forward pass.
+fn host_update<const D: usize>(
+    optimizer: &mut AdamW,
+    s: &StepScalars,
+    index: usize,
+    host: &mut [f32],
+    grad: TensorData,
+    shape: [usize; D],
+    device: &Device,
+) -> Result<Tensor<D>, Error> {
+    let grad = grad
+        .as_slice::<f32>()
+        .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
+    optimizer.update(s, index, host, grad);
+    Ok(Tensor::from_data(
+        TensorData::new(host.to_vec(), shape),
+        device,
+    ))
+}
+
 impl Trainer {
     /// A trainer starting from `params` with `cfg`'s loss and optimiser settings (its `epochs`,
     /// `batch_size` and `seed` are not used here). Flushes subnormals on this thread and on
@@ -346,28 +367,18 @@ impl Trainer {
         {
             let shape = [LAYER_SIZES[i], LAYER_SIZES[i + 1]];
             if let Some(g) = linear.weight.val().grad(&grads) {
-                let g = g.into_data();
-                let g = g
-                    .as_slice::<f32>()
-                    .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
-                self.optimizer.update(&s, 2 * i, weight, g);
-                linear.weight = Param::from_tensor(Tensor::from_data(
-                    TensorData::new(weight.clone(), shape),
-                    &self.device,
-                ));
+                let (optimizer, device) = (&mut self.optimizer, &self.device);
+                let new = host_update(optimizer, &s, 2 * i, weight, g.into_data(), shape, device)?;
+                linear.weight = Param::from_tensor(new);
             }
             if let Some(param) = linear.bias.as_mut()
                 && let Some(g) = param.val().grad(&grads)
             {
-                let g = g.into_data();
-                let g = g
-                    .as_slice::<f32>()
-                    .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
-                self.optimizer.update(&s, 2 * i + 1, bias, g);
-                *param = Param::from_tensor(Tensor::from_data(
-                    TensorData::new(bias.clone(), [shape[1]]),
-                    &self.device,
-                ));
+                let (optimizer, device) = (&mut self.optimizer, &self.device);
+                let shape = [shape[1]];
+                let new =
+                    host_update(optimizer, &s, 2 * i + 1, bias, g.into_data(), shape, device)?;
+                *param = Param::from_tensor(new);
             }
         }
         Ok(value)

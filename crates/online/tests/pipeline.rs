@@ -9,7 +9,7 @@ use evtac_online::input::{
     self, EventSource, MemorySource, NetworkOptions, OpenOptions, SourceSpec,
 };
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Backoff, Estimate, Model, Notice};
+use evtac_online::{Backoff, Estimate, Model, Notice, Summary};
 use std::io::Write;
 use std::net::TcpListener;
 use std::ops::ControlFlow;
@@ -70,7 +70,7 @@ fn run_tcp(
     model: &Model,
     port: u16,
     network: NetworkOptions,
-) -> (Vec<Estimate>, Vec<Notice>, evtac_online::Summary) {
+) -> (Vec<Estimate>, Vec<Notice>, Summary) {
     let mut notices = Vec::new();
     let spec = SourceSpec::Tcp {
         host: "127.0.0.1".into(),
@@ -233,23 +233,19 @@ fn an_unreachable_server_fails_with_a_clear_message() {
     );
 }
 
-#[test]
-fn stopping_early_and_dropping_when_behind() {
-    let events: Vec<Event> = Synthetic::new(3, 300_000.0, 1000, 300_000).collect();
-    let dir = tempfile::tempdir().unwrap();
-    let model = model(dir.path());
-
-    // The caller stops after 10 estimates: the run ends cleanly.
-    let mut seen = 0;
+/// Runs `source` through the pipeline with a caller that breaks off after `n` estimates, and
+/// checks that it saw exactly `n`.
+fn break_after(source: impl EventSource + 'static, model: &Model, n: u64) -> Summary {
+    let mut seen = 0u64;
     let summary = pipeline::run(
-        MemorySource::new(events.clone(), 512),
+        source,
         model.estimator(SENSOR, 1000).unwrap(),
         &PipelineConfig::default(),
         |out| {
             if matches!(out, Output::Estimate(_)) {
                 seen += 1;
             }
-            if seen == 10 {
+            if seen == n {
                 ControlFlow::Break(())
             } else {
                 ControlFlow::Continue(())
@@ -257,7 +253,18 @@ fn stopping_early_and_dropping_when_behind() {
         },
     )
     .unwrap();
-    assert_eq!(seen, 10);
+    assert_eq!(seen, n);
+    summary
+}
+
+#[test]
+fn stopping_early_and_dropping_when_behind() {
+    let events: Vec<Event> = Synthetic::new(3, 300_000.0, 1000, 300_000).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+
+    // The caller stops after 10 estimates: the run ends cleanly.
+    let summary = break_after(MemorySource::new(events.clone(), 512), &model, 10);
     assert!(summary.estimates >= 10);
 
     // A one-chunk queue and a slow consumer: with dropping, events are dropped and counted,
@@ -373,24 +380,7 @@ fn a_stop_ends_the_run_with_its_summary_while_the_input_blocks() {
     assert_eq!(summary.events, events.len() as u64);
 
     // A caller that breaks off while the input blocks is not held up either.
-    let mut seen = 0u64;
-    let summary = pipeline::run(
-        silent(),
-        model.estimator(SENSOR, 1000).unwrap(),
-        &PipelineConfig::default(),
-        |out| {
-            if matches!(out, Output::Estimate(_)) {
-                seen += 1;
-            }
-            if seen == 20 {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        },
-    )
-    .unwrap();
-    assert_eq!(seen, 20);
+    let summary = break_after(silent(), &model, 20);
     assert!(summary.estimates >= 20);
 }
 

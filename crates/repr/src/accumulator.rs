@@ -167,13 +167,8 @@ impl StaticAccumulator {
         expf_slice(exponents, &mut decay, self.flavor);
         for (((&pixel, e), &f), out) in pixels.iter().zip(events).zip(&decay).zip(values) {
             let v = &mut self.potentials[pixel as usize];
-            let c = if p.ignore_polarity || e.polarity {
-                p.eta
-            } else {
-                -p.eta
-            };
             let n = p.neutral_potential;
-            *v = clamp((*v - n) * f + n + c, &p);
+            *v = clamp((*v - n) * f + n + contribution(&p, e.polarity), &p);
             *out = *v;
         }
         if let Some(last) = events.last() {
@@ -193,12 +188,7 @@ impl StaticAccumulator {
         let last = &mut self.times[pixel];
         *v = decay(p, *v, t - *last, self.flavor);
         *last = t;
-        let c = if p.ignore_polarity || polarity {
-            p.eta
-        } else {
-            -p.eta
-        };
-        *v = clamp(*v + c, p);
+        *v = clamp(*v + contribution(p, polarity), p);
         self.highest_time = t;
         *v
     }
@@ -279,6 +269,17 @@ impl StaticAccumulator {
         self.potentials.fill(self.params.neutral_potential);
         self.times.fill(0);
         self.highest_time = 0;
+    }
+}
+
+/// One event's contribution: `+eta` for ON events (or every event with ignored polarity),
+/// `-eta` for OFF events.
+#[inline(always)]
+fn contribution(p: &AccumulatorParams, polarity: bool) -> f32 {
+    if p.ignore_polarity || polarity {
+        p.eta
+    } else {
+        -p.eta
     }
 }
 

@@ -26,7 +26,6 @@ pub(crate) struct Fifo<T> {
     head: usize,
     /// Emptied blocks, kept for reuse.
     spare: Vec<Vec<T>>,
-    len: usize,
 }
 
 impl<T: Copy> Fifo<T> {
@@ -34,10 +33,9 @@ impl<T: Copy> Fifo<T> {
     pub(crate) fn new() -> Self {
         Self {
             full: VecDeque::new(),
-            tail: Vec::new(),
+            tail: Vec::with_capacity(BLOCK),
             head: 0,
             spare: Vec::new(),
-            len: 0,
         }
     }
 
@@ -46,11 +44,11 @@ impl<T: Copy> Fifo<T> {
     pub(crate) fn push_back(&mut self, item: T) {
         self.make_room();
         self.tail.push(item);
-        self.len += 1;
     }
 
     /// Makes sure the block being filled has room: a full one moves to the full blocks and a
-    /// spare (or new) block takes its place.
+    /// spare (or new) block takes its place. Blocks are allocated with room for [`BLOCK`]
+    /// entries, so filling one does not reallocate it.
     #[inline]
     fn make_room(&mut self) {
         if self.tail.len() == BLOCK {
@@ -60,8 +58,6 @@ impl<T: Copy> Fifo<T> {
                 .unwrap_or_else(|| Vec::with_capacity(BLOCK));
             let done = std::mem::replace(&mut self.tail, fresh);
             self.full.push_back(done);
-        } else if self.tail.capacity() == 0 {
-            self.tail.reserve_exact(BLOCK);
         }
     }
 
@@ -71,9 +67,8 @@ impl<T: Copy> Fifo<T> {
         let mut items = items.into_iter().peekable();
         while items.peek().is_some() {
             self.make_room();
-            let before = self.tail.len();
-            self.tail.extend(items.by_ref().take(BLOCK - before));
-            self.len += self.tail.len() - before;
+            let room = BLOCK - self.tail.len();
+            self.tail.extend(items.by_ref().take(room));
         }
     }
 
@@ -89,7 +84,6 @@ impl<T: Copy> Fifo<T> {
             tail,
             head,
             spare,
-            len,
         } = self;
         loop {
             let block = full.front().unwrap_or(tail);
@@ -98,7 +92,6 @@ impl<T: Copy> Fifo<T> {
                     return;
                 }
                 *head += 1;
-                *len -= 1;
                 on_pop(*item);
             }
             // The oldest block is used up.
@@ -116,9 +109,15 @@ impl<T: Copy> Fifo<T> {
         }
     }
 
-    /// Number of entries.
+    /// Number of entries: the full blocks and the one being filled, less those taken from
+    /// the oldest.
     pub(crate) fn len(&self) -> usize {
-        self.len
+        self.full.len() * BLOCK + self.tail.len() - self.head
+    }
+
+    /// Whether the queue holds no entry.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 
     /// Removes every entry (keeping the blocks for reuse).
@@ -129,7 +128,6 @@ impl<T: Copy> Fifo<T> {
         }
         self.tail.clear();
         self.head = 0;
-        self.len = 0;
     }
 }
 

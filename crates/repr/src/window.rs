@@ -64,7 +64,7 @@ impl SlidingWindow {
     /// When a pixel is outside the frame, or `counts` or `pixels` is shorter than `events`.
     #[inline]
     pub(crate) fn add_batch(&mut self, events: &[Event], pixels: &[u32], counts: &mut [u32]) {
-        for ((&p, _), out) in pixels.iter().zip(events).zip(counts.iter_mut()) {
+        for (&p, out) in pixels[..events.len()].iter().zip(counts.iter_mut()) {
             let c = &mut self.counts[p as usize];
             *c += 1;
             *out = *c;
@@ -107,7 +107,7 @@ impl SlidingWindow {
 
     /// Whether the window holds no event.
     pub fn is_empty(&self) -> bool {
-        self.queue.len() == 0
+        self.queue.is_empty()
     }
 
     /// Empties the window.
