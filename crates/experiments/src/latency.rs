@@ -5,13 +5,16 @@
 //! interval.
 //!
 //! Events before motion onset are applied before timing starts: the sensor is still then and an
-//! online system would have processed them as they came. Runs on the calling thread, alone.
+//! online system would have processed them as they came (and made an estimate from them, which
+//! primes the [`StreamingPredictor`] the steps run through, as `evtac online` does). Runs on the
+//! calling thread, alone.
 
 use crate::dataset::{self, Dataset, FRAME};
 use crate::results::LatencyCell;
 use crate::sampling::{MOTION_POINTS, equally_spaced_indices};
 use crate::training::Model;
 use evtac_events::manifest::TrialMeta;
+use evtac_learn::StreamingPredictor;
 use evtac_repr::{FeatureExtractor, Mask};
 use std::time::Instant;
 
@@ -51,6 +54,7 @@ pub fn measure(
                 source,
             }
         })?;
+    let mut stream = StreamingPredictor::new(model.predictor.clone());
     let mut times_us = Vec::new();
     for meta in trials {
         let path = ds.dir.join(&meta.file);
@@ -64,6 +68,7 @@ pub fn measure(
         let mut cursor = events.partition_point(|e| e.t <= meta.motion_start_us);
         fx.push_with_roi(&events[..cursor], &roi).map_err(repr)?;
         fx.advance_to(meta.motion_start_us).map_err(repr)?;
+        stream.predict(fx.features(0));
         let mut trial_times = Vec::new();
         let mut t_k = meta.motion_start_us + step;
         while t_k <= meta.motion_end_us {
@@ -71,7 +76,7 @@ pub fn measure(
             let end = cursor + events[cursor..].partition_point(|e| e.t <= t_k);
             fx.push_with_roi(&events[cursor..end], &roi).map_err(repr)?;
             fx.advance_to(t_k).map_err(repr)?;
-            let y = model.predictor.predict_one(fx.features(0));
+            let y = stream.predict(fx.features(0));
             std::hint::black_box(y);
             trial_times.push(started.elapsed().as_secs_f64() * 1e6);
             cursor = end;

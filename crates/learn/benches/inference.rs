@@ -1,6 +1,10 @@
 //! Single-sample inference latency: the hand-written [`Predictor`] against burn's forward pass on
 //! the same weights (the measurement behind the predictor's design), plus a tail-latency table
-//! (median, P99, P99.9) printed before criterion's runs.
+//! (median, P99, P99.9) printed before criterion's runs. Three inputs for the hand-written pass:
+//! sparse off-grid features (float32 first layer), dense pooled features (every value a multiple
+//! of 1/64: the exact first layer from scratch), and a stream of pooled samples each differing
+//! from the previous one in 50 cells, run through a [`StreamingPredictor`] (what the online
+//! estimator does at 3 M events/s).
 //!
 //! The PyTorch CPU reference is `benches/pytorch_baseline.py` (run in the same session).
 
@@ -9,7 +13,7 @@ use std::time::Instant;
 
 use burn::tensor::{Device, Tensor, TensorData};
 use criterion::{Criterion, criterion_group, criterion_main};
-use evtac_learn::{Mlp, Parameters, Predictor};
+use evtac_learn::{Mlp, Parameters, Predictor, StreamingPredictor};
 
 /// A sparse feature vector like a pooled binarised representation.
 fn sample(k: usize) -> Vec<f32> {
@@ -22,6 +26,33 @@ fn sample(k: usize) -> Vec<f32> {
             }
         })
         .collect()
+}
+
+/// Dense pooled features (a multiple of 1/64 in every cell), like a combined representation.
+fn pooled(k: usize) -> Vec<f32> {
+    (0..900)
+        .map(|j| ((j * 13 + k) % 64 + 1) as f32 / 64.0)
+        .collect()
+}
+
+/// 64 pooled samples in a loop, each differing from the one before in 50 cells by one count.
+fn pooled_stream() -> Vec<Vec<f32>> {
+    let mut x = pooled(0);
+    let mut out = Vec::new();
+    for k in 0..64 {
+        for c in 0..50 {
+            let cell = (k * 389 + c * 17) % 900;
+            let count = (x[cell] * 64.0) as u8;
+            let count = if k < 32 {
+                count % 64 + 1
+            } else {
+                count.max(2) - 1
+            };
+            x[cell] = f32::from(count) / 64.0;
+        }
+        out.push(x.clone());
+    }
+    out
 }
 
 /// Median, P99 and P99.9 in microseconds of `f` over `n` timed calls.
@@ -55,9 +86,24 @@ fn bench(c: &mut Criterion) {
         [out[0], out[1]]
     };
 
+    let dense: Vec<Vec<f32>> = (0..64).map(pooled).collect();
+    let stream = pooled_stream();
+    let mut streaming = StreamingPredictor::new(predictor.clone());
     for (name, stats) in [
         (
-            "hand-written",
+            "hand-written, pooled (exact first layer)",
+            percentiles(100_000, |i| {
+                black_box(predictor.predict_one(&dense[i % 64]));
+            }),
+        ),
+        (
+            "hand-written, streaming (50 cells changed)",
+            percentiles(100_000, |i| {
+                black_box(streaming.predict(&stream[i % 64]));
+            }),
+        ),
+        (
+            "hand-written, off-grid (float32 first layer)",
             percentiles(100_000, |i| {
                 black_box(predictor.predict_one(&samples[i % 64]));
             }),
@@ -80,6 +126,18 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             i = (i + 1) % 64;
             black_box(predictor.predict_one(black_box(&samples[i])))
+        })
+    });
+    c.bench_function("predict_one/hand-written-pooled", |b| {
+        b.iter(|| {
+            i = (i + 1) % 64;
+            black_box(predictor.predict_one(black_box(&dense[i])))
+        })
+    });
+    c.bench_function("predict/streaming-50-cells", |b| {
+        b.iter(|| {
+            i = (i + 1) % 64;
+            black_box(streaming.predict(black_box(&stream[i])))
         })
     });
     c.bench_function("predict_one/burn-flex", |b| {

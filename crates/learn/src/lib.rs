@@ -10,6 +10,9 @@
 //! - [`bundle`]: the [`ModelBundle`] folder (`model.safetensors`, `config.json`, `mask.npy`,
 //!   `history.csv`).
 //! - [`predictor`]: allocation-free single-sample inference ([`Predictor`]).
+//! - [`cell_layer`]: the first layer computed exactly on pooled cell counts, and
+//!   [`streaming`]: [`StreamingPredictor`], which updates it from the cells that changed
+//!   between consecutive samples (what a live estimator needs).
 //! - [`metrics`]: MAE overall / pitch / roll.
 //! - [`ftz`]: [`flush_denormals`], to call on every thread that trains or infers.
 //!
@@ -35,11 +38,13 @@
 
 pub mod adamw;
 pub mod bundle;
+pub mod cell_layer;
 pub mod data;
 pub mod ftz;
 pub mod metrics;
 pub mod model;
 pub mod predictor;
+pub mod streaming;
 pub mod training;
 
 pub use adamw::AdamWConfig;
@@ -49,4 +54,5 @@ pub use ftz::flush_denormals;
 pub use metrics::{Mae, mae};
 pub use model::{INPUTS, Mlp, OUTPUTS, Parameters};
 pub use predictor::Predictor;
+pub use streaming::StreamingPredictor;
 pub use training::{EpochRecord, TrainConfig, Trained, Trainer, train};

@@ -4,17 +4,23 @@
 //! per-call overhead dominates a single 900-feature sample: creating input tensors, dispatching
 //! eight operations and reading the result back allocates on every call and costs tens of
 //! microseconds before any arithmetic (measured in `benches/inference.rs`, which times both). The
-//! hand-written pass is allocation-free: activations live in fixed-size stack arrays and each
-//! layer is a sequence of `y += x[i] * W[i, :]` row updates over the transposed weight
-//! (`[in, out]`), 64 outputs at a time held in registers, which vectorises without horizontal
-//! sums and skips zero inputs outright (the masked, binarised representations are mostly
-//! zeros). The weights of each 64-output block are stored together (`[block][in][64]`), so a
-//! block streams through one contiguous panel: next to the representation's state the first
-//! layer's 0.9 MB no longer stays in a 1 MB L2 cache, and a contiguous stream is what the
-//! prefetcher brings in from L3 fastest (dynamic estimate at 3M events/s: 53 -> 46 us
-//! median). It is compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time,
-//! with identical results on all three. Training stays on burn.
+//! hand-written pass is allocation-free: activations live in fixed-size stack arrays.
+//!
+//! The first layer has two forms:
+//! - on pooled features (every feature a multiple of 1/64 in `[0, 1]`, which is what every
+//!   evtac representation produces) it is computed exactly from the cell counts with
+//!   fixed-point weights ([`crate::cell_layer`]), so that [`crate::StreamingPredictor`] can
+//!   update it from the cells that changed and still give the same bits;
+//! - on any other input, in float32 like the other layers.
+//!
+//! The float32 layers are sequences of `y += x[i] * W[i, :]` row updates over the transposed
+//! weight (`[in, out]`), 64 outputs at a time held in registers, which vectorises without
+//! horizontal sums and skips zero inputs outright. The weights of each 64-output block are
+//! stored together (`[block][in][64]`), so a block streams through one contiguous panel. They
+//! are compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time, with
+//! identical results on all three. Training stays on burn.
 
+use crate::cell_layer::{self, CellLayer};
 use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
 
 /// Errors of this module.
@@ -32,7 +38,8 @@ pub enum Error {
     },
 }
 
-const H1: usize = LAYER_SIZES[1];
+/// Width of the first hidden layer.
+pub(crate) const H1: usize = LAYER_SIZES[1];
 const H2: usize = LAYER_SIZES[2];
 const H3: usize = LAYER_SIZES[3];
 
@@ -123,6 +130,8 @@ fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], relu
 /// ```
 #[derive(Debug, Clone)]
 pub struct Predictor {
+    /// The first layer in fixed point, for pooled features.
+    cells: CellLayer,
     layers: [Dense; 4],
 }
 
@@ -142,12 +151,19 @@ impl Predictor {
                 bias: params.layers[i].bias.clone(),
             }
         };
+        let first = &params.layers[0];
         Ok(Self {
+            cells: CellLayer::new(
+                &model::transpose(&first.weight, LAYER_SIZES[1], INPUTS),
+                &first.bias,
+            ),
             layers: [dense(0), dense(1), dense(2), dense(3)],
         })
     }
 
-    /// (pitch, roll) in degrees for one sample of 900 features. Allocation-free.
+    /// (pitch, roll) in degrees for one sample of 900 features. Allocation-free. Pooled
+    /// features (multiples of 1/64 in `[0, 1]`) go through the exact first layer (see the
+    /// module docs), any others through the float32 one.
     ///
     /// # Panics
     ///
@@ -160,15 +176,32 @@ impl Predictor {
             "predict_one needs {INPUTS} features"
         );
         let mut h1 = [0.0_f32; H1];
+        let mut counts = [0_u8; INPUTS];
+        if cell_layer::cell_counts(features, &mut counts).is_some() {
+            let mut sums = [0.0_f64; H1];
+            self.cells.sums(&counts, &mut sums);
+            self.cells.output(&sums, &mut h1);
+        } else {
+            self.layers[0].forward(features, &mut h1, true);
+        }
+        self.after_first_layer(&h1)
+    }
+
+    /// The layers after the first, from its output.
+    pub(crate) fn after_first_layer(&self, h1: &[f32; H1]) -> [f32; 2] {
         let mut h2 = [0.0_f32; H2];
         let mut h3 = [0.0_f32; H3];
         let mut out = [0.0_f32; OUTPUTS];
-        let [l0, l1, l2, l3] = &self.layers;
-        l0.forward(features, &mut h1, true);
-        l1.forward(&h1, &mut h2, true);
+        let [_, l1, l2, l3] = &self.layers;
+        l1.forward(h1, &mut h2, true);
         l2.forward(&h2, &mut h3, true);
         l3.forward(&h3, &mut out, false);
         out
+    }
+
+    /// The first layer in fixed point.
+    pub(crate) fn cell_layer(&self) -> &CellLayer {
+        &self.cells
     }
 
     /// (pitch, roll) for every row of `features` (n x 900, flat).
@@ -178,9 +211,12 @@ impl Predictor {
                 len: features.len(),
             });
         }
+        // Rows in a set are mostly consecutive samples of a trial, which differ in few cells:
+        // streaming through them gives the same results as one at a time, faster.
+        let mut stream = crate::streaming::CellSums::new();
         Ok(features
             .chunks_exact(INPUTS)
-            .map(|row| self.predict_one(row))
+            .map(|row| stream.predict(self, row))
             .collect())
     }
 }
@@ -208,6 +244,12 @@ mod tests {
             for k in 0..OUTPUTS {
                 assert!((f64::from(g[k]) - r[k]).abs() < 1e-4, "{g:?} vs {r:?}");
             }
+        }
+        // Pooled features take the exact first layer.
+        let pooled: Vec<f32> = (0..INPUTS).map(|i| ((i * 11) % 65) as f32 / 64.0).collect();
+        let (g, r) = (p.predict_one(&pooled), params.forward_f64(&pooled));
+        for k in 0..OUTPUTS {
+            assert!((f64::from(g[k]) - r[k]).abs() < 1e-4, "{g:?} vs {r:?}");
         }
         assert!(matches!(
             p.predict(&x[1..]),
