@@ -14,7 +14,7 @@
 //! integers below `2^46` in magnitude: exact in `f64`, whatever the order of the terms. That
 //! is the point: adding `(new - old) * q_i` for the cells that changed since the previous
 //! sample gives the same bits as summing every cell from scratch, so a live estimator only
-//! touches the rows of the few cells that changed (about 50 of 900 per millisecond at 3 M
+//! touches the rows of the few cells that changed (50-85 of 900 per millisecond at 3 M
 //! events/s) instead of streaming all 0.9 MB of weights through the cache for every estimate
 //! ([`crate::StreamingPredictor`]). The scaling by a power of two is exact, the bias is added
 //! with one rounding in `f64`, then one rounding to `f32`. It is also the same on every CPU.

@@ -11,7 +11,8 @@
 //! that changed since the previous estimate (a few dozen of 900 per millisecond), with the
 //! same results as a full forward pass. Reading the whole first layer (0.9 MB) for every
 //! estimate also pushed the representation's state out of the 1 MB L2 cache before the next
-//! interval's events (combined at 3 M events/s in 1 ms packets: about 72 -> 55 us median,
+//! interval's events (combined at 3 M events/s in 1 ms packets: 70-74 -> 63-65 us median in
+//! interleaved runs; at 300 k events/s the whole estimate's cost about halves,
 //! `benches/latency.rs`).
 
 use crate::latency::LatencyStats;
