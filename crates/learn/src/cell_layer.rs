@@ -32,9 +32,9 @@ pub const CELL_PIXELS: u8 = 64;
 /// stay below `2^46`, well inside `f64`'s 53-bit integers.
 const Q_MAX: f64 = (1u64 << 30) as f64;
 
-/// The pooled cell counts behind `features` (`count = x * 64`), or `None` when a feature is
-/// not a multiple of 1/64 in `[0, 1]`.
-pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> Option<()> {
+/// Writes the pooled cell counts behind `features` (`count = x * 64`) into `counts`; `false`
+/// when a feature is not a multiple of 1/64 in `[0, 1]` (then `counts` means nothing).
+pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> bool {
     let mut on_grid = true;
     for (c, &x) in counts.iter_mut().zip(features) {
         // Exact for every multiple of 1/64: multiplying by a power of two only moves the
@@ -45,7 +45,7 @@ pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> Option
         *c = scaled as u8;
         on_grid &= f32::from(*c) == scaled && *c <= CELL_PIXELS;
     }
-    on_grid.then_some(())
+    on_grid
 }
 
 /// The first layer in fixed point (see the module docs): weights `[in][out]` row-major, so
@@ -132,9 +132,7 @@ fn sums(q: &[i32], fan_out: usize, counts: &[u8; INPUTS], acc: &mut [f64]) {
     if !fan_out.is_multiple_of(BLOCK) {
         for (row, &c) in q.chunks_exact(fan_out).zip(counts) {
             if c != 0 {
-                for (a, &w) in acc.iter_mut().zip(row) {
-                    *a += f64::from(c) * f64::from(w);
-                }
+                add_scaled(acc, row, f64::from(c));
             }
         }
         return;
@@ -143,10 +141,7 @@ fn sums(q: &[i32], fan_out: usize, counts: &[u8; INPUTS], acc: &mut [f64]) {
         let mut block = [0.0_f64; BLOCK];
         for (row, &c) in q.chunks_exact(fan_out).zip(counts) {
             if c != 0 {
-                let row = &row[b * BLOCK..(b + 1) * BLOCK];
-                for (a, &w) in block.iter_mut().zip(row) {
-                    *a += f64::from(c) * f64::from(w);
-                }
+                add_scaled(&mut block, &row[b * BLOCK..(b + 1) * BLOCK], f64::from(c));
             }
         }
         out.copy_from_slice(&block);
@@ -157,6 +152,13 @@ fn sums(q: &[i32], fan_out: usize, counts: &[u8; INPUTS], acc: &mut [f64]) {
 /// value is an integer below `2^53`, so the result is exact on all of them.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 fn add_row(acc: &mut [f64], row: &[i32], delta: f64) {
+    add_scaled(acc, row, delta);
+}
+
+/// The one loop behind [`add_row`] and [`sums`], inlined into each compiled version so that it
+/// vectorises with that version's instructions.
+#[inline(always)]
+fn add_scaled(acc: &mut [f64], row: &[i32], delta: f64) {
     for (a, &q) in acc.iter_mut().zip(row) {
         *a += delta * f64::from(q);
     }
@@ -182,11 +184,11 @@ mod tests {
         let mut x = [0.0_f32; INPUTS];
         x[3] = 1.0;
         x[7] = 5.0 / 64.0;
-        assert!(cell_counts(&x, &mut counts).is_some());
+        assert!(cell_counts(&x, &mut counts));
         assert_eq!((counts[3], counts[7], counts[0]), (64, 5, 0));
         for bad in [0.1, -1.0 / 64.0, 65.0 / 64.0, f32::NAN, f32::INFINITY] {
             x[5] = bad;
-            assert!(cell_counts(&x, &mut counts).is_none(), "{bad}");
+            assert!(!cell_counts(&x, &mut counts), "{bad}");
         }
     }
 

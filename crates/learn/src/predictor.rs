@@ -177,7 +177,7 @@ impl Predictor {
         );
         let mut h1 = [0.0_f32; H1];
         let mut counts = [0_u8; INPUTS];
-        if cell_layer::cell_counts(features, &mut counts).is_some() {
+        if cell_layer::cell_counts(features, &mut counts) {
             let mut sums = [0.0_f64; H1];
             self.cells.sums(&counts, &mut sums);
             self.cells.output(&sums, &mut h1);

@@ -90,7 +90,7 @@ impl CellSums {
             "StreamingPredictor::predict needs {INPUTS} features"
         );
         let mut counts = [0_u8; INPUTS];
-        if cell_layer::cell_counts(features, &mut counts).is_none() {
+        if !cell_layer::cell_counts(features, &mut counts) {
             return predictor.predict_one(features);
         }
         let layer = predictor.cell_layer();
