@@ -109,7 +109,10 @@ impl Estimator {
     ) -> Result<Self, Error> {
         let crop = Resolution::new(CROP_SIZE, CROP_SIZE);
         let roi = Roi::centered(sensor, crop).ok_or(Error::SensorTooSmall { sensor })?;
-        let extractor = FeatureExtractor::new(std::slice::from_ref(representation), crop, mask)?;
+        // Where the representation allows it (the combined one), the accumulator takes events
+        // as they leave the window, in the work done ahead of each estimate.
+        let extractor = FeatureExtractor::new(std::slice::from_ref(representation), crop, mask)?
+            .deferring_accumulation();
         let schedule = Schedule::new(interval_us)?;
         let interval = Duration::from_micros(interval_us.unsigned_abs());
         Ok(Self {
@@ -184,17 +187,19 @@ impl Estimator {
             self.counters.span_us = Some((first, last));
         }
         self.extractor.push(crop)?;
-        if let Some(next) = self.schedule.next() {
-            // Apply what belongs to the next estimate now: when a later chunk makes it final,
-            // only that chunk's events are left to do (a live stream arrives in many packets
-            // per interval).
-            self.extractor.prepare(next)?;
-        }
         // An event at `t` proves that every event before `t` has arrived; one at `t` itself
         // may still follow in the next chunk.
         let proven = latest.map_or(i64::MIN, |t| t.saturating_sub(1));
         let horizon = horizon.map_or(proven, |h| h.max(proven));
-        self.estimate_until(horizon, arrival, emit)
+        self.estimate_until(horizon, arrival, emit)?;
+        if let Some(next) = self.schedule.next() {
+            // Ahead of the next estimate, after this chunk's estimates are out: apply the
+            // events that belong to it and let the windows drop what leaves them by then
+            // (known now: the window reaches back past every event yet to come). When a later
+            // chunk makes it final, only that chunk's events are left to do.
+            self.extractor.prepare(next)?;
+        }
+        Ok(())
     }
 
     /// Ends the stream: emits the estimates up to the last event's time.

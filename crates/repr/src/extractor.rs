@@ -24,6 +24,18 @@
 //! the window, and since the potential (lazy decay) has not changed since that event, it is
 //! computed then, from the potential, when the dynamic pixel clears.
 //!
+//! # Deferred accumulation
+//! That shortcut goes one step further on request ([`FeatureExtractor::deferring_accumulation`],
+//! what the online estimator uses). If every static plane of an accumulator is such a lazy plane
+//! and they are all read by one window, the potential is only ever read when a pixel's last
+//! event leaves that window, and all of the pixel's events have left it by then. So the
+//! accumulator can take each event as it *leaves* the window instead of when it arrives: per
+//! pixel it sees the same events in the same order and computes the same potentials, only later.
+//! The outputs are identical; the accumulator's work (the exponential decay per event, the
+//! costliest step) moves from the events that just arrived to those leaving, which a live
+//! estimator handles in [`FeatureExtractor::prepare`] ahead of the next sample. The potentials
+//! themselves then lag by the window, so [`FeatureExtractor::potentials`] withholds them.
+//!
 //! # Edge cases, documented
 //! - Before the first event, or for an empty stream, every output is the initial state:
 //!   potentials at the neutral potential, counts 0, thresholded as usual (all zero with the
@@ -51,11 +63,16 @@ struct AccSlot {
     params: AccumulatorParams,
     acc: StaticAccumulator,
     planes: Vec<usize>,
+    /// Fed from its window as events leave it, not as they arrive (see "Deferred
+    /// accumulation" in the module docs).
+    deferred: bool,
 }
 
 struct WindowSlot {
     window: SlidingWindow,
     planes: Vec<usize>,
+    /// The deferred accumulators this window feeds.
+    deferred: Vec<usize>,
 }
 
 struct StaticPlane {
@@ -228,6 +245,7 @@ impl FeatureExtractor {
                         params,
                         acc: StaticAccumulator::with_params(frame, params),
                         planes: Vec::new(),
+                        deferred: false,
                     },
                 );
                 let rule = StaticThreshold::new(s);
@@ -257,6 +275,7 @@ impl FeatureExtractor {
                     || WindowSlot {
                         window: SlidingWindow::new(frame, window_us),
                         planes: Vec::new(),
+                        deferred: Vec::new(),
                     },
                 );
                 let plane = index_or_push(
@@ -430,22 +449,107 @@ impl FeatureExtractor {
         }
         pending.drain(..n);
         for slot in windows.iter_mut() {
-            let planes = &slot.planes;
-            slot.window.expire_through(t_k, |pixel, count| {
-                let p = pixel as usize;
-                for &dp in planes {
-                    // One event fewer clears the pixel exactly when the count falls to the
-                    // threshold.
-                    if count == dplanes[dp].count_threshold {
-                        dplanes[dp].bits[p] = 0;
-                        let targets = &dplanes[dp].outputs;
-                        settle_lazy_static_bits(targets, outputs, splanes, accs, masks, p);
-                        propagate(outputs, targets, splanes, dplanes, p);
-                    }
+            let WindowSlot {
+                window,
+                planes,
+                deferred,
+            } = slot;
+            if deferred.is_empty() {
+                window.expire_through(t_k, |pixel, count| {
+                    clear_expired(planes, pixel, count, accs, splanes, dplanes, outputs, masks);
+                });
+                continue;
+            }
+            window.expire_batches_through::<BATCH>(t_k, |batch| {
+                // The deferred accumulators take the events first: a pixel that clears has
+                // then had all of its events applied (none of its events is left in the window,
+                // so none follows in the batch).
+                let mut pixels = [0u32; BATCH];
+                let mut events = [Event::default(); BATCH];
+                for ((p, e), x) in pixels.iter_mut().zip(&mut events).zip(batch) {
+                    *p = x.entry.pixel;
+                    e.t = x.entry.t;
+                    e.polarity = x.entry.polarity;
+                }
+                let mut values = [0f32; BATCH];
+                for &a in deferred.iter() {
+                    let n = batch.len();
+                    accs[a]
+                        .acc
+                        .update_batch(&pixels[..n], &events[..n], &mut values);
+                }
+                for x in batch {
+                    let (pixel, count) = (x.entry.pixel, x.count);
+                    clear_expired(planes, pixel, count, accs, splanes, dplanes, outputs, masks);
                 }
             });
         }
         Ok(())
+    }
+
+    /// Defers accumulation where the outputs allow it, for live use, and resets the extractor
+    /// to its initial state. An accumulator whose static planes are only read when a pixel's
+    /// last event leaves a window (combined outputs with `count_threshold` 0, one window
+    /// length) then takes each event when it leaves that window instead of when it arrives:
+    /// outputs and features are the same, but the work moves from [`Self::advance_to`] to
+    /// [`Self::prepare`] calls that run ahead of the next sample. [`Self::potentials`] returns
+    /// `None` for such outputs (their potentials lag by the window). See "Deferred
+    /// accumulation" in the module docs.
+    ///
+    /// ```
+    /// use evtac_events::{Event, Resolution};
+    /// use evtac_repr::{FeatureExtractor, ReprConfig};
+    ///
+    /// // The paper's combined representation.
+    /// let frame = Resolution::new(240, 240);
+    /// let mut fx =
+    ///     FeatureExtractor::new(&[ReprConfig::default()], frame, None)?.deferring_accumulation();
+    /// assert_eq!(fx.deferred_accumulators(), 1);
+    /// let e = |t| Event { t, x: 3, y: 4, polarity: true };
+    /// fx.push(&[e(1_000), e(2_000), e(3_000)])?;
+    /// fx.advance_to(3_000)?;
+    /// assert!(fx.potentials(0).is_none());
+    /// fx.advance_to(700_000)?; // all three left the 640 ms window: the static part holds
+    /// assert_eq!(fx.frame(0)[4 * 240 + 3], 1);
+    /// # Ok::<(), evtac_repr::ReprError>(())
+    /// ```
+    pub fn deferring_accumulation(mut self) -> Self {
+        self.reset();
+        let Self {
+            accs,
+            windows,
+            splanes,
+            dplanes,
+            outputs,
+            ..
+        } = &mut self;
+        for (a, slot) in accs.iter_mut().enumerate() {
+            // The windows whose clearing reads the accumulator's planes; `lazy` planes only
+            // feed combined outputs.
+            let mut feeding = Vec::new();
+            let mut all_lazy = true;
+            for &sp in &slot.planes {
+                all_lazy &= splanes[sp].lazy;
+                for &o in &splanes[sp].outputs {
+                    if let Kind::Combined(_, d) = outputs[o].kind
+                        && !feeding.contains(&dplanes[d].window)
+                    {
+                        feeding.push(dplanes[d].window);
+                    }
+                }
+            }
+            if let (&[w], true) = (&feeding[..], all_lazy) {
+                slot.deferred = true;
+                windows[w].deferred.push(a);
+            }
+        }
+        self
+    }
+
+    /// How many accumulators take their events as they leave a window (see
+    /// [`Self::deferring_accumulation`]).
+    pub fn deferred_accumulators(&self) -> usize {
+        self.accs.iter().filter(|a| a.deferred).count()
     }
 
     /// Recomputes static planes in full from their accumulators: all of them (`sync_only`
@@ -495,14 +599,17 @@ impl FeatureExtractor {
         self.outputs[i].pool.frame()
     }
 
-    /// The potential surface behind output `i` (static and combined configs), row-major.
+    /// The potential surface behind output `i` (static and combined configs), row-major;
+    /// `None` for dynamic configs and for deferred accumulators
+    /// ([`Self::deferring_accumulation`]).
     ///
     /// # Panics
     /// When `i >= self.len()`.
     pub fn potentials(&self, i: usize) -> Option<&[f32]> {
         match self.outputs[i].kind {
             Kind::Static(s) | Kind::Combined(s, _) => {
-                Some(self.accs[self.splanes[s].acc].acc.potentials())
+                let slot = &self.accs[self.splanes[s].acc];
+                (!slot.deferred).then(|| slot.acc.potentials())
             }
             Kind::Dynamic(_) => None,
         }
@@ -638,7 +745,7 @@ fn apply_batch(
     for (p, e) in pixels.iter_mut().zip(batch) {
         *p = u32::from(e.y) * width + u32::from(e.x);
         // The whole batch's state is requested at once: the loads overlap.
-        for slot in accs.iter() {
+        for slot in accs.iter().filter(|a| !a.deferred) {
             slot.acc.prefetch(*p as usize);
         }
         for slot in windows.iter() {
@@ -646,7 +753,7 @@ fn apply_batch(
         }
     }
     let mut values = [0f32; BATCH];
-    for slot in accs.iter_mut() {
+    for slot in accs.iter_mut().filter(|a| !a.deferred) {
         slot.acc.update_batch(pixels, batch, &mut values);
         if slot.params.synchronous_decay {
             // Recomputed in full after the synchronous decay in `advance_to`.
@@ -687,6 +794,32 @@ fn apply_batch(
                     propagate(outputs, &dplanes[dp].outputs, splanes, dplanes, p);
                 }
             }
+        }
+    }
+}
+
+/// After an event at pixel `pixel` left a window, leaving `count` there: clears the pixel in
+/// the window's dynamic `planes` whose threshold it fell to, and updates their outputs.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn clear_expired(
+    planes: &[usize],
+    pixel: u32,
+    count: u32,
+    accs: &[AccSlot],
+    splanes: &mut [StaticPlane],
+    dplanes: &mut [DynamicPlane],
+    outputs: &mut [Output],
+    masks: &[Mask],
+) {
+    let p = pixel as usize;
+    for &dp in planes {
+        // One event fewer clears the pixel exactly when the count falls to the threshold.
+        if count == dplanes[dp].count_threshold {
+            dplanes[dp].bits[p] = 0;
+            let targets = &dplanes[dp].outputs;
+            settle_lazy_static_bits(targets, outputs, splanes, accs, masks, p);
+            propagate(outputs, targets, splanes, dplanes, p);
         }
     }
 }

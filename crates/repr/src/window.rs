@@ -24,9 +24,26 @@ use evtac_events::Resolution;
 pub struct SlidingWindow {
     window_us: i64,
     counts: Vec<u32>,
-    /// `(t, pixel)` of every event in the window, oldest first (in blocks: a window of
-    /// millions of events grows without copying, see [`crate::fifo`]).
-    queue: Fifo<(i64, u32)>,
+    /// Every event in the window, oldest first (in blocks: a window of millions of events
+    /// grows without copying, see [`crate::fifo`]).
+    queue: Fifo<Entry>,
+}
+
+/// One event in the window. The polarity costs nothing (the entry is padded to 16 bytes
+/// anyway) and lets an accumulator take the event when it leaves (see
+/// [`SlidingWindow::expire_batches_through`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Entry {
+    pub(crate) t: i64,
+    pub(crate) pixel: u32,
+    pub(crate) polarity: bool,
+}
+
+/// An event that left the window, with its pixel's count after it left.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Expired {
+    pub(crate) entry: Entry,
+    pub(crate) count: u32,
 }
 
 impl SlidingWindow {
@@ -53,7 +70,13 @@ impl SlidingWindow {
     pub fn add(&mut self, t: i64, pixel: u32) -> u32 {
         let c = &mut self.counts[pixel as usize];
         *c += 1;
-        self.queue.push_back((t, pixel));
+        // The polarity is only read by an accumulator fed from the window, which the
+        // extractor sets up through `add_batch`.
+        self.queue.push_back(Entry {
+            t,
+            pixel,
+            polarity: true,
+        });
         *c
     }
 
@@ -70,7 +93,11 @@ impl SlidingWindow {
             *out = *c;
         }
         self.queue
-            .extend(events.iter().zip(pixels).map(|(e, &p)| (e.t, p)));
+            .extend(events.iter().zip(pixels).map(|(e, &pixel)| Entry {
+                t: e.t,
+                pixel,
+                polarity: e.polarity,
+            }));
     }
 
     /// Hints the cache to load pixel `pixel`'s count (an event for it is coming).
@@ -86,13 +113,43 @@ impl SlidingWindow {
         let start = t_k.saturating_sub(self.window_us);
         let counts = &mut self.counts;
         self.queue.pop_while(
-            |&(t, _)| t <= start,
-            |(_, pixel)| {
-                let c = &mut counts[pixel as usize];
+            |e| e.t <= start,
+            |e| {
+                let c = &mut counts[e.pixel as usize];
                 *c -= 1;
-                on_expire(pixel, *c);
+                on_expire(e.pixel, *c);
             },
         );
+    }
+
+    /// [`Self::expire_through`] in batches of at most `BATCH`: each batch of events that left,
+    /// oldest first, is handed to `on_batch` after their counts have been decremented.
+    #[inline]
+    pub(crate) fn expire_batches_through<const BATCH: usize>(
+        &mut self,
+        t_k: i64,
+        mut on_batch: impl FnMut(&[Expired]),
+    ) {
+        let start = t_k.saturating_sub(self.window_us);
+        let counts = &mut self.counts;
+        let mut batch = [Expired::default(); BATCH];
+        let mut n = 0;
+        self.queue.pop_while(
+            |e| e.t <= start,
+            |entry| {
+                let c = &mut counts[entry.pixel as usize];
+                *c -= 1;
+                batch[n] = Expired { entry, count: *c };
+                n += 1;
+                if n == BATCH {
+                    on_batch(&batch);
+                    n = 0;
+                }
+            },
+        );
+        if n > 0 {
+            on_batch(&batch[..n]);
+        }
     }
 
     /// The per-pixel counts, row-major.
@@ -120,6 +177,39 @@ impl SlidingWindow {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batched_expiry_hands_over_what_single_expiry_reports() {
+        let (mut one, mut batched) = (
+            SlidingWindow::new(Resolution::new(4, 1), 10),
+            SlidingWindow::new(Resolution::new(4, 1), 10),
+        );
+        let events: Vec<Event> = (0..20)
+            .map(|i| Event {
+                t: i,
+                x: (i * 7 % 4) as u16,
+                y: 0,
+                polarity: i % 3 == 0,
+            })
+            .collect();
+        let pixels: Vec<u32> = events.iter().map(|e| u32::from(e.x)).collect();
+        for w in [&mut one, &mut batched] {
+            w.add_batch(&events, &pixels, &mut [0; 20]);
+        }
+        let mut expected = Vec::new();
+        one.expire_through(25, |p, c| expected.push((p, c)));
+        let (mut got, mut sizes) = (Vec::new(), Vec::new());
+        batched.expire_batches_through::<4>(25, |batch| {
+            sizes.push(batch.len());
+            for (x, e) in batch.iter().zip(&events[got.len()..]) {
+                assert_eq!((x.entry.t, x.entry.polarity), (e.t, e.polarity));
+                got.push((x.entry.pixel, x.count));
+            }
+        });
+        assert_eq!(got, expected);
+        assert_eq!(sizes, [4, 4, 4, 4]);
+        assert_eq!(batched.counts(), one.counts());
+    }
 
     #[test]
     fn window_is_half_open_on_the_left() {

@@ -78,6 +78,71 @@ fn configs() -> Vec<ReprConfig> {
     ]
 }
 
+/// Combined configs whose accumulators can take events as they leave the window (see
+/// `FeatureExtractor::deferring_accumulation`), next to some that cannot.
+fn deferrable_configs() -> Vec<ReprConfig> {
+    let s = StaticConfig {
+        tau_ms: 0.2,
+        ..StaticConfig::default()
+    };
+    let d = DynamicConfig {
+        window_ms: 0.15,
+        count_threshold: 0,
+    };
+    let short = DynamicConfig {
+        window_ms: 0.04,
+        ..d
+    };
+    let ignore = StaticConfig {
+        polarity: Polarity::Ignore,
+        tau_ms: 0.1,
+        ..s
+    };
+    let combined = |static_part, dynamic_part| ReprConfig::Combined {
+        static_part,
+        dynamic_part,
+    };
+    vec![
+        // Deferred: two planes on one accumulator, both read by one window.
+        combined(s, d),
+        combined(
+            StaticConfig {
+                threshold: 1.0,
+                threshold_space: ThresholdSpace::U8,
+                ..s
+            },
+            d,
+        ),
+        // Deferred, under the short window.
+        combined(StaticConfig { tau_ms: 0.05, ..s }, short),
+        // Not deferred: one accumulator read by two windows.
+        combined(ignore, d),
+        combined(ignore, short),
+        // Not deferred: synchronous decay, and a dynamic part that does not set a pixel at its
+        // first event.
+        combined(
+            StaticConfig {
+                synchronous_decay: true,
+                tau_ms: 0.3,
+                ..s
+            },
+            d,
+        ),
+        combined(
+            StaticConfig { tau_ms: 0.4, ..s },
+            DynamicConfig {
+                count_threshold: 1,
+                ..d
+            },
+        ),
+        // A dynamic output on a window that feeds a deferred accumulator.
+        ReprConfig::Dynamic(DynamicConfig {
+            count_threshold: 1,
+            ..d
+        }),
+    ]
+}
+
 fn sample_times(events: &[Event], n: usize) -> Vec<i64> {
     let end = events.last().map_or(0, |e| e.t) + 200;
     let mut t: Vec<i64> = (0..n)
@@ -148,8 +213,12 @@ fn streamed(
     samples: &[i64],
     cuts: &[usize],
     eager: bool,
+    defer: bool,
 ) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
     let mut fx = FeatureExtractor::new(configs, RES, Some(mask)).unwrap();
+    if defer {
+        fx = fx.deferring_accumulation();
+    }
     let mut out = vec![Vec::new(); configs.len()];
     let mut pushed = 0;
     let mut next_cut = cuts.iter().copied().peekable();
@@ -199,7 +268,7 @@ proptest! {
         let configs = configs();
         let expected = reference(&configs, &mask, &events, &samples);
         let cuts = random_batches(seed, events.len(), chunks);
-        let got = streamed(&configs, &mask, &events, &samples, &cuts, false);
+        let got = streamed(&configs, &mask, &events, &samples, &cuts, false, false);
         for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
             for (k, (g, e)) in g.iter().zip(e).enumerate() {
                 prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
@@ -208,11 +277,50 @@ proptest! {
         }
         // One push of everything gives the same, and so does applying each chunk ahead of its
         // sample as it arrives.
-        let whole = streamed(&configs, &mask, &events, &samples, &[], false);
+        let whole = streamed(&configs, &mask, &events, &samples, &[], false, false);
         prop_assert_eq!(&whole, &got);
-        let eager = streamed(&configs, &mask, &events, &samples, &cuts, true);
+        let eager = streamed(&configs, &mask, &events, &samples, &cuts, true, false);
         prop_assert_eq!(eager, got);
     }
+
+    #[test]
+    fn deferred_accumulation_matches_reference(
+        seed in any::<u64>(),
+        n in 0usize..600,
+        max_gap in 0i64..40,
+        samples in 1usize..40,
+        chunks in 1usize..30,
+    ) {
+        let events = random_stream(seed, RES, n, 3, max_gap);
+        let samples = sample_times(&events, samples);
+        let mask = random_mask(seed);
+        let configs = deferrable_configs();
+        let expected = reference(&configs, &mask, &events, &samples);
+        let cuts = random_batches(seed, events.len(), chunks);
+        for eager in [false, true] {
+            let got = streamed(&configs, &mask, &events, &samples, &cuts, eager, true);
+            for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+                for (k, (g, e)) in g.iter().zip(e).enumerate() {
+                    prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
+                    prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn deferral_takes_only_accumulators_read_by_one_window() {
+    let fx = FeatureExtractor::new(&deferrable_configs(), RES, None).unwrap();
+    assert_eq!(fx.deferred_accumulators(), 0, "off unless asked for");
+    let fx = fx.deferring_accumulation();
+    assert_eq!(fx.deferred_accumulators(), 2);
+    let deferred: Vec<bool> = (0..fx.len()).map(|i| fx.potentials(i).is_none()).collect();
+    assert_eq!(
+        deferred,
+        [true, true, true, false, false, false, false, true],
+        "potentials are withheld for deferred accumulators (and dynamic outputs)"
+    );
 }
 
 #[test]
