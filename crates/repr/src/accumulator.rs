@@ -378,6 +378,43 @@ mod tests {
         ));
     }
 
+    proptest::proptest! {
+        /// The batched update (vectorized decay factors) against the event-by-event one, with
+        /// pixels repeated within a batch and gaps long enough for `expf`'s special path.
+        #[test]
+        fn batches_equal_event_by_event_updates(
+            steps in proptest::collection::vec((0u32..6, 0i64..3_000_000, proptest::bool::ANY), 0..300),
+            tau_ms in 0.01f64..2_000.0,
+            linear in proptest::bool::ANY,
+        ) {
+            let config = StaticConfig {
+                tau_ms,
+                decay: if linear { Decay::Linear } else { Decay::Exponential },
+                ..StaticConfig::default()
+            };
+            let res = Resolution::new(3, 2);
+            let (mut batched, mut single) = (
+                StaticAccumulator::new(res, &config).unwrap(),
+                StaticAccumulator::new(res, &config).unwrap(),
+            );
+            let mut t = 0;
+            let events: Vec<Event> = steps
+                .iter()
+                .map(|&(p, gap, polarity)| {
+                    // Mostly short gaps, some very long ones.
+                    t += if gap % 7 == 0 { gap * 1_000 } else { gap % 5_000 };
+                    ev(t, (p % 3) as u16, (p / 3) as u16, polarity)
+                })
+                .collect();
+            batched.accumulate(&events).unwrap();
+            for e in &events {
+                single.update(usize::from(e.y) * 3 + usize::from(e.x), e.t, e.polarity);
+            }
+            let bits = |a: &StaticAccumulator| a.potentials().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&batched), bits(&single));
+        }
+    }
+
     #[test]
     fn synchronous_decay_moves_every_pixel() {
         let cfg = StaticConfig {
