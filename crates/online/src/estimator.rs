@@ -3,8 +3,11 @@
 //! [`Estimator`] is what the estimation thread runs, and also what an offline check or a
 //! benchmark can drive directly. Per chunk it crops events to the 240x240 region of interest,
 //! hands them to the representation and applies at once those that belong to the next grid
-//! time (`FeatureExtractor::prepare`); for every grid time that the chunk makes final it
-//! advances the representation to that time, runs the MLP, and stamps the latency. Nothing on
+//! time (`FeatureExtractor::push_and_prepare`); for every grid time that the chunk makes final
+//! it advances the representation to that time, runs the MLP, and stamps the latency. Then,
+//! before the next chunk, it does the work of the next grid time that is already known: the
+//! window drops the events that will have left it, and a deferred accumulator (the combined
+//! representation's, see `FeatureExtractor::deferring_accumulation`) takes them. Nothing on
 //! this path allocates once the buffers have grown to the largest chunk seen.
 //!
 //! The MLP runs as a [`StreamingPredictor`]: its first layer is updated from the pooled cells
@@ -186,7 +189,13 @@ impl Estimator {
             let first = self.counters.span_us.map_or(first, |(f, _)| f);
             self.counters.span_us = Some((first, last));
         }
-        self.extractor.push(crop)?;
+        match self.schedule.next() {
+            // Applies at once the events that belong to the next estimate (straight from the
+            // crop buffer), so when a later chunk makes it final only that chunk's events are
+            // left to do; the rest wait in the representation's queue.
+            Some(next) => self.extractor.push_and_prepare(crop, next)?,
+            None => self.extractor.push(crop)?,
+        }
         // An event at `t` proves that every event before `t` has arrived; one at `t` itself
         // may still follow in the next chunk.
         let proven = latest.map_or(i64::MIN, |t| t.saturating_sub(1));
@@ -194,9 +203,8 @@ impl Estimator {
         self.estimate_until(horizon, arrival, emit)?;
         if let Some(next) = self.schedule.next() {
             // Ahead of the next estimate, after this chunk's estimates are out: apply the
-            // events that belong to it and let the windows drop what leaves them by then
-            // (known now: the window reaches back past every event yet to come). When a later
-            // chunk makes it final, only that chunk's events are left to do.
+            // queued events that belong to it and let the windows drop what leaves them by
+            // then (known now: the window reaches back past every event yet to come).
             self.extractor.prepare(next)?;
         }
         Ok(())

@@ -419,13 +419,53 @@ impl FeatureExtractor {
     /// # Ok::<(), evtac_repr::ReprError>(())
     /// ```
     pub fn prepare(&mut self, t_next: i64) -> Result<(), ReprError> {
-        let t_k = t_next;
+        self.check_prepared(t_next)?;
+        self.apply_through(&[], t_next);
+        Ok(())
+    }
+
+    /// [`Self::push`] then [`Self::prepare`]`(t_next)`, with the same result and errors, but
+    /// the events of `events` that `t_next` takes are applied straight from the slice when
+    /// nothing earlier is queued, rather than copied into the queue first: what a live
+    /// estimator calls per chunk.
+    ///
+    /// ```
+    /// use evtac_events::{Event, Resolution};
+    /// use evtac_repr::{FeatureExtractor, ReprConfig};
+    ///
+    /// let frame = Resolution::new(240, 240);
+    /// let mut fx = FeatureExtractor::new(&[ReprConfig::default()], frame, None)?;
+    /// let e = |t| Event { t, x: 1, y: 2, polarity: true };
+    /// fx.push_and_prepare(&[e(500), e(1_000), e(1_500)], 1_000)?;
+    /// assert_eq!(fx.pending(), 1); // the event after 1 000 waits for its sample
+    /// # Ok::<(), evtac_repr::ReprError>(())
+    /// ```
+    pub fn push_and_prepare(&mut self, events: &[Event], t_next: i64) -> Result<(), ReprError> {
+        self.last_pushed =
+            crate::check::check_events(events, Some(self.resolution), self.last_pushed)?;
+        if let Err(err) = self.check_prepared(t_next) {
+            // As `push` then a failing `prepare`: the events stay queued.
+            self.pending.extend(events);
+            return Err(err);
+        }
+        self.apply_through(events, t_next);
+        Ok(())
+    }
+
+    /// Accepts `t_k` as the latest prepared time unless it is before the previous one.
+    fn check_prepared(&mut self, t_k: i64) -> Result<(), ReprError> {
         if let Some(previous) = self.prepared
             && t_k < previous
         {
             return Err(ReprError::SampleTimeBackwards { t: t_k, previous });
         }
         self.prepared = Some(t_k);
+        Ok(())
+    }
+
+    /// Applies the queued events with `t <= t_k`, then those of `incoming` (checked, and after
+    /// everything queued), queueing the rest, and moves the windows to end at `t_k`.
+    fn apply_through(&mut self, incoming: &[Event], t_k: i64) {
         let n = self.pending.partition_point(|e| e.t <= t_k);
         let width = u32::from(self.resolution.width);
         let Self {
@@ -440,7 +480,13 @@ impl FeatureExtractor {
         } = self;
         let (front, back) = pending.as_slices();
         let in_front = n.min(front.len());
-        for events in [&front[..in_front], &back[..n - in_front]] {
+        // Incoming events go straight in when nothing queued comes before them.
+        let m = if n == pending.len() {
+            incoming.partition_point(|e| e.t <= t_k)
+        } else {
+            0
+        };
+        for events in [&front[..in_front], &back[..n - in_front], &incoming[..m]] {
             for batch in events.chunks(BATCH) {
                 apply_batch(
                     batch, width, accs, windows, splanes, dplanes, outputs, masks,
@@ -448,6 +494,7 @@ impl FeatureExtractor {
             }
         }
         pending.drain(..n);
+        pending.extend(&incoming[m..]);
         for slot in windows.iter_mut() {
             let WindowSlot {
                 window,
@@ -484,7 +531,6 @@ impl FeatureExtractor {
                 }
             });
         }
-        Ok(())
     }
 
     /// Defers accumulation where the outputs allow it, for live use, and resets the extractor

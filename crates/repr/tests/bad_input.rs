@@ -157,3 +157,38 @@ fn a_sample_before_a_prepared_time_is_an_error() {
         "the event is in the window of the default combined config"
     );
 }
+
+#[test]
+fn push_and_prepare_rejects_what_push_and_prepare_reject() {
+    let mut fx = extractor();
+    // A bad chunk: nothing queued or applied.
+    assert!(matches!(
+        fx.push_and_prepare(&[ev(10, 0, 0), ev(9, 0, 0)], 20),
+        Err(ReprError::EventOutOfOrder { index: 1, .. })
+    ));
+    assert!(matches!(
+        fx.push_and_prepare(&[ev(10, 240, 0)], 20),
+        Err(ReprError::EventOutOfFrame {
+            index: 0,
+            x: 240,
+            ..
+        })
+    ));
+    assert_eq!(fx.pending(), 0);
+    fx.push_and_prepare(&[ev(10, 3, 0), ev(30, 4, 0)], 20)
+        .unwrap();
+    assert_eq!(fx.pending(), 1, "the event after the prepared time waits");
+    // A prepared time before the previous one: an error, and the chunk stays queued as `push`
+    // then a failing `prepare` would leave it.
+    assert!(matches!(
+        fx.push_and_prepare(&[ev(40, 5, 0)], 15),
+        Err(ReprError::SampleTimeBackwards {
+            t: 15,
+            previous: 20
+        })
+    ));
+    assert_eq!(fx.pending(), 2);
+    fx.advance_to(40).unwrap();
+    let set: Vec<usize> = (0..240).filter(|&x| fx.frame(0)[x] == 1).collect();
+    assert_eq!(set, [3, 4, 5]);
+}

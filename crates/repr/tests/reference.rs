@@ -206,13 +206,24 @@ fn reference(
     out
 }
 
+/// How `streamed` hands each chunk to the extractor.
+#[derive(Clone, Copy, Debug)]
+enum Feed {
+    /// `push`; the events wait for `advance_to`.
+    Push,
+    /// `push`, then `prepare` up to the next sample, as each chunk arrives.
+    PushThenPrepare,
+    /// `push_and_prepare` up to the next sample.
+    PushAndPrepare,
+}
+
 fn streamed(
     configs: &[ReprConfig],
     mask: &Mask,
     events: &[Event],
     samples: &[i64],
     cuts: &[usize],
-    eager: bool,
+    feed: Feed,
     defer: bool,
 ) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
     let mut fx = FeatureExtractor::new(configs, RES, Some(mask)).unwrap();
@@ -229,11 +240,16 @@ fn streamed(
                 .by_ref()
                 .find(|&c| c > pushed)
                 .unwrap_or(events.len());
-            fx.push(&events[pushed..end]).unwrap();
+            let chunk = &events[pushed..end];
             pushed = end;
-            if eager {
-                // What a live estimator does as each chunk arrives.
-                fx.prepare(t_k).unwrap();
+            // The last two are what a live estimator does as each chunk arrives.
+            match feed {
+                Feed::Push => fx.push(chunk).unwrap(),
+                Feed::PushThenPrepare => {
+                    fx.push(chunk).unwrap();
+                    fx.prepare(t_k).unwrap();
+                }
+                Feed::PushAndPrepare => fx.push_and_prepare(chunk, t_k).unwrap(),
             }
         }
         fx.advance_to(t_k).unwrap();
@@ -268,7 +284,7 @@ proptest! {
         let configs = configs();
         let expected = reference(&configs, &mask, &events, &samples);
         let cuts = random_batches(seed, events.len(), chunks);
-        let got = streamed(&configs, &mask, &events, &samples, &cuts, false, false);
+        let got = streamed(&configs, &mask, &events, &samples, &cuts, Feed::Push, false);
         for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
             for (k, (g, e)) in g.iter().zip(e).enumerate() {
                 prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
@@ -276,11 +292,13 @@ proptest! {
             }
         }
         // One push of everything gives the same, and so does applying each chunk ahead of its
-        // sample as it arrives.
-        let whole = streamed(&configs, &mask, &events, &samples, &[], false, false);
+        // sample as it arrives, either way.
+        let whole = streamed(&configs, &mask, &events, &samples, &[], Feed::Push, false);
         prop_assert_eq!(&whole, &got);
-        let eager = streamed(&configs, &mask, &events, &samples, &cuts, true, false);
-        prop_assert_eq!(eager, got);
+        for feed in [Feed::PushThenPrepare, Feed::PushAndPrepare] {
+            let eager = streamed(&configs, &mask, &events, &samples, &cuts, feed, false);
+            prop_assert_eq!(&eager, &got, "{:?}", feed);
+        }
     }
 
     #[test]
@@ -297,8 +315,8 @@ proptest! {
         let configs = deferrable_configs();
         let expected = reference(&configs, &mask, &events, &samples);
         let cuts = random_batches(seed, events.len(), chunks);
-        for eager in [false, true] {
-            let got = streamed(&configs, &mask, &events, &samples, &cuts, eager, true);
+        for feed in [Feed::Push, Feed::PushThenPrepare, Feed::PushAndPrepare] {
+            let got = streamed(&configs, &mask, &events, &samples, &cuts, feed, true);
             for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
                 for (k, (g, e)) in g.iter().zip(e).enumerate() {
                     prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
