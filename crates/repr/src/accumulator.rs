@@ -383,7 +383,10 @@ mod tests {
         /// pixels repeated within a batch and gaps long enough for `expf`'s special path.
         #[test]
         fn batches_equal_event_by_event_updates(
-            steps in proptest::collection::vec((0u32..6, 0i64..3_000_000, proptest::bool::ANY), 0..300),
+            steps in proptest::collection::vec(
+                (0u32..6, 0i64..3_000_000, proptest::bool::ANY),
+                0..300,
+            ),
             tau_ms in 0.01f64..2_000.0,
             linear in proptest::bool::ANY,
         ) {
@@ -410,7 +413,9 @@ mod tests {
             for e in &events {
                 single.update(usize::from(e.y) * 3 + usize::from(e.x), e.t, e.polarity);
             }
-            let bits = |a: &StaticAccumulator| a.potentials().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let bits = |a: &StaticAccumulator| {
+                a.potentials().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
             proptest::prop_assert_eq!(bits(&batched), bits(&single));
         }
     }
