@@ -6,8 +6,11 @@
 //!
 //! Events before motion onset are applied before timing starts: the sensor is still then and an
 //! online system would have processed them as they came (and made an estimate from them, which
-//! primes the [`StreamingPredictor`] the steps run through, as `evtac online` does). Runs on the
-//! calling thread, alone.
+//! primes the [`StreamingPredictor`] the steps run through, as `evtac online` does). Likewise
+//! each step's work that is known before its events arrive (the dynamic window dropping what
+//! leaves it, and the combined representation's accumulator taking those events, see
+//! `FeatureExtractor::deferring_accumulation`) is done before its timing starts, as `evtac
+//! online` does between estimates. Runs on the calling thread, alone.
 
 use crate::dataset::{self, Dataset, FRAME};
 use crate::results::LatencyCell;
@@ -47,13 +50,12 @@ pub fn measure(
     evtac_learn::flush_denormals();
     let config = model.representation.config;
     let step = i64::from(interval_ms.max(1)) * 1000;
-    let mut fx =
-        FeatureExtractor::new(std::slice::from_ref(&config), FRAME, mask).map_err(|source| {
-            Error::Repr {
-                trial: String::new(),
-                source,
-            }
-        })?;
+    let mut fx = FeatureExtractor::new(std::slice::from_ref(&config), FRAME, mask)
+        .map_err(|source| Error::Repr {
+            trial: String::new(),
+            source,
+        })?
+        .deferring_accumulation();
     let mut stream = StreamingPredictor::new(model.predictor.clone());
     let mut times_us = Vec::new();
     for meta in trials {
@@ -72,6 +74,7 @@ pub fn measure(
         let mut trial_times = Vec::new();
         let mut t_k = meta.motion_start_us + step;
         while t_k <= meta.motion_end_us {
+            fx.prepare(t_k).map_err(repr)?;
             let started = Instant::now();
             let end = cursor + events[cursor..].partition_point(|e| e.t <= t_k);
             fx.push_with_roi(&events[cursor..end], &roi).map_err(repr)?;
