@@ -847,7 +847,7 @@ fn apply_batch(
 /// After an event at pixel `pixel` left a window, leaving `count` there: clears the pixel in
 /// the window's dynamic `planes` whose threshold it fell to, and updates their outputs.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 fn clear_expired(
     planes: &[usize],
     pixel: u32,
