@@ -159,13 +159,11 @@ fn sample_times(events: &[Event], n: usize) -> Vec<i64> {
     t
 }
 
+/// Frame and features per config per sample.
+type Outputs = Vec<Vec<(Vec<u8>, Vec<f32>)>>;
+
 /// Frames and features per config per sample, computed the plain way.
-fn reference(
-    configs: &[ReprConfig],
-    mask: &Mask,
-    events: &[Event],
-    samples: &[i64],
-) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
+fn reference(configs: &[ReprConfig], mask: &Mask, events: &[Event], samples: &[i64]) -> Outputs {
     let mut accs: Vec<Option<StaticAccumulator>> = configs
         .iter()
         .map(|c| {
@@ -225,7 +223,7 @@ fn streamed(
     cuts: &[usize],
     feed: Feed,
     defer: bool,
-) -> Vec<Vec<(Vec<u8>, Vec<f32>)>> {
+) -> Outputs {
     let mut fx = FeatureExtractor::new(configs, RES, Some(mask)).unwrap();
     if defer {
         fx = fx.deferring_accumulation();
@@ -267,6 +265,53 @@ fn random_mask(seed: u64) -> Mask {
     Mask::from_pixels(RES, &pixels).unwrap()
 }
 
+/// A random stream with its sample times, mask and chunk boundaries, from the proptest inputs.
+struct Case {
+    events: Vec<Event>,
+    samples: Vec<i64>,
+    mask: Mask,
+    cuts: Vec<usize>,
+}
+
+impl Case {
+    fn new(seed: u64, n: usize, max_gap: i64, samples: usize, chunks: usize) -> Self {
+        let events = random_stream(seed, RES, n, 3, max_gap);
+        Self {
+            samples: sample_times(&events, samples),
+            mask: random_mask(seed),
+            cuts: random_batches(seed, events.len(), chunks),
+            events,
+        }
+    }
+
+    fn reference(&self, configs: &[ReprConfig]) -> Outputs {
+        reference(configs, &self.mask, &self.events, &self.samples)
+    }
+
+    fn streamed(&self, configs: &[ReprConfig], cuts: &[usize], feed: Feed, defer: bool) -> Outputs {
+        streamed(
+            configs,
+            &self.mask,
+            &self.events,
+            &self.samples,
+            cuts,
+            feed,
+            defer,
+        )
+    }
+}
+
+/// Every frame and feature of `got` equal to `expected`, naming the first that differs.
+fn check_outputs(got: &Outputs, expected: &Outputs) -> Result<(), TestCaseError> {
+    for (i, (g, e)) in got.iter().zip(expected).enumerate() {
+        for (k, (g, e)) in g.iter().zip(e).enumerate() {
+            prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
+            prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
+        }
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -278,25 +323,16 @@ proptest! {
         samples in 1usize..40,
         chunks in 1usize..30,
     ) {
-        let events = random_stream(seed, RES, n, 3, max_gap);
-        let samples = sample_times(&events, samples);
-        let mask = random_mask(seed);
+        let case = Case::new(seed, n, max_gap, samples, chunks);
         let configs = configs();
-        let expected = reference(&configs, &mask, &events, &samples);
-        let cuts = random_batches(seed, events.len(), chunks);
-        let got = streamed(&configs, &mask, &events, &samples, &cuts, Feed::Push, false);
-        for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
-            for (k, (g, e)) in g.iter().zip(e).enumerate() {
-                prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
-                prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
-            }
-        }
+        let got = case.streamed(&configs, &case.cuts, Feed::Push, false);
+        check_outputs(&got, &case.reference(&configs))?;
         // One push of everything gives the same, and so does applying each chunk ahead of its
         // sample as it arrives, either way.
-        let whole = streamed(&configs, &mask, &events, &samples, &[], Feed::Push, false);
+        let whole = case.streamed(&configs, &[], Feed::Push, false);
         prop_assert_eq!(&whole, &got);
         for feed in [Feed::PushThenPrepare, Feed::PushAndPrepare] {
-            let eager = streamed(&configs, &mask, &events, &samples, &cuts, feed, false);
+            let eager = case.streamed(&configs, &case.cuts, feed, false);
             prop_assert_eq!(&eager, &got, "{:?}", feed);
         }
     }
@@ -309,20 +345,11 @@ proptest! {
         samples in 1usize..40,
         chunks in 1usize..30,
     ) {
-        let events = random_stream(seed, RES, n, 3, max_gap);
-        let samples = sample_times(&events, samples);
-        let mask = random_mask(seed);
+        let case = Case::new(seed, n, max_gap, samples, chunks);
         let configs = deferrable_configs();
-        let expected = reference(&configs, &mask, &events, &samples);
-        let cuts = random_batches(seed, events.len(), chunks);
+        let expected = case.reference(&configs);
         for feed in [Feed::Push, Feed::PushThenPrepare, Feed::PushAndPrepare] {
-            let got = streamed(&configs, &mask, &events, &samples, &cuts, feed, true);
-            for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
-                for (k, (g, e)) in g.iter().zip(e).enumerate() {
-                    prop_assert_eq!(&g.0, &e.0, "frame of config {} at sample {}", i, k);
-                    prop_assert_eq!(&g.1, &e.1, "features of config {} at sample {}", i, k);
-                }
-            }
+            check_outputs(&case.streamed(&configs, &case.cuts, feed, true), &expected)?;
         }
     }
 }
