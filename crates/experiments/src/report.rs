@@ -284,8 +284,8 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
              plus an RTX 2080 Ti for inference), from a step's new events to the MLP's output; the \
              work known before they arrive (the dynamic window dropping what leaves it by the \
              step) is done before timing starts, as `evtac online` does between estimates. \
-             Paper: every representation under 10 ms at every interval; static and dynamic under the interval, combined over it for a few \
-             samples at 1 and 2 ms.\n"
+             Paper: every representation under 10 ms at every interval; static and dynamic \
+             under the interval, combined over it for a few samples at 1 and 2 ms.\n"
         );
         let _ = writeln!(
             md,

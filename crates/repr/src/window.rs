@@ -29,8 +29,8 @@ pub struct SlidingWindow {
     queue: Fifo<Entry>,
 }
 
-/// One event in the window. The polarity costs nothing (the entry is padded to 16 bytes
-/// anyway) and lets an accumulator take the event when it leaves (see
+/// One event in the window. The polarity takes no extra space (the entry is padded to 16
+/// bytes anyway) and lets an accumulator take the event when it leaves (see
 /// [`SlidingWindow::expire_batches_through`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Entry {
