@@ -1,8 +1,7 @@
 //! Tests of `evtac online`.
 
 use crate::common::{evtac, run_ok};
-use evtac_learn::bundle::{BundleConfig, BundleMetrics, FORMAT_VERSION};
-use evtac_learn::{Mae, ModelBundle, Parameters, TrainConfig};
+use evtac_learn::{ModelBundle, Representation};
 use evtac_repr::ReprConfig;
 use std::io::Write;
 use std::path::Path;
@@ -10,27 +9,9 @@ use std::process::Stdio;
 
 /// An untrained bundle (weights from a seed) with the default representation.
 fn bundle(dir: &Path) {
-    let bundle = ModelBundle {
-        parameters: Parameters::init(4),
-        config: BundleConfig {
-            format_version: FORMAT_VERSION,
-            architecture: vec![900, 256, 128, 64, 2],
-            training: TrainConfig::default(),
-            representation: serde_json::to_value(ReprConfig::default()).unwrap(),
-            metrics: BundleMetrics {
-                best_epoch: 0,
-                validation: Mae {
-                    overall: 0.0,
-                    pitch: 0.0,
-                    roll: 0.0,
-                },
-                evaluations: Default::default(),
-            },
-        },
-        mask: None,
-        history: Vec::new(),
-    };
-    bundle.save(dir).unwrap();
+    ModelBundle::untrained(4, Representation::new(ReprConfig::default()), None)
+        .save(dir)
+        .unwrap();
 }
 
 /// 50 ms of events around the sensor's centre, as `t,x,y,p` CSV.

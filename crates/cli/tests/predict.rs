@@ -1,32 +1,15 @@
 //! Tests of `evtac predict`.
 
 use crate::common::{evtac, run_ok};
-use evtac_learn::{Mae, ModelBundle, Parameters, Predictor, TrainConfig, Trained};
+use evtac_learn::{ModelBundle, Parameters, Predictor, Representation};
+use evtac_repr::ReprConfig;
 use ndarray::Array2;
 
 /// A bundle with seeded initial weights (prediction does not care whether they were trained).
 fn write_bundle(dir: &std::path::Path) -> Parameters {
-    let parameters = Parameters::init(21);
-    let mae = Mae {
-        overall: 1.0,
-        pitch: 1.0,
-        roll: 1.0,
-    };
-    let trained = Trained {
-        parameters: parameters.clone(),
-        best_epoch: 1,
-        best_val: mae,
-        history: Vec::new(),
-    };
-    ModelBundle::from_trained(
-        trained,
-        TrainConfig::default(),
-        serde_json::json!(null),
-        None,
-    )
-    .save(dir)
-    .expect("bundle saved");
-    parameters
+    let bundle = ModelBundle::untrained(21, Representation::new(ReprConfig::default()), None);
+    bundle.save(dir).expect("bundle saved");
+    bundle.parameters
 }
 
 fn features(n: usize) -> Array2<f32> {

@@ -2,17 +2,20 @@
 //! figure, resuming, and the exported job list.
 
 use crate::common::run_ok;
+use evtac_experiments::report::FIGURES;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// One tiny reproduction shared by the tests of `train`, `evaluate`, `tune` and `reproduce`
-/// (simulated once per test binary): its output folder.
+/// (simulated once per test binary, and the only end-to-end reproduction in the test suite):
+/// its output folder. It runs twice: the second run resumes the finished one, and must find
+/// every job done and give the same Experiment 1 results.
 pub fn tiny_run() -> &'static Path {
     static RUN: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     let (_, out) = RUN.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
         let out = dir.path().join("out");
-        run_ok(&[
+        let args = [
             "reproduce",
             "--scale",
             "tiny",
@@ -20,20 +23,21 @@ pub fn tiny_run() -> &'static Path {
             "1",
             "--out",
             out.to_str().expect("utf-8 path"),
-        ]);
+        ];
+        run_ok(&args);
+        let exp1 = |out: &Path| results(out)["exp1"].clone();
+        let first = exp1(&out);
+        run_ok(&args);
+        assert_eq!(exp1(&out), first, "a resumed run changed Experiment 1");
         (dir, out)
     });
     out
 }
 
-const FIGURES: [&str; 6] = [
-    "tuning.png",
-    "phase_mae.png",
-    "example_trial.png",
-    "contours.png",
-    "speed_depth.png",
-    "latency.png",
-];
+/// `results.json` of a finished run.
+fn results(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
+}
 
 #[test]
 fn tiny_reproduction_writes_the_report_with_every_figure() {
@@ -46,7 +50,7 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         report.contains("0.160 ± 0.004"),
         "the paper's numbers are quoted"
     );
-    for fig in FIGURES {
+    for (fig, _) in FIGURES {
         let bytes = std::fs::read(out.join("figures").join(fig)).unwrap();
         assert!(bytes.starts_with(b"\x89PNG"), "{fig} is not a PNG");
         assert!(bytes.len() > 5_000, "{fig} is nearly empty");
@@ -55,11 +59,14 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
             "{fig} not referenced"
         );
     }
-    let results: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let results = results(out);
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
     assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
-    assert!(!results["exp3_speed"].as_array().unwrap().is_empty());
+    let speeds = results["exp3_speed"].as_array().unwrap();
+    assert!(
+        speeds.iter().any(|p| p["seen"] == false),
+        "Experiment 3 has no unseen speed"
+    );
     assert!(!results["exp3_depth"].as_array().unwrap().is_empty());
     assert_eq!(results["latency"].as_array().map(Vec::len), Some(12));
     let mae = results["exp1"][0]["test"]["overall"]["mean"]

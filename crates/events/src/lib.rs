@@ -29,6 +29,7 @@ pub mod check;
 pub mod csv;
 mod error;
 pub mod evt;
+pub mod layout;
 pub mod manifest;
 pub mod npy;
 mod recording;

@@ -44,8 +44,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-/// The manifest's file name inside a dataset folder.
-pub const FILE_NAME: &str = "trials.csv";
+use crate::layout::MANIFEST_FILE as FILE_NAME;
 
 /// The manifest's columns, in file order.
 pub const COLUMNS: [&str; 13] = [

@@ -16,7 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = PathBuf::from(args.next().unwrap_or_else(|| "reproduce-out".into()));
     let seed: u64 = args.next().map_or(Ok(0), |s| s.parse())?;
     let scale: Scale = scale_name.parse()?;
-    let plan = Plan::for_scale(&scale_name).ok_or("unknown scale")?;
+    let plan = Plan::for_scale(scale);
     let started = Instant::now();
     let data = out.join("data");
     for protocol in [

@@ -13,11 +13,13 @@
 //! A file exists only once complete (written to a temporary name, then renamed), so an
 //! interrupted run resumes with the files it finished. Trials run in parallel (rayon).
 
-use crate::dataset::{self, Dataset, FRAME};
+use crate::dataset::{self, Dataset};
 use crate::sampling::{Phase, SampleTime, Sampling};
 use evtac_events::Event;
+use evtac_events::layout::CACHE_DIR;
 use evtac_events::manifest::TrialMeta;
 use evtac_learn::FeatureSet;
+use evtac_repr::CROP;
 use evtac_repr::{FeatureExtractor, Mask, ReprConfig};
 use ndarray::Array2;
 use rayon::prelude::*;
@@ -26,8 +28,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The cache folder inside a dataset folder.
-pub const CACHE_DIR: &str = "cache";
 /// Number of features per sample (30 x 30 cells of the 240 x 240 crop).
 pub const FEATURES: usize = 900;
 
@@ -281,7 +281,7 @@ impl<'a> FeatureCache<'a> {
             trial: meta.trial.clone(),
             source,
         };
-        let mut fx = FeatureExtractor::new_with_masks(&sel, FRAME, &sel_masks).map_err(repr)?;
+        let mut fx = FeatureExtractor::new_with_masks(&sel, CROP, &sel_masks).map_err(repr)?;
         let times: Vec<i64> = samples.times.iter().map(|s| s.t_us).collect();
         let mut out: Vec<Vec<f32>> = vec![Vec::with_capacity(times.len() * FEATURES); sel.len()];
         fx.run(&events, &times, |_, fx| {

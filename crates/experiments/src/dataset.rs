@@ -4,22 +4,14 @@
 
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
+use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR, NO_CONTACT_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_labels::geometry::Calibration;
 use evtac_labels::{LabelConfig, LabelSeries};
-use evtac_repr::{Mask, ReprConfig};
+use evtac_repr::{CROP, Mask, ReprConfig};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
-
-/// The crop every representation works on: the sensor's centered 240 x 240 pixels.
-pub const FRAME: Resolution = Resolution::new(240, 240);
-/// The calibration file inside a dataset folder.
-pub const CALIBRATION_FILE: &str = "calibration.json";
-/// The no-contact recording inside a dataset folder.
-pub const NO_CONTACT_FILE: &str = "no_contact.aedat4";
-/// The labels folder inside a dataset folder.
-pub const LABELS_DIR: &str = "labels";
 
 /// Errors opening or reading a dataset.
 #[derive(Debug, thiserror::Error)]
@@ -53,7 +45,7 @@ pub enum Error {
         source: evtac_events::Error,
     },
     /// A recording is smaller than the 240 x 240 crop.
-    #[error("{path}: sensor {sensor} is smaller than the {FRAME} crop")]
+    #[error("{path}: sensor {sensor} is smaller than the {CROP} crop")]
     SensorTooSmall {
         /// The file.
         path: PathBuf,
@@ -114,18 +106,18 @@ pub fn read_full(path: &Path) -> Result<(Resolution, Vec<Event>), Error> {
         path: path.to_path_buf(),
         source,
     })?;
-    Ok((rec.resolution.unwrap_or(FRAME), rec.events))
+    Ok((rec.resolution.unwrap_or(CROP), rec.events))
 }
 
-/// The centered [`FRAME`] crop of `sensor`.
-pub fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
-    Roi::centered(sensor, FRAME).ok_or(Error::SensorTooSmall {
+/// The centered [`CROP`] crop of `sensor`.
+fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
+    evtac_repr::centered_crop(sensor).map_err(|_| Error::SensorTooSmall {
         path: path.to_path_buf(),
         sensor,
     })
 }
 
-/// Reads a recording's events, cropped to the centered [`FRAME`], in time order.
+/// Reads a recording's events, cropped to the centered [`CROP`], in time order.
 pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
     let (sensor, events) = read_full(path)?;
     let roi = crop_of(sensor, path)?;
@@ -236,12 +228,12 @@ impl Dataset {
         sampling.times((meta.motion_start_us, meta.motion_end_us), stop)
     }
 
-    /// The events of `meta`'s recording cropped to [`FRAME`].
+    /// The events of `meta`'s recording cropped to [`CROP`].
     pub fn events(&self, meta: &TrialMeta) -> Result<Vec<Event>, Error> {
         read_cropped(&self.dir.join(&meta.file))
     }
 
-    /// The no-contact recording's events cropped to [`FRAME`], or `None` when the dataset has
+    /// The no-contact recording's events cropped to [`CROP`], or `None` when the dataset has
     /// no `no_contact.aedat4`.
     pub fn no_contact_events(&self) -> Result<Option<Vec<Event>>, Error> {
         let path = self.dir.join(NO_CONTACT_FILE);
@@ -262,7 +254,7 @@ impl Dataset {
         let (Some(s), Some(events)) = (config.static_part(), no_contact) else {
             return Ok(None);
         };
-        Mask::from_no_contact(FRAME, s, events)
+        Mask::from_no_contact(CROP, s, events)
             .map(Some)
             .map_err(|source| Error::Mask {
                 path: self.dir.join(NO_CONTACT_FILE),

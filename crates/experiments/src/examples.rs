@@ -2,10 +2,11 @@
 //! curves, and the static and dynamic contour overlays at two speeds and two depths.
 
 use crate::cache::FeatureCache;
-use crate::dataset::FRAME;
 use crate::results::{ExampleTrial, Overlay};
-use crate::training::{Error, Model};
+use crate::training::Error;
 use evtac_events::manifest::TrialMeta;
+use evtac_learn::Model;
+use evtac_repr::CROP;
 use evtac_repr::{FeatureExtractor, ReprConfig};
 
 /// Spacing of the example curves' samples (20 ms: smooth curves, few predictions).
@@ -33,16 +34,13 @@ pub fn example_trial(
         .map(|k| meta.motion_start_us + k * CURVE_STEP_US)
         .take_while(|&t| t <= meta.motion_end_us)
         .collect();
-    let configs: Vec<ReprConfig> = models
-        .iter()
-        .map(|(_, m)| m.representation.config)
-        .collect();
+    let configs: Vec<ReprConfig> = models.iter().map(|(_, m)| m.repr_config()).collect();
     let masks = configs
         .iter()
         .map(|c| cache.mask(c))
         .collect::<Result<Vec<_>, _>>()?;
     let mask_refs: Vec<_> = masks.iter().map(|m| m.as_ref()).collect();
-    let mut fx = FeatureExtractor::new_with_masks(&configs, FRAME, &mask_refs)
+    let mut fx = FeatureExtractor::new_with_masks(&configs, CROP, &mask_refs)
         .map_err(repr_err(&meta.trial))?;
     let mut preds: Vec<Vec<[f32; 2]>> = vec![Vec::with_capacity(times.len()); models.len()];
     evtac_learn::flush_denormals();
@@ -130,7 +128,7 @@ fn frames(
         .map(|c| cache.mask(c))
         .collect::<Result<Vec<_>, _>>()?;
     let mask_refs: Vec<_> = masks.iter().map(|m| m.as_ref()).collect();
-    let mut fx = FeatureExtractor::new_with_masks(configs, FRAME, &mask_refs)
+    let mut fx = FeatureExtractor::new_with_masks(configs, CROP, &mask_refs)
         .map_err(repr_err(&meta.trial))?;
     let events = cache.dataset().events(meta)?;
     let mut out = Vec::new();
@@ -169,8 +167,8 @@ pub fn overlays(
                     ),
                     first_label: format!("{} deg/s", a.speed_deg_s),
                     second_label: format!("{} deg/s", b.speed_deg_s),
-                    width: usize::from(FRAME.width),
-                    height: usize::from(FRAME.height),
+                    width: usize::from(CROP.width),
+                    height: usize::from(CROP.height),
                     first: fa[i].clone(),
                     second: fb[i].clone(),
                 },
@@ -192,8 +190,8 @@ pub fn overlays(
                     ),
                     first_label: format!("{} mm", a.depth_mm),
                     second_label: format!("{} mm", b.depth_mm),
-                    width: usize::from(FRAME.width),
-                    height: usize::from(FRAME.height),
+                    width: usize::from(CROP.width),
+                    height: usize::from(CROP.height),
                     first: fa[i].clone(),
                     second: fb[i].clone(),
                 },

@@ -8,7 +8,9 @@ use crate::plan::Plan;
 use crate::results::{Exp1Repr, Mae, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
-use crate::training::{self, Error, Model, TrainSpec};
+use crate::stage::{FeatureSet, Stage};
+use crate::training::{self, Error, TrainSpec};
+use evtac_learn::Model;
 use evtac_learn::ModelBundle;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -95,6 +97,34 @@ pub fn train_all(
     )
 }
 
+/// What Experiments 1 and 2 do before evaluating: the features of every trial of `cache`'s
+/// dataset under each of `reprs` (sampled by `sampling`), then the training `jobs` (run or
+/// resumed), each reported as its stage.
+#[allow(clippy::too_many_arguments)]
+pub fn features_then_training(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    reprs: &[(&'static str, ReprConfig)],
+    sampling: Sampling,
+    (features, training): (FeatureSet, Stage),
+    jobs: &[SeedJob],
+    progress: &dyn Progress,
+) -> Result<(), Error> {
+    let all = cache.dataset().trials(
+        &[
+            splits.get(Split::Train),
+            splits.get(Split::Val),
+            splits.get(Split::Test),
+        ]
+        .concat(),
+    )?;
+    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
+    progress.stage(Stage::Features(features), all.len() as u64);
+    cache.ensure(&all, &configs, sampling, &|| progress.advance(1))?;
+    progress.stage(training, jobs.len() as u64);
+    train_all(cache, splits, jobs, progress)
+}
+
 /// Runs Experiment 1 and evaluates every model on the test split.
 pub fn run(
     cache: &FeatureCache<'_>,
@@ -105,21 +135,17 @@ pub fn run(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<Exp1Repr>, Error> {
-    let ds = cache.dataset();
-    let all = ds.trials(
-        &[
-            splits.get(Split::Train),
-            splits.get(Split::Val),
-            splits.get(Split::Test),
-        ]
-        .concat(),
-    )?;
-    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
-    progress.stage("features (experiment 1)", all.len() as u64);
-    cache.ensure(&all, &configs, Sampling::MOTION, &|| progress.advance(1))?;
     let jobs = jobs(reprs, plan, seed, out);
-    progress.stage("experiment 1 training", jobs.len() as u64);
-    train_all(cache, splits, &jobs, progress)?;
+    let stages = (FeatureSet::Exp1, Stage::Exp1Training);
+    features_then_training(
+        cache,
+        splits,
+        reprs,
+        Sampling::MOTION,
+        stages,
+        &jobs,
+        progress,
+    )?;
     let mut results = Vec::new();
     for &(name, config) in reprs {
         let test = training::load_split(
@@ -134,8 +160,8 @@ pub fn run(
         let mut val_runs = Vec::new();
         let seeds = seeds(seed, plan.seeds);
         for &s in &seeds {
-            let model = Model::load(&model_dir(out, name, s))?;
-            let pred = model.predict(&test)?;
+            let model = training::load_model(&model_dir(out, name, s))?;
+            let pred = training::predict(&model, &test)?;
             runs.push(training::mae_in(&test, &pred, None));
             val_runs.push(Mae::from(model.bundle.config.metrics.validation));
         }
@@ -155,7 +181,7 @@ pub fn run(
 pub fn models(out: &Path, name: &str, seed: u64, n: usize) -> Result<Vec<Model>, Error> {
     seeds(seed, n)
         .into_iter()
-        .map(|s| Model::load(&model_dir(out, name, s)))
+        .map(|s| training::load_model(&model_dir(out, name, s)))
         .collect()
 }
 

@@ -10,7 +10,9 @@ use crate::plan::Plan;
 use crate::results::{Exp2Cell, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
-use crate::training::{self, Error, Model, TrainSpec};
+use crate::stage::{FeatureSet, Stage};
+use crate::training::{self, Error, TrainSpec};
+use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 
@@ -71,21 +73,10 @@ pub fn run(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<Exp2Cell>, Error> {
-    let ds = cache.dataset();
-    let all = ds.trials(
-        &[
-            splits.get(Split::Train),
-            splits.get(Split::Val),
-            splits.get(Split::Test),
-        ]
-        .concat(),
-    )?;
-    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
-    progress.stage("features (experiment 2)", all.len() as u64);
-    cache.ensure(&all, &configs, Sampling::WITH_STOP, &|| progress.advance(1))?;
     let jobs = jobs(reprs, plan, seed, out);
-    progress.stage("experiment 2 training", jobs.len() as u64);
-    exp1::train_all(cache, splits, &jobs, progress)?;
+    let stages = (FeatureSet::Exp2, Stage::Exp2Training);
+    let sampling = Sampling::WITH_STOP;
+    exp1::features_then_training(cache, splits, reprs, sampling, stages, &jobs, progress)?;
     let mut cells = Vec::new();
     for (setting, _) in SETTINGS {
         for &(name, config) in reprs {
@@ -102,12 +93,12 @@ pub fn run(
             } else {
                 exp1::seeds(seed, plan.exp2_seeds)
                     .into_iter()
-                    .map(|s| Model::load(&model_dir(out, setting, name, s)))
+                    .map(|s| training::load_model(&model_dir(out, setting, name, s)))
                     .collect::<Result<_, _>>()?
             };
             let (mut motion, mut stop) = (Vec::new(), Vec::new());
             for m in &models {
-                let pred = m.predict(&test)?;
+                let pred = training::predict(m, &test)?;
                 motion.push(training::mae_in(&test, &pred, Some(Phase::Motion)));
                 stop.push(training::mae_in(&test, &pred, Some(Phase::Stop)));
             }

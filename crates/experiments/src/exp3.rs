@@ -5,8 +5,10 @@ use crate::cache::FeatureCache;
 use crate::jobs::Progress;
 use crate::results::{Exp3Point, MaeStats};
 use crate::sampling::{Phase, Sampling};
-use crate::training::{self, Error, Model};
+use crate::stage::{FeatureSet, Stage};
+use crate::training::{self, Error};
 use evtac_events::manifest::TrialMeta;
+use evtac_learn::Model;
 use std::collections::BTreeMap;
 
 /// Which condition a dataset varies.
@@ -49,28 +51,26 @@ pub fn run(
     }
     let configs: Vec<_> = models
         .iter()
-        .filter_map(|(_, m)| m.first().map(|m| m.representation.config))
+        .filter_map(|(_, m)| m.first().map(|m| m.repr_config()))
         .collect();
-    progress.stage(
-        match axis {
-            Axis::Speed => "features (experiment 3, speed)",
-            Axis::Depth => "features (experiment 3, depth)",
-        },
-        trials.len() as u64,
-    );
+    let set = match axis {
+        Axis::Speed => FeatureSet::Exp3Speed,
+        Axis::Depth => FeatureSet::Exp3Depth,
+    };
+    progress.stage(Stage::Features(set), trials.len() as u64);
     cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
     let mut out = Vec::new();
     for (name, ms) in models {
         let Some(first) = ms.first() else { continue };
         let set = cache.load(
             &trials,
-            &first.representation.config,
+            &first.repr_config(),
             Sampling::MOTION,
             &[Phase::Motion],
         )?;
         let preds: Vec<Vec<[f32; 2]>> = ms
             .iter()
-            .map(|m| m.predict(&set))
+            .map(|m| training::predict(m, &set))
             .collect::<Result<_, _>>()?;
         let labels = training::label_rows(&set);
         for (&key, members) in &by_value {

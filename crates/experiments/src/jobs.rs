@@ -3,6 +3,7 @@
 //! jobs (folders with `done`); a half-written folder is redone. The same job list can be exported
 //! as one `evtac ...` command per line for a Slurm array or GNU parallel.
 
+use crate::stage::Stage;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -26,9 +27,9 @@ pub enum Error {
 /// Progress of a long run, reported by the library and shown by the binary (libraries never
 /// print). Every method has a do-nothing default.
 pub trait Progress: Sync {
-    /// A stage named `name` starts with `total` units of work.
-    fn stage(&self, name: &str, total: u64) {
-        let _ = (name, total);
+    /// `stage` starts with `total` units of work.
+    fn stage(&self, stage: Stage, total: u64) {
+        let _ = (stage, total);
     }
     /// `n` units of the current stage are done.
     fn advance(&self, n: u64) {

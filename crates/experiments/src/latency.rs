@@ -1,24 +1,25 @@
 //! The latency study: Experiment 1's test trials processed sequentially at sampling intervals of
 //! 1, 2, 5 and 10 ms; the end-to-end time of each step, from handing the step's new events to the
-//! representation (crop included) to the end of the MLP's forward pass, at 50 uniformly spaced
-//! steps per trial (so long trials do not dominate). Median, P99 and max per representation and
+//! estimator (crop included) to the end of the MLP's forward pass, at 50 uniformly spaced steps
+//! per trial (so long trials do not dominate). Median, P99 and max per representation and
 //! interval.
 //!
-//! Events before motion onset are applied before timing starts: the sensor is still then and an
-//! online system would have processed them as they came (and made an estimate from them, which
-//! primes the [`StreamingPredictor`] the steps run through, as `evtac online` does). Likewise
-//! each step's work that is known before its events arrive (the dynamic window dropping what
-//! leaves it, and the combined representation's accumulator taking those events, see
-//! `FeatureExtractor::deferring_accumulation`) is done before its timing starts, as `evtac
-//! online` does between estimates. Runs on the calling thread, alone.
+//! Each step runs through [`evtac_online::Estimator`], the estimation core of `evtac online`, so
+//! the study measures what runs live, not a copy of it: one chunk per step, stamped when it is
+//! handed over, with the step's time as the horizon. Events before motion onset go in as one
+//! untimed chunk: the sensor is still then and an online system would have processed them as
+//! they came (its estimate at onset primes the streaming first layer, as live). The work the
+//! estimator does ahead of each estimate (the window dropping what leaves it by then, and the
+//! combined representation's accumulator taking those events) happens at the end of the previous
+//! step, outside the timing, as it does between estimates live. Runs on the calling thread,
+//! alone.
 
-use crate::dataset::{self, Dataset, FRAME};
+use crate::dataset::{self, Dataset};
 use crate::results::LatencyCell;
 use crate::sampling::{MOTION_POINTS, equally_spaced_indices};
-use crate::training::Model;
 use evtac_events::manifest::TrialMeta;
-use evtac_learn::StreamingPredictor;
-use evtac_repr::{FeatureExtractor, Mask};
+use evtac_learn::Model;
+use evtac_online::Estimator;
 use std::time::Instant;
 
 /// Errors of the latency study.
@@ -28,60 +29,52 @@ pub enum Error {
     /// A recording could not be read.
     #[error(transparent)]
     Dataset(#[from] dataset::Error),
-    /// The representation failed.
+    /// The estimator failed.
     #[error("trial `{trial}`: {source}")]
-    Repr {
+    Estimator {
         /// The trial.
         trial: String,
         /// The cause.
-        source: evtac_repr::ReprError,
+        source: evtac_online::EstimatorError,
     },
 }
 
-/// Measures one representation (`model` with its `mask`) at `interval_ms` over `trials`.
+/// Measures `model` (named `name` in the results) at `interval_ms` over `trials`.
 pub fn measure(
     ds: &Dataset,
     trials: &[&TrialMeta],
     name: &str,
     model: &Model,
-    mask: Option<&Mask>,
     interval_ms: u32,
 ) -> Result<LatencyCell, Error> {
     evtac_learn::flush_denormals();
-    let config = model.representation.config;
     let step = i64::from(interval_ms.max(1)) * 1000;
-    let mut fx = FeatureExtractor::new(std::slice::from_ref(&config), FRAME, mask)
-        .map_err(|source| Error::Repr {
-            trial: String::new(),
-            source,
-        })?
-        .deferring_accumulation();
-    let mut stream = StreamingPredictor::new(model.predictor.clone());
     let mut times_us = Vec::new();
     for meta in trials {
         let path = ds.dir.join(&meta.file);
         let (sensor, events) = dataset::read_full(&path)?;
-        let roi = dataset::crop_of(sensor, &path)?;
-        let repr = |source| Error::Repr {
+        let failed = |source| Error::Estimator {
             trial: meta.trial.clone(),
             source,
         };
-        fx.reset();
+        let mut estimator = Estimator::for_model(model, sensor, step).map_err(failed)?;
+        estimator.start_grid_at(meta.motion_start_us);
         let mut cursor = events.partition_point(|e| e.t <= meta.motion_start_us);
-        fx.push_with_roi(&events[..cursor], &roi).map_err(repr)?;
-        fx.advance_to(meta.motion_start_us).map_err(repr)?;
-        stream.predict(fx.features(0));
+        let horizon = Some(meta.motion_start_us);
+        estimator
+            .process(&events[..cursor], horizon, Instant::now(), &mut |_| {})
+            .map_err(failed)?;
         let mut trial_times = Vec::new();
         let mut t_k = meta.motion_start_us + step;
         while t_k <= meta.motion_end_us {
-            fx.prepare(t_k).map_err(repr)?;
-            let started = Instant::now();
             let end = cursor + events[cursor..].partition_point(|e| e.t <= t_k);
-            fx.push_with_roi(&events[cursor..end], &roi).map_err(repr)?;
-            fx.advance_to(t_k).map_err(repr)?;
-            let y = stream.predict(fx.features(0));
-            std::hint::black_box(y);
-            trial_times.push(started.elapsed().as_secs_f64() * 1e6);
+            let mut record = |estimate: &evtac_online::Estimate| {
+                std::hint::black_box(estimate);
+                trial_times.push(estimate.latency.as_secs_f64() * 1e6);
+            };
+            estimator
+                .process(&events[cursor..end], Some(t_k), Instant::now(), &mut record)
+                .map_err(failed)?;
             cursor = end;
             t_k += step;
         }

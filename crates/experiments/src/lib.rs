@@ -7,7 +7,8 @@
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
 //!   computed in one pass for many configs, reused.
-//! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption.
+//! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
+//!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
 //!   experiments; [`pipeline`] runs them all; [`results`], [`report`] and [`plots`] write
@@ -21,7 +22,7 @@
 //!
 //! // Datasets as `evtac simulate` writes them: data/exp1, data/exp2, data/exp3-speed, ...
 //! let data = Datasets::in_dir(Path::new("data"));
-//! let plan = Plan::for_scale("small").expect("a known scale");
+//! let plan = Plan::for_scale(evtac_sim::Scale::Small);
 //! let results = reproduce(&data, &plan, 0, Path::new("out"), &Quiet)?;
 //! println!("static test MAE {}", results.exp1[0].test.overall.display());
 //! # Ok::<(), evtac_experiments::pipeline::Error>(())
@@ -42,5 +43,6 @@ pub mod report;
 pub mod results;
 pub mod sampling;
 pub mod splits;
+pub mod stage;
 pub mod training;
 pub mod tuning;

@@ -10,9 +10,11 @@ use crate::plan::Plan;
 use crate::results::{Results, RunInfo};
 use crate::sampling::Sampling;
 use crate::splits::Split;
-use crate::training::{self, Model, TrainSpec};
+use crate::stage::Stage;
+use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
 use crate::{examples, exp1, exp2, exp3, latency, report};
+use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -36,6 +38,19 @@ pub enum Error {
     /// The feature cache failed.
     #[error(transparent)]
     Cache(#[from] crate::cache::Error),
+    /// A dataset could not be simulated.
+    #[error("simulating {protocol} into {dir}: {source}")]
+    Simulation {
+        /// The protocol.
+        protocol: evtac_sim::Protocol,
+        /// The dataset folder.
+        dir: PathBuf,
+        /// The cause (boxed: it is large, and rare).
+        source: Box<evtac_sim::DatasetError>,
+    },
+    /// The `done` marker of a simulated dataset could not be written.
+    #[error(transparent)]
+    Jobs(#[from] jobs::Error),
     /// A tuning run's chosen config could not be read back.
     #[error("the {0} tuning chose no readable config")]
     NoChoice(&'static str),
@@ -68,7 +83,7 @@ impl Datasets {
     pub fn in_dir(dir: &Path) -> Datasets {
         let opt = |name: &str| {
             let p = dir.join(name);
-            p.join(evtac_events::manifest::FILE_NAME)
+            p.join(evtac_events::layout::MANIFEST_FILE)
                 .is_file()
                 .then_some(p)
         };
@@ -79,6 +94,35 @@ impl Datasets {
             exp3_depth: opt("exp3-depth"),
         }
     }
+}
+
+/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) at `scale` into
+/// `dir`, laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked done is
+/// kept, so an interrupted simulation resumes.
+pub fn simulate_all(
+    dir: &Path,
+    scale: evtac_sim::Scale,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<(), Error> {
+    for protocol in crate::stage::PROTOCOLS {
+        let out = dir.join(protocol.name());
+        if jobs::is_done(&out) {
+            continue;
+        }
+        let config = evtac_sim::DatasetConfig::new(protocol, scale, seed);
+        let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
+        progress.stage(Stage::Simulating(protocol), n as u64);
+        evtac_sim::simulate_dataset(&config, &out, |_| progress.advance(1)).map_err(|source| {
+            Error::Simulation {
+                protocol,
+                dir: out.clone(),
+                source: Box::new(source),
+            }
+        })?;
+        jobs::mark_done(&out)?;
+    }
+    Ok(())
 }
 
 struct Stages<'a> {
@@ -159,7 +203,7 @@ pub fn reproduce(
             let loaded: Vec<(&str, Model)> = reprs
                 .iter()
                 .map(|(name, _)| {
-                    Model::load(&exp2::model_dir(&models, exp2::SETTINGS[2].0, name, seed))
+                    training::load_model(&exp2::model_dir(&models, exp2::SETTINGS[2].0, name, seed))
                         .map(|m| (*name, m))
                 })
                 .collect::<Result<_, _>>()?;
@@ -206,22 +250,14 @@ pub fn reproduce(
     let test = ds1.trials(splits1.get(Split::Test))?;
     let test = &test[..test.len().min(plan.latency_trials)];
     progress.stage(
-        "latency",
+        Stage::Latency,
         (exp1_models.len() * plan.latency_intervals_ms.len()) as u64,
     );
     let mut lat = Vec::new();
     for (name, ms) in &exp1_models {
         let Some(model) = ms.first() else { continue };
-        let mask = cache1.mask(&model.representation.config)?;
         for &iv in &plan.latency_intervals_ms {
-            lat.push(latency::measure(
-                &ds1,
-                test,
-                name,
-                model,
-                mask.as_ref(),
-                iv,
-            )?);
+            lat.push(latency::measure(&ds1, test, name, model, iv)?);
             progress.advance(1);
         }
     }
@@ -229,7 +265,7 @@ pub fn reproduce(
 
     let mut results = Results {
         run: RunInfo {
-            scale: plan.scale.clone(),
+            scale: plan.scale.name().to_string(),
             seed,
             plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
             stage_seconds: Vec::new(),

@@ -8,13 +8,14 @@
 //! tuning figure shows). The report states the plan it ran.
 
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use evtac_sim::Scale;
 use serde::{Deserialize, Serialize};
 
 /// The settings of one reproduction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
-    /// `tiny`, `small` or `paper`.
-    pub scale: String,
+    /// The scale: also how many trials the simulated datasets have.
+    pub scale: Scale,
     /// Static decay constants tried, ms.
     pub static_taus_ms: Vec<f64>,
     /// Static thresholds tried, event contributions.
@@ -44,13 +45,13 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The plan of a scale (`tiny`, `small`, `paper`), or `None` for another name.
-    pub fn for_scale(scale: &str) -> Option<Plan> {
+    /// The plan of a scale.
+    pub fn for_scale(scale: Scale) -> Plan {
         let paper_center_static = (1000.0, 2.0);
         let paper_center_dynamic = (640.0, 0);
         match scale {
-            "paper" => Some(Plan {
-                scale: scale.into(),
+            Scale::Paper => Plan {
+                scale,
                 static_taus_ms: vec![100.0, 250.0, 500.0, 750.0, 1000.0, 1500.0, 2000.0],
                 static_thresholds: vec![0.0, 1.0, 2.0, 3.0, 4.0],
                 dynamic_windows_ms: vec![10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0],
@@ -64,9 +65,9 @@ impl Plan {
                 exp2_seeds: 10,
                 latency_trials: 150,
                 latency_intervals_ms: vec![1, 2, 5, 10],
-            }),
-            "small" => Some(Plan {
-                scale: scale.into(),
+            },
+            Scale::Small => Plan {
+                scale,
                 static_taus_ms: vec![100.0, 300.0, 1000.0, 2000.0],
                 static_thresholds: vec![0.0, 1.0, 2.0, 4.0],
                 dynamic_windows_ms: vec![40.0, 160.0, 640.0, 1280.0],
@@ -80,9 +81,9 @@ impl Plan {
                 exp2_seeds: 3,
                 latency_trials: 20,
                 latency_intervals_ms: vec![1, 2, 5, 10],
-            }),
-            "tiny" => Some(Plan {
-                scale: scale.into(),
+            },
+            Scale::Tiny => Plan {
+                scale,
                 static_taus_ms: vec![100.0, 1000.0],
                 static_thresholds: vec![0.0, 2.0],
                 dynamic_windows_ms: vec![80.0, 640.0],
@@ -96,8 +97,7 @@ impl Plan {
                 exp2_seeds: 2,
                 latency_trials: 2,
                 latency_intervals_ms: vec![1, 2, 5, 10],
-            }),
-            _ => None,
+            },
         }
     }
 
@@ -166,18 +166,17 @@ mod tests {
 
     #[test]
     fn paper_and_small_grids_are_full_and_tiny_grid_is_a_cross() {
-        let paper = Plan::for_scale("paper").unwrap();
+        let paper = Plan::for_scale(Scale::Paper);
         assert_eq!(paper.static_grid().len(), 7 * 5);
         assert_eq!(paper.dynamic_grid().len(), 8 * 5);
-        let small = Plan::for_scale("small").unwrap();
+        let small = Plan::for_scale(Scale::Small);
         assert_eq!(small.static_grid().len(), 4 * 4);
         assert_eq!(small.dynamic_grid().len(), 4 * 4);
-        let tiny = Plan::for_scale("tiny").unwrap();
+        let tiny = Plan::for_scale(Scale::Tiny);
         let g = tiny.static_grid();
         // 2 taus at threshold 2, plus the other threshold at tau 1000.
         assert_eq!(g.len(), 2 + 1);
         assert!(g.contains(&(1000.0, 2.0)));
         assert!(g.iter().all(|&(t, th)| t == 1000.0 || th == 2.0));
-        assert!(Plan::for_scale("huge").is_none());
     }
 }

@@ -7,6 +7,7 @@
 //! speed, depth and direction (and overall size), so every marginal ends within a trial or two of
 //! 70:15:15. A plain random split leaves marginals off by several trials at these sizes.
 
+use evtac_events::layout::SPLITS_FILE;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -14,8 +15,6 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::Path;
 
-/// File name of the splits inside a dataset folder.
-pub const SPLITS_FILE: &str = "splits.json";
 /// Shares of the train, validation and test splits.
 pub const RATIOS: [f64; 3] = [0.70, 0.15, 0.15];
 

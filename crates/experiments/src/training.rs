@@ -3,13 +3,13 @@
 //! `done` marker. `evtac train` and `evtac reproduce` both run exactly this.
 
 use crate::cache::{self, FeatureCache, LoadedSet};
-use crate::dataset::{self, FRAME};
+use crate::dataset;
 use crate::results::Mae;
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
-use evtac_learn::{EpochRecord, ModelBundle, Predictor, TrainConfig};
+use evtac_learn::bundle::SampleCounts;
+use evtac_learn::{EpochRecord, Model, ModelBundle, Representation, TrainConfig};
 use evtac_repr::ReprConfig;
-use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -42,14 +42,6 @@ pub enum Error {
         /// The cause.
         source: evtac_learn::predictor::Error,
     },
-    /// The bundle's representation is not a representation config.
-    #[error("{model}: the bundle's `representation` is not an evtac representation: {source}")]
-    Representation {
-        /// The model folder.
-        model: PathBuf,
-        /// The cause.
-        source: serde_json::Error,
-    },
     /// The job's marker could not be written.
     #[error(transparent)]
     Jobs(#[from] crate::jobs::Error),
@@ -63,19 +55,6 @@ pub enum Error {
         /// The phases asked for.
         phases: Vec<Phase>,
     },
-}
-
-/// What the bundle's `representation` holds: everything needed to compute the features again.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Representation {
-    /// The representation config.
-    pub config: ReprConfig,
-    /// The crop the features are pooled from (`240x240`, centered on the sensor).
-    pub frame: String,
-    /// Samples per phase used for training.
-    pub sampling: Sampling,
-    /// Phases trained on.
-    pub phases: Vec<Phase>,
 }
 
 /// One training job.
@@ -153,77 +132,34 @@ pub fn train_job(
         }
     })?;
     let val_mae = Mae::from(trained.best_val);
-    let mask = cache.mask(&spec.repr)?.and_then(|m| {
-        Array2::from_shape_vec(
-            (usize::from(FRAME.height), usize::from(FRAME.width)),
-            m.pixels().to_vec(),
-        )
-        .ok()
-    });
+    let mask = cache.mask(&spec.repr)?;
     let representation = Representation {
-        config: spec.repr,
-        frame: FRAME.to_string(),
-        sampling: spec.sampling,
-        phases: spec.phases.clone(),
+        sampling: Some(SampleCounts {
+            motion_points: spec.sampling.motion_points,
+            stop_points: spec.sampling.stop_points,
+        }),
+        phases: spec.phases.iter().map(|p| p.as_str().to_string()).collect(),
+        ..Representation::new(spec.repr)
     };
-    let value = serde_json::to_value(&representation).unwrap_or(serde_json::Value::Null);
-    let bundle = ModelBundle::from_trained(trained, cfg, value, mask);
+    let bundle = ModelBundle::from_trained(trained, cfg, representation, mask);
     bundle.save(out)?;
     crate::jobs::mark_done(out)?;
     Ok(val_mae)
 }
 
-/// A loaded model: its predictor and representation.
-pub struct Model {
-    /// Where it was loaded from.
-    pub dir: PathBuf,
-    /// The bundle.
-    pub bundle: ModelBundle,
-    /// Its representation settings.
-    pub representation: Representation,
-    /// Its predictor.
-    pub predictor: Predictor,
+/// Loads the model bundle a training job wrote into `dir`.
+pub fn load_model(dir: &Path) -> Result<Model, Error> {
+    Ok(Model::load(dir)?)
 }
 
-impl std::fmt::Debug for Model {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Model")
-            .field("dir", &self.dir)
-            .field("representation", &self.representation)
-            .finish()
-    }
-}
-
-impl Model {
-    /// Loads the bundle in `dir`.
-    pub fn load(dir: &Path) -> Result<Model, Error> {
-        let bundle = ModelBundle::load(dir)?;
-        let representation: Representation =
-            serde_json::from_value(bundle.config.representation.clone()).map_err(|source| {
-                Error::Representation {
-                    model: dir.to_path_buf(),
-                    source,
-                }
-            })?;
-        let predictor = bundle.predictor()?;
-        Ok(Model {
-            dir: dir.to_path_buf(),
-            bundle,
-            representation,
-            predictor,
+/// Predictions of `model` for every row of `set`.
+pub fn predict(model: &Model, set: &LoadedSet) -> Result<Vec<[f32; 2]>, Error> {
+    model
+        .predict(&set.set.features)
+        .map_err(|source| Error::Predict {
+            model: model.dir.clone(),
+            source,
         })
-    }
-
-    /// Predictions for every row of `set`.
-    pub fn predict(&self, set: &LoadedSet) -> Result<Vec<[f32; 2]>, Error> {
-        evtac_learn::flush_denormals();
-        self.predictor
-            .predict(&set.set.features)
-            .map_err(|source| Error::Predict {
-                model: self.dir.clone(),
-                source,
-            })
-    }
 }
 
 /// Labels of a loaded set as rows.

@@ -8,6 +8,7 @@ use crate::plan::{self, Plan};
 use crate::results::{Mae, Tuning, TuningRun};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
+use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error, TrainSpec};
 use evtac_learn::ModelBundle;
 use evtac_repr::ReprConfig;
@@ -101,11 +102,11 @@ pub fn tune(
     let trials = ds.trials(&[splits.get(Split::Train), splits.get(Split::Val)].concat())?;
     let configs: Vec<ReprConfig> = points.iter().map(|p| p.config).collect();
     progress.stage(
-        &format!("features ({} tuning)", kind.name()),
+        Stage::Features(FeatureSet::Tuning(kind)),
         trials.len() as u64,
     );
     cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
-    progress.stage(&format!("tuning {}", kind.name()), points.len() as u64);
+    progress.stage(Stage::Tuning(kind), points.len() as u64);
     jobs::run_all(
         &points,
         |p| run_dir(out, kind, &p.config),

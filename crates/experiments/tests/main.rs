@@ -1,7 +1,6 @@
 //! Integration tests of evtac-experiments on small simulated datasets.
 
 mod cache;
-mod pipeline;
 mod resume;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};

@@ -19,7 +19,7 @@ fn resumed_run_redoes_only_the_unfinished_job() {
     let splits = ds.splits(1).unwrap();
     assert!(data.join("splits.json").is_file());
     let cache = FeatureCache::new(&ds).unwrap();
-    let mut p = Plan::for_scale("tiny").unwrap();
+    let mut p = Plan::for_scale(evtac_sim::Scale::Tiny);
     p.epochs = 1;
     p.seeds = 2;
     let reprs = exp1::representations(

@@ -2,6 +2,7 @@
 //! trial's recording, write `labels/<trial>.csv`, and check the labels against the commanded
 //! stop angles and, where the simulator left one, the exact ground truth.
 
+use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR};
 use std::path::{Path, PathBuf};
 
 use evtac_events::ImuSample;
@@ -13,12 +14,6 @@ use crate::geometry::Calibration;
 use crate::series::LabelSeries;
 use crate::trial::{LabelConfig, TrialLabels, TrialMotion, label_imu};
 use crate::validation::{StopCheck, Summary, TruthError};
-
-/// The calibration's file name inside a dataset folder.
-pub const CALIBRATION_FILE: &str = "calibration.json";
-
-/// The folder, inside a dataset folder, that holds the labels.
-pub const LABELS_DIR: &str = "labels";
 
 /// Where the labels of `trial` go: `<dataset_dir>/labels/<trial>.csv`.
 pub fn labels_path(dataset_dir: impl AsRef<Path>, trial: &str) -> PathBuf {

@@ -3,8 +3,8 @@
 //! | file                | contents |
 //! |---------------------|----------|
 //! | `model.safetensors` | weights in PyTorch `nn.Linear` layout: `layers.{i}.weight` f32 `[out, in]` and `layers.{i}.bias` f32 `[out]` for `i = 0..4` (900-256-128-64-2); metadata `{"format": "pt"}` |
-//! | `config.json`       | [`BundleConfig`]: format version, architecture, training config (with the seed), the caller's representation config, metrics |
-//! | `mask.npy`          | optional no-contact mask, u8 `H x W` (absent when none was used) |
+//! | `config.json`       | [`BundleConfig`]: format version, architecture, training config (with the seed), the [`Representation`] the features were built with (config, crop, how the samples were drawn), metrics |
+//! | `mask.npy`          | optional no-contact mask, u8 `H x W` = the crop (absent when none was used) |
 //! | `history.csv`       | one row per epoch: `epoch,train_loss,val_mae,val_mae_pitch,val_mae_roll,seconds` |
 //!
 //! In PyTorch the weights load into
@@ -14,6 +14,11 @@
 //!
 //! The safetensors file depends only on the weights, so the same seed and data give the same
 //! bytes; `history.csv` also records wall-clock times and differs between runs.
+//!
+//! Format 2 (written now) types `representation`. Format 1 bundles still load: their
+//! `representation` was the writer's own JSON, either a bare representation config or
+//! `{"config": ..., "frame": "240x240", "sampling": ..., "phases": ...}`; anything else is an
+//! error that says which shapes are understood.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -21,6 +26,8 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 use serde::{Deserialize, Serialize};
+
+use evtac_repr::{CROP, Mask, ReprConfig};
 
 use crate::metrics::Mae;
 use crate::model::{self, LAYER_SIZES, LAYERS, LayerParameters, Parameters};
@@ -35,8 +42,10 @@ pub const CONFIG_FILE: &str = "config.json";
 pub const MASK_FILE: &str = "mask.npy";
 /// The training-curve file inside a bundle.
 pub const HISTORY_FILE: &str = "history.csv";
-/// The bundle format written by this version; loading rejects other versions.
-pub const FORMAT_VERSION: u32 = 1;
+/// The bundle format written by this version.
+pub const FORMAT_VERSION: u32 = 2;
+/// The oldest bundle format this version still loads.
+pub const OLDEST_FORMAT_VERSION: u32 = 1;
 /// Header of `history.csv`.
 const HISTORY_HEADER: &str = "epoch,train_loss,val_mae,val_mae_pitch,val_mae_roll,seconds";
 
@@ -99,14 +108,37 @@ pub enum Error {
         source: serde_json::Error,
     },
     /// The bundle was written by an incompatible format version.
-    #[error("{path}: format_version {found} is not supported (this build reads {FORMAT_VERSION})")]
+    #[error(
+        "{path}: format_version {found} is not supported (this build reads \
+         {OLDEST_FORMAT_VERSION} to {FORMAT_VERSION})"
+    )]
     FormatVersion {
         /// The config file.
         path: PathBuf,
         /// The version found.
         found: u32,
     },
-    /// `mask.npy` could not be read as a u8 2-D array.
+    /// `config.json`'s `representation` is not one this build understands.
+    #[error(
+        "{path}: `representation` is not an evtac representation (expected \
+         {{\"config\": {{\"kind\": \"static\" | \"dynamic\" | \"combined\", ...}}, \
+         \"frame\": \"240x240\"}}, or in format 1 a bare config): {reason}"
+    )]
+    Representation {
+        /// The config file.
+        path: PathBuf,
+        /// Why it did not parse.
+        reason: String,
+    },
+    /// The features were built on a crop other than the one evtac's 900 inputs come from.
+    #[error("{path}: the model's features come from a {frame} crop; evtac's MLP takes {CROP}")]
+    Frame {
+        /// The config file.
+        path: PathBuf,
+        /// The crop the bundle names.
+        frame: String,
+    },
+    /// `mask.npy` could not be read as a u8 2-D array of the crop's size.
     #[error("{path}: {message}")]
     Mask {
         /// The file.
@@ -141,20 +173,116 @@ pub struct BundleMetrics {
     pub evaluations: BTreeMap<String, Mae>,
 }
 
+/// How many samples per trial the training set took from each phase (provenance: loading never
+/// interprets it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SampleCounts {
+    /// Points from each trial's motion phase.
+    pub motion_points: usize,
+    /// Points from each trial's stop phase (0: none).
+    pub stop_points: usize,
+}
+
+/// What the model's 900 inputs are: everything needed to compute the features again.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Representation {
+    /// The representation config.
+    pub config: ReprConfig,
+    /// The crop of the sensor the features are pooled from, centered (always [`CROP`]).
+    #[serde(with = "resolution_text")]
+    pub frame: evtac_events::Resolution,
+    /// How the training samples were drawn, when the writer knows (provenance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<SampleCounts>,
+    /// The trial phases trained on (`motion`, `stop`), when the writer knows (provenance).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<String>,
+}
+
+impl Representation {
+    /// `config` on the paper's crop, with no provenance.
+    pub fn new(config: ReprConfig) -> Self {
+        Self {
+            config,
+            frame: CROP,
+            sampling: None,
+            phases: Vec::new(),
+        }
+    }
+}
+
+/// A resolution as `"240x240"`, the way people write it.
+mod resolution_text {
+    use evtac_events::Resolution;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(r: &Resolution, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(r)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Resolution, D::Error> {
+        let text = String::deserialize(d)?;
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
+
 /// The contents of `config.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BundleConfig {
-    /// Bundle format version ([`FORMAT_VERSION`]).
+    /// Bundle format version ([`FORMAT_VERSION`] when written by this build).
     pub format_version: u32,
     /// Layer widths, input first (always `[900, 256, 128, 64, 2]`; informational).
     pub architecture: Vec<usize>,
     /// The training recipe, including the seed.
     pub training: TrainConfig,
-    /// The representation settings needed to compute the features again, as the caller's own
-    /// serde value (this crate does not interpret it).
-    pub representation: serde_json::Value,
+    /// What the inputs are.
+    pub representation: Representation,
     /// Validation and evaluation results.
     pub metrics: BundleMetrics,
+}
+
+/// `config.json` with its representation not yet interpreted (it depends on the version).
+#[derive(Deserialize)]
+struct RawConfig {
+    format_version: u32,
+    architecture: Vec<usize>,
+    training: TrainConfig,
+    representation: serde_json::Value,
+    metrics: BundleMetrics,
+}
+
+impl RawConfig {
+    /// The typed config, reading format 1's representation shapes too.
+    fn typed(self, path: &Path) -> Result<BundleConfig, Error> {
+        let invalid = |reason: String| Error::Representation {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let value = self.representation;
+        let representation = match serde_json::from_value::<Representation>(value.clone()) {
+            Ok(r) => r,
+            Err(typed) if self.format_version == 1 => {
+                // Format 1 also wrote a bare config (online tests, hand-made bundles).
+                serde_json::from_value::<ReprConfig>(value)
+                    .map(Representation::new)
+                    .map_err(|bare| invalid(format!("{typed}; as a bare config: {bare}")))?
+            }
+            Err(typed) => return Err(invalid(typed.to_string())),
+        };
+        if representation.frame != CROP {
+            return Err(Error::Frame {
+                path: path.to_path_buf(),
+                frame: representation.frame.to_string(),
+            });
+        }
+        Ok(BundleConfig {
+            format_version: self.format_version,
+            architecture: self.architecture,
+            training: self.training,
+            representation,
+            metrics: self.metrics,
+        })
+    }
 }
 
 /// A trained model with its provenance (see the module docs for the folder layout).
@@ -164,20 +292,20 @@ pub struct ModelBundle {
     pub parameters: Parameters,
     /// The configuration and metrics.
     pub config: BundleConfig,
-    /// The no-contact mask used by the representation, if any (u8, `H x W`).
-    pub mask: Option<Array2<u8>>,
+    /// The no-contact mask used by the representation, if any (the crop's size).
+    pub mask: Option<Mask>,
     /// The training curve.
     pub history: Vec<EpochRecord>,
 }
 
 impl ModelBundle {
-    /// A bundle from a training result, the config it was trained with, the caller's
-    /// representation settings and the mask.
+    /// A bundle from a training result, the config it was trained with, the representation
+    /// and the mask.
     pub fn from_trained(
         trained: Trained,
         training: TrainConfig,
-        representation: serde_json::Value,
-        mask: Option<Array2<u8>>,
+        representation: Representation,
+        mask: Option<Mask>,
     ) -> Self {
         Self {
             parameters: trained.parameters,
@@ -195,6 +323,27 @@ impl ModelBundle {
             mask,
             history: trained.history,
         }
+    }
+
+    /// An untrained bundle: PyTorch's initial weights from `seed`, no training curve, zero
+    /// metrics. For checking a pipeline end to end without training first (tests, benchmarks).
+    pub fn untrained(seed: u64, representation: Representation, mask: Option<Mask>) -> Self {
+        let zero = Mae {
+            overall: 0.0,
+            pitch: 0.0,
+            roll: 0.0,
+        };
+        let trained = Trained {
+            parameters: Parameters::init(seed),
+            best_epoch: 0,
+            best_val: zero,
+            history: Vec::new(),
+        };
+        let training = TrainConfig {
+            seed,
+            ..TrainConfig::default()
+        };
+        Self::from_trained(trained, training, representation, mask)
     }
 
     /// A [`Predictor`] for these weights.
@@ -225,10 +374,16 @@ impl ModelBundle {
 
         let mask_path = dir.join(MASK_FILE);
         match &self.mask {
-            Some(mask) => ndarray_npy::write_npy(&mask_path, mask).map_err(|e| Error::Mask {
-                path: mask_path.clone(),
-                message: e.to_string(),
-            })?,
+            Some(mask) => {
+                let size = mask.resolution();
+                let shape = (usize::from(size.height), usize::from(size.width));
+                let array = Array2::from_shape_vec(shape, mask.pixels().to_vec())
+                    .expect("a mask holds height x width pixels");
+                ndarray_npy::write_npy(&mask_path, &array).map_err(|e| Error::Mask {
+                    path: mask_path.clone(),
+                    message: e.to_string(),
+                })?
+            }
             None => match std::fs::remove_file(&mask_path) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                     return Err(io(&mask_path)(e));
@@ -266,25 +421,21 @@ impl ModelBundle {
             path: config_path.clone(),
             source,
         })?;
-        if version.format_version != FORMAT_VERSION {
+        if !(OLDEST_FORMAT_VERSION..=FORMAT_VERSION).contains(&version.format_version) {
             return Err(Error::FormatVersion {
                 path: config_path,
                 found: version.format_version,
             });
         }
-        let config: BundleConfig = serde_json::from_str(&text).map_err(|source| Error::Json {
+        let raw: RawConfig = serde_json::from_str(&text).map_err(|source| Error::Json {
             path: config_path.clone(),
             source,
         })?;
+        let config = raw.typed(&config_path)?;
 
         let mask_path = dir.join(MASK_FILE);
         let mask = if mask_path.is_file() {
-            Some(
-                ndarray_npy::read_npy::<_, Array2<u8>>(&mask_path).map_err(|e| Error::Mask {
-                    path: mask_path.clone(),
-                    message: e.to_string(),
-                })?,
-            )
+            Some(read_mask(&mask_path, config.representation.frame)?)
         } else {
             None
         };
@@ -305,6 +456,23 @@ impl ModelBundle {
             history,
         })
     }
+}
+
+/// Reads `mask.npy` and checks that it covers `frame`.
+fn read_mask(path: &Path, frame: evtac_events::Resolution) -> Result<Mask, Error> {
+    let err = |message: String| Error::Mask {
+        path: path.to_path_buf(),
+        message,
+    };
+    let array = ndarray_npy::read_npy::<_, Array2<u8>>(path).map_err(|e| err(e.to_string()))?;
+    let (height, width) = array.dim();
+    if (width, height) != (usize::from(frame.width), usize::from(frame.height)) {
+        return Err(err(format!(
+            "the mask is {width}x{height} but the features' crop is {frame}"
+        )));
+    }
+    let pixels: Vec<u8> = array.iter().copied().collect();
+    Mask::from_pixels(frame, &pixels).map_err(|e| err(e.to_string()))
 }
 
 /// Reads and checks only the weights of `model.safetensors` (e.g. for prediction).
@@ -465,8 +633,11 @@ mod tests {
                 seed,
                 ..TrainConfig::default()
             },
-            serde_json::json!({"static": {"tau_ms": 1000}}),
-            mask.then(|| Array2::from_shape_fn((4, 3), |(y, x)| u8::from(x == y))),
+            Representation::new(ReprConfig::Static(Default::default())),
+            mask.then(|| {
+                let pixels: Vec<u8> = (0..CROP.pixels()).map(|i| u8::from(i % 7 == 0)).collect();
+                Mask::from_pixels(CROP, &pixels).expect("the crop's size")
+            }),
         )
     }
 
@@ -496,6 +667,77 @@ mod tests {
             load_weights(&dir.path().join(MODEL_FILE)),
             Err(Error::SafeTensors { .. })
         ));
+    }
+
+    /// Rewrites the saved `config.json`'s representation as `representation` and its version.
+    fn with_config(dir: &Path, version: u32, representation: serde_json::Value) {
+        let path = dir.join(CONFIG_FILE);
+        let mut json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("json");
+        json["format_version"] = version.into();
+        json["representation"] = representation;
+        std::fs::write(&path, json.to_string()).expect("write");
+    }
+
+    #[test]
+    fn format_1_bundles_still_load() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let b = bundle(2, true);
+        b.save(dir.path()).expect("save");
+        let config =
+            serde_json::json!({"kind": "dynamic", "window_ms": 640.0, "count_threshold": 0});
+        // A bare config, as online tests and hand-made bundles wrote it.
+        with_config(dir.path(), 1, config.clone());
+        let loaded = ModelBundle::load(dir.path()).expect("bare config");
+        let expected: ReprConfig = serde_json::from_value(config.clone()).expect("config");
+        assert_eq!(loaded.config.representation, Representation::new(expected));
+        assert_eq!(loaded.mask, b.mask);
+        // The object evtac-experiments wrote.
+        let wrapped = serde_json::json!({"config": config, "frame": "240x240",
+            "sampling": {"motion_points": 50, "stop_points": 10}, "phases": ["motion", "stop"]});
+        with_config(dir.path(), 1, wrapped);
+        let r = ModelBundle::load(dir.path())
+            .expect("wrapped")
+            .config
+            .representation;
+        assert_eq!(r.config, expected);
+        assert_eq!(r.sampling.map(|s| s.stop_points), Some(10));
+        assert_eq!(r.phases, ["motion", "stop"]);
+        // Format 2 does not take a bare config, and nothing takes another shape.
+        with_config(dir.path(), 2, serde_json::json!({"kind": "dynamic"}));
+        let e = ModelBundle::load(dir.path()).expect_err("bare in format 2");
+        assert!(matches!(e, Error::Representation { .. }), "{e}");
+        with_config(dir.path(), 1, serde_json::json!({"repr": "static"}));
+        let e = ModelBundle::load(dir.path()).expect_err("unknown shape");
+        assert!(
+            e.to_string().contains("is not an evtac representation"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn another_crop_or_mask_size_is_an_error() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        bundle(2, false).save(dir.path()).expect("save");
+        let config =
+            serde_json::json!({"kind": "dynamic", "window_ms": 640.0, "count_threshold": 0});
+        with_config(
+            dir.path(),
+            2,
+            serde_json::json!({"config": config, "frame": "320x240"}),
+        );
+        let e = ModelBundle::load(dir.path()).expect_err("frame");
+        assert!(e.to_string().contains("320x240 crop"), "{e}");
+        with_config(
+            dir.path(),
+            2,
+            serde_json::json!({"config": config, "frame": "240x240"}),
+        );
+        ModelBundle::load(dir.path()).expect("the crop");
+        let mask = Array2::<u8>::zeros((4, 3));
+        ndarray_npy::write_npy(dir.path().join(MASK_FILE), &mask).expect("write mask");
+        let e = ModelBundle::load(dir.path()).expect_err("mask size");
+        assert!(e.to_string().contains("mask is 3x4"), "{e}");
     }
 
     #[test]

@@ -23,7 +23,10 @@
 //! above `2^29`), so a pre-activation moves by at most `900 * 2^-30` (8e-7) of the largest
 //! weight: the size of the rounding a float32 sum of 900 terms makes anyway.
 
-use crate::model::INPUTS;
+use crate::model::{INPUTS, LAYER_SIZES};
+
+/// Width of the first hidden layer: the number of sums.
+const H1: usize = LAYER_SIZES[1];
 
 /// Cells pooled per feature: a feature is `count / CELL_PIXELS`.
 pub const CELL_PIXELS: u8 = 64;
@@ -46,6 +49,37 @@ pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> bool {
         on_grid &= f32::from(*c) == scaled && *c <= CELL_PIXELS;
     }
     on_grid
+}
+
+/// A stream's state: the cell counts of the latest pooled sample and the first layer's exact
+/// sums for them ([`crate::StreamingPredictor`] keeps one; [`crate::Predictor::predict`] streams
+/// a batch through one). Kept apart from the layer, so a batch needs no copy of the weights.
+#[derive(Debug, Clone)]
+pub(crate) struct CellSums {
+    counts: [u8; INPUTS],
+    sums: [f64; H1],
+}
+
+impl CellSums {
+    /// All-zero counts, whose sums are all zero.
+    pub(crate) fn new() -> Self {
+        Self {
+            counts: [0; INPUTS],
+            sums: [0.0; H1],
+        }
+    }
+
+    /// Moves the state to `counts`, updating the sums from the cells that changed, and writes
+    /// the layer's output for them into `h1`.
+    pub(crate) fn update(&mut self, layer: &CellLayer, counts: &[u8; INPUTS], h1: &mut [f32; H1]) {
+        for (cell, (&new, old)) in counts.iter().zip(self.counts.iter_mut()).enumerate() {
+            if new != *old {
+                layer.add_cell(&mut self.sums, cell, i32::from(new) - i32::from(*old));
+                *old = new;
+            }
+        }
+        layer.output(&self.sums, h1);
+    }
 }
 
 /// The first layer in fixed point (see the module docs): weights `[in][out]` row-major, so

@@ -9,6 +9,8 @@
 //!   32, 100 epochs, validation MAE per epoch, best checkpoint kept.
 //! - [`bundle`]: the [`ModelBundle`] folder (`model.safetensors`, `config.json`, `mask.npy`,
 //!   `history.csv`).
+//! - [`Model`]: a bundle loaded for use (predictor, representation, mask): what every consumer
+//!   of a trained model loads.
 //! - [`predictor`]: allocation-free single-sample inference ([`Predictor`]).
 //! - [`cell_layer`]: the first layer computed exactly on pooled cell counts, and
 //!   [`streaming`]: [`StreamingPredictor`], which updates it from the cells that changed
@@ -22,17 +24,19 @@
 //! the kernel and faulted back in, which made steps 2.5x slower here.
 //!
 //! ```no_run
-//! use evtac_learn::{FeatureSet, ModelBundle, TrainConfig, train};
+//! use evtac_learn::{FeatureSet, Model, ModelBundle, Representation, TrainConfig, train};
+//! use evtac_repr::ReprConfig;
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! # let (train_set, val_set) = (FeatureSet::default(), FeatureSet::default());
 //! let cfg = TrainConfig { seed: 7, ..TrainConfig::default() };
 //! let trained = train(&train_set, &val_set, &cfg, |r| {
 //!     eprintln!("epoch {} loss {:.4} val MAE {:.3}", r.epoch, r.train_loss, r.val_mae)
 //! })?;
-//! let bundle = ModelBundle::from_trained(trained, cfg, serde_json::json!({"repr": "static"}), None);
+//! let representation = Representation::new(ReprConfig::Static(Default::default()));
+//! let bundle = ModelBundle::from_trained(trained, cfg, representation, None);
 //! bundle.save("model".as_ref())?;
-//! let predictor = ModelBundle::load("model".as_ref())?.predictor()?;
-//! let [pitch, roll] = predictor.predict_one(&[0.0; 900]);
+//! let model = Model::load("model".as_ref())?;
+//! let [pitch, roll] = model.predictor.predict_one(&[0.0; 900]);
 //! # Ok(()) }
 //! ```
 
@@ -45,14 +49,16 @@ pub mod metrics;
 pub mod model;
 pub mod predictor;
 pub mod streaming;
+mod trained_model;
 pub mod training;
 
 pub use adamw::AdamWConfig;
-pub use bundle::{BundleConfig, BundleMetrics, ModelBundle};
+pub use bundle::{BundleConfig, BundleMetrics, ModelBundle, Representation};
 pub use data::FeatureSet;
 pub use ftz::flush_denormals;
 pub use metrics::{Mae, mae};
 pub use model::{INPUTS, Mlp, OUTPUTS, Parameters};
 pub use predictor::Predictor;
 pub use streaming::StreamingPredictor;
+pub use trained_model::Model;
 pub use training::{EpochRecord, TrainConfig, Trained, Trainer, train};

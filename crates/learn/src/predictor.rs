@@ -20,7 +20,7 @@
 //! are compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time, with
 //! identical results on all three. Training stays on burn.
 
-use crate::cell_layer::{self, CellLayer};
+use crate::cell_layer::{self, CellLayer, CellSums};
 use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
 
 /// Errors of this module.
@@ -39,7 +39,7 @@ pub enum Error {
 }
 
 /// Width of the first hidden layer.
-pub(crate) const H1: usize = LAYER_SIZES[1];
+const H1: usize = LAYER_SIZES[1];
 const H2: usize = LAYER_SIZES[2];
 const H3: usize = LAYER_SIZES[3];
 
@@ -188,7 +188,7 @@ impl Predictor {
     }
 
     /// The layers after the first, from its output.
-    pub(crate) fn after_first_layer(&self, h1: &[f32; H1]) -> [f32; 2] {
+    fn after_first_layer(&self, h1: &[f32; H1]) -> [f32; 2] {
         let mut h2 = [0.0_f32; H2];
         let mut h3 = [0.0_f32; H3];
         let mut out = [0.0_f32; OUTPUTS];
@@ -199,9 +199,25 @@ impl Predictor {
         out
     }
 
-    /// The first layer in fixed point.
-    pub(crate) fn cell_layer(&self) -> &CellLayer {
-        &self.cells
+    /// (pitch, roll) for the next sample of the stream whose state is `state`: bit for bit
+    /// [`Predictor::predict_one`]. Features off the 1/64 grid take the float32 path and leave
+    /// `state` as it was.
+    ///
+    /// # Panics
+    /// When `features.len() != 900`, as [`Predictor::predict_one`].
+    pub(crate) fn predict_streaming(&self, state: &mut CellSums, features: &[f32]) -> [f32; 2] {
+        assert_eq!(
+            features.len(),
+            INPUTS,
+            "StreamingPredictor::predict needs {INPUTS} features"
+        );
+        let mut counts = [0_u8; INPUTS];
+        if !cell_layer::cell_counts(features, &mut counts) {
+            return self.predict_one(features);
+        }
+        let mut h1 = [0.0_f32; H1];
+        state.update(&self.cells, &counts, &mut h1);
+        self.after_first_layer(&h1)
     }
 
     /// (pitch, roll) for every row of `features` (n x 900, flat).
@@ -213,10 +229,10 @@ impl Predictor {
         }
         // Rows in a set are mostly consecutive samples of a trial, which differ in few cells:
         // streaming through them gives the same results as one at a time, faster.
-        let mut stream = crate::streaming::CellSums::new();
+        let mut stream = CellSums::new();
         Ok(features
             .chunks_exact(INPUTS)
-            .map(|row| stream.predict(self, row))
+            .map(|row| self.predict_streaming(&mut stream, row))
             .collect())
     }
 }

@@ -10,9 +10,8 @@
 //! [`StreamingPredictor`] returns exactly what [`Predictor::predict_one`] does for the same
 //! features, touching about 1 KB of weights per changed cell.
 
-use crate::cell_layer;
-use crate::model::INPUTS;
-use crate::predictor::{H1, Predictor};
+use crate::cell_layer::CellSums;
+use crate::predictor::Predictor;
 
 /// A [`Predictor`] for a sequence of samples: the same results as
 /// [`Predictor::predict_one`] on each, faster when consecutive samples differ in few cells.
@@ -55,7 +54,7 @@ impl StreamingPredictor {
     /// # Panics
     /// When `features.len() != 900`, as [`Predictor::predict_one`].
     pub fn predict(&mut self, features: &[f32]) -> [f32; 2] {
-        self.state.predict(&self.predictor, features)
+        self.predictor.predict_streaming(&mut self.state, features)
     }
 
     /// Back to all-zero features (the next sample is summed from scratch).
@@ -64,52 +63,11 @@ impl StreamingPredictor {
     }
 }
 
-/// The stream's state: the cell counts of the latest pooled sample and the first layer's
-/// integer sums for them. Kept apart from the predictor so that [`Predictor::predict`] can
-/// stream through a batch without a copy of the weights.
-#[derive(Debug, Clone)]
-pub(crate) struct CellSums {
-    counts: [u8; INPUTS],
-    sums: [f64; H1],
-}
-
-impl CellSums {
-    /// All-zero counts, whose sums are all zero.
-    pub(crate) fn new() -> Self {
-        Self {
-            counts: [0; INPUTS],
-            sums: [0.0; H1],
-        }
-    }
-
-    /// See [`StreamingPredictor::predict`].
-    pub(crate) fn predict(&mut self, predictor: &Predictor, features: &[f32]) -> [f32; 2] {
-        assert_eq!(
-            features.len(),
-            INPUTS,
-            "StreamingPredictor::predict needs {INPUTS} features"
-        );
-        let mut counts = [0_u8; INPUTS];
-        if !cell_layer::cell_counts(features, &mut counts) {
-            return predictor.predict_one(features);
-        }
-        let layer = predictor.cell_layer();
-        for (cell, (&new, old)) in counts.iter().zip(self.counts.iter_mut()).enumerate() {
-            if new != *old {
-                layer.add_cell(&mut self.sums, cell, i32::from(new) - i32::from(*old));
-                *old = new;
-            }
-        }
-        let mut h1 = [0.0_f32; H1];
-        layer.output(&self.sums, &mut h1);
-        predictor.after_first_layer(&h1)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::Parameters;
+    use crate::model::INPUTS;
     use proptest::prelude::*;
 
     proptest! {

@@ -1,8 +1,10 @@
 //! Bundles: PyTorch-layout safetensors readable by the `safetensors` Python package with a numpy
 //! forward pass matching [`Predictor`], and byte-identical weights for identical seeds.
 
+use evtac_learn::Representation;
 use evtac_learn::bundle::MODEL_FILE;
 use evtac_learn::{FeatureSet, ModelBundle, Predictor, TrainConfig, train};
+use evtac_repr::{CROP, Mask, ReprConfig};
 use ndarray::Array2;
 
 /// A small deterministic training set: `n` samples whose features are bumps placed by the label.
@@ -36,8 +38,8 @@ fn train_bundle(seed: u64, dir: &std::path::Path) -> ModelBundle {
     let bundle = ModelBundle::from_trained(
         trained,
         cfg,
-        serde_json::json!({"kind": "test"}),
-        Some(Array2::from_elem((240, 240), 1u8)),
+        Representation::new(ReprConfig::default()),
+        Some(Mask::from_pixels(CROP, &[1; 240 * 240]).expect("mask")),
     );
     bundle.save(dir).expect("saves");
     bundle

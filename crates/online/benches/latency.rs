@@ -23,9 +23,10 @@ mod support;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use evtac_events::Event;
+use evtac_learn::Model;
 use evtac_online::input::{MemorySource, Paced};
 use evtac_online::pipeline::{self, PipelineConfig};
-use evtac_online::{LatencyStats, Model};
+use evtac_online::{Estimator, LatencyStats};
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
@@ -62,8 +63,7 @@ fn estimate(c: &mut Criterion) {
                     })
                     .collect();
                 let per_interval = (1000 / packet_us) as usize;
-                let mut estimator = model
-                    .estimator(support::SENSOR, 1000)
+                let mut estimator = Estimator::for_model(&model, support::SENSOR, 1000)
                     .expect("the estimator builds");
                 let mut stats = LatencyStats::new(Duration::from_millis(1));
                 let mut packet =
@@ -157,9 +157,8 @@ fn paced_pipeline(_c: &mut Criterion) {
         {
             let events = support::Synthetic::new(2, rate, 1000, SPAN_US).collect();
             let source = Paced::new(MemorySource::new(events, 1 << 16), 1000);
-            let estimator = model
-                .estimator(support::SENSOR, 1000)
-                .expect("the estimator builds");
+            let estimator =
+                Estimator::for_model(&model, support::SENSOR, 1000).expect("the estimator builds");
             let config = PipelineConfig {
                 busy_poll,
                 ..PipelineConfig::default()

@@ -21,23 +21,17 @@
 use crate::latency::LatencyStats;
 use crate::schedule::{self, Schedule};
 use evtac_events::{Event, Resolution, Roi};
-use evtac_learn::{Predictor, StreamingPredictor};
-use evtac_repr::{FeatureExtractor, Mask, ReprConfig};
+use evtac_learn::{Model, Predictor, StreamingPredictor};
+use evtac_repr::{CROP, FeatureExtractor, Mask, ReprConfig, SensorTooSmall};
 use std::time::{Duration, Instant};
-
-/// Side of the square crop the paper's representations are built on.
-pub const CROP_SIZE: u16 = 240;
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
     /// The sensor is smaller than the 240x240 region of interest.
-    #[error("the sensor ({sensor}) is smaller than the {CROP_SIZE}x{CROP_SIZE} region of interest")]
-    SensorTooSmall {
-        /// The sensor resolution.
-        sensor: Resolution,
-    },
+    #[error(transparent)]
+    SensorTooSmall(#[from] SensorTooSmall),
     /// The estimate interval is invalid.
     #[error(transparent)]
     Schedule(#[from] schedule::Error),
@@ -100,8 +94,20 @@ impl std::fmt::Debug for Estimator {
 }
 
 impl Estimator {
+    /// An estimator running `model` on a sensor of `sensor` pixels, estimating every
+    /// `interval_us` microseconds of event time.
+    pub fn for_model(model: &Model, sensor: Resolution, interval_us: i64) -> Result<Self, Error> {
+        Self::new(
+            &model.repr_config(),
+            model.mask(),
+            model.predictor.clone(),
+            sensor,
+            interval_us,
+        )
+    }
+
     /// An estimator for a sensor of `sensor` pixels, cropped to its centered 240x240 region,
-    /// with the model's representation, no-contact mask and predictor, estimating every
+    /// with the given representation, no-contact mask and predictor, estimating every
     /// `interval_us` microseconds of event time.
     pub fn new(
         representation: &ReprConfig,
@@ -110,11 +116,10 @@ impl Estimator {
         sensor: Resolution,
         interval_us: i64,
     ) -> Result<Self, Error> {
-        let crop = Resolution::new(CROP_SIZE, CROP_SIZE);
-        let roi = Roi::centered(sensor, crop).ok_or(Error::SensorTooSmall { sensor })?;
+        let roi = evtac_repr::centered_crop(sensor)?;
         // Where the representation allows it (the combined one), the accumulator takes events
         // as they leave the window, in the work done ahead of each estimate.
-        let extractor = FeatureExtractor::new(std::slice::from_ref(representation), crop, mask)?
+        let extractor = FeatureExtractor::new(std::slice::from_ref(representation), CROP, mask)?
             .deferring_accumulation();
         let schedule = Schedule::new(interval_us)?;
         let interval = Duration::from_micros(interval_us.unsigned_abs());
@@ -128,6 +133,13 @@ impl Estimator {
             counters: Counters::default(),
             stats: LatencyStats::new(interval),
         })
+    }
+
+    /// Puts the first estimate at `t_us` (then one every interval) instead of at the first
+    /// multiple of the interval at or after the first event. No effect once the first event
+    /// has been processed. Events before `t_us` are applied with no estimate for them.
+    pub fn start_grid_at(&mut self, t_us: i64) {
+        self.schedule.start_at(t_us);
     }
 
     /// The crop applied to incoming events.

@@ -1,7 +1,7 @@
 //! Online contact-angle estimation from live or replayed event streams, with measured latency.
 //!
 //! A robot needs the contact angle while it moves. This crate runs a trained model (an
-//! `evtac-learn` model bundle: weights, representation settings, no-contact mask) on an event
+//! [`evtac_learn::Model`]: weights, representation settings, no-contact mask) on an event
 //! stream and emits `(pitch, roll)` at a fixed interval of event time, stamping each estimate
 //! with its processing latency.
 //!
@@ -19,7 +19,8 @@
 //! ```no_run
 //! use evtac_online::input::{self, OpenOptions, SourceSpec};
 //! use evtac_online::pipeline::{self, Output, PipelineConfig};
-//! use evtac_online::Model;
+//! use evtac_learn::Model;
+//! use evtac_online::Estimator;
 //! use std::ops::ControlFlow;
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,7 +28,7 @@
 //! let spec: SourceSpec = "recording.aedat4".parse()?;
 //! let opened = input::open(&spec, &OpenOptions::default(), &mut |notice| eprintln!("{notice}"))?;
 //! let sensor = opened.resolution.ok_or("the recording does not state its sensor size")?;
-//! let estimator = model.estimator(sensor, 1000)?;
+//! let estimator = Estimator::for_model(&model, sensor, 1000)?;
 //! let summary = pipeline::run(opened.source, estimator, &PipelineConfig::default(), |out| {
 //!     if let Output::Estimate(e) = out {
 //!         println!("{} {} {}", e.t_us, e.pitch_deg, e.roll_deg);
@@ -42,14 +43,12 @@ mod backoff;
 mod estimator;
 pub mod input;
 mod latency;
-mod model;
 mod notice;
 pub mod pipeline;
 mod schedule;
 
 pub use backoff::Backoff;
-pub use estimator::{CROP_SIZE, Counters, Error as EstimatorError, Estimate, Estimator};
+pub use estimator::{Counters, Error as EstimatorError, Estimate, Estimator};
 pub use latency::{LatencyStats, Summary};
-pub use model::{Error as ModelError, Model};
 pub use notice::Notice;
 pub use schedule::{Error as ScheduleError, Schedule};

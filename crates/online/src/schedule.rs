@@ -61,6 +61,12 @@ impl Schedule {
         }
     }
 
+    /// Starts the grid at `t` exactly (no effect once started): for a caller that knows when
+    /// estimates matter, such as the latency study, which estimates from a trial's motion onset.
+    pub fn start_at(&mut self, t: i64) {
+        self.next.get_or_insert(t);
+    }
+
     /// The next estimate time if it is at or before `horizon` (all events with `t <= horizon`
     /// have arrived), advancing the grid; `None` when nothing is due.
     #[inline]
@@ -105,6 +111,16 @@ mod tests {
         let mut s = Schedule::new(1000).unwrap();
         s.start(-1500);
         assert_eq!(s.next(), Some(-1000));
+    }
+
+    #[test]
+    fn a_grid_started_at_a_time_keeps_it() {
+        let mut s = Schedule::new(1000).unwrap();
+        s.start_at(12_345);
+        s.start(0);
+        assert_eq!(due(&mut s, 14_345), vec![12_345, 13_345, 14_345]);
+        s.start_at(0);
+        assert_eq!(s.next(), Some(15_345), "start only once");
     }
 
     #[test]

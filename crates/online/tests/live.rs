@@ -3,9 +3,10 @@
 //! sent, and they equal the estimates of the same events replayed from memory.
 
 use crate::support::{self, SENSOR, Synthetic};
+use evtac_learn::Model;
 use evtac_online::input::{self, MemorySource, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Backoff, Estimate, Model, Notice};
+use evtac_online::{Backoff, Estimate, Estimator, Notice};
 use std::io::{BufRead, BufReader, Write};
 use std::ops::ControlFlow;
 use std::process::{Command, Stdio};
@@ -121,7 +122,7 @@ fn estimates_arrive_while_a_dv_network_writer_streams() {
     let mut notices: Vec<Notice> = Vec::new();
     let opened = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap();
     assert_eq!(opened.resolution, Some(SENSOR));
-    let estimator = model.estimator(SENSOR, 1000).unwrap();
+    let estimator = Estimator::for_model(&model, SENSOR, 1000).unwrap();
     let mut estimates: Vec<(Estimate, f64)> = Vec::new();
     let summary = pipeline::run(
         opened.source,
@@ -160,7 +161,7 @@ fn estimates_arrive_while_a_dv_network_writer_streams() {
     let mut reference = Vec::new();
     pipeline::run(
         MemorySource::new(events.clone(), 4096),
-        model.estimator(SENSOR, 1000).unwrap(),
+        Estimator::for_model(&model, SENSOR, 1000).unwrap(),
         &PipelineConfig::default(),
         |out| {
             if let Output::Estimate(e) = out {

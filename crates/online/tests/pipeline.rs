@@ -5,11 +5,12 @@
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_events::Event;
 use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
+use evtac_learn::Model;
 use evtac_online::input::{
     self, EventSource, MemorySource, NetworkOptions, OpenOptions, SourceSpec,
 };
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Backoff, Estimate, Model, Notice, Summary};
+use evtac_online::{Backoff, Estimate, Estimator, Notice, Summary};
 use std::io::Write;
 use std::net::TcpListener;
 use std::ops::ControlFlow;
@@ -81,7 +82,7 @@ fn run_tcp(
         ..OpenOptions::default()
     };
     let opened = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap();
-    let estimator = model.estimator(opened.resolution.unwrap(), 1000).unwrap();
+    let estimator = Estimator::for_model(model, opened.resolution.unwrap(), 1000).unwrap();
     let mut estimates = Vec::new();
     let summary = pipeline::run(
         opened.source,
@@ -102,7 +103,7 @@ fn run_tcp(
 /// Offline estimates of the same events, all in one chunk.
 fn reference(model: &Model, events: &[Event]) -> Vec<Estimate> {
     let mut estimates = Vec::new();
-    let estimator = model.estimator(SENSOR, 1000).unwrap();
+    let estimator = Estimator::for_model(model, SENSOR, 1000).unwrap();
     pipeline::run(
         MemorySource::new(events.to_vec(), usize::MAX),
         estimator,
@@ -239,7 +240,7 @@ fn break_after(source: impl EventSource + 'static, model: &Model, n: u64) -> Sum
     let mut seen = 0u64;
     let summary = pipeline::run(
         source,
-        model.estimator(SENSOR, 1000).unwrap(),
+        Estimator::for_model(model, SENSOR, 1000).unwrap(),
         &PipelineConfig::default(),
         |out| {
             if matches!(out, Output::Estimate(_)) {
@@ -278,7 +279,7 @@ fn stopping_early_and_dropping_when_behind() {
         let mut notices = 0;
         let summary = pipeline::run(
             MemorySource::new(events.clone(), 64),
-            model.estimator(SENSOR, 1000).unwrap(),
+            Estimator::for_model(&model, SENSOR, 1000).unwrap(),
             &config,
             |out| {
                 match out {
@@ -310,7 +311,7 @@ fn out_of_order_events_are_skipped_and_counted() {
     let model = model(dir.path());
     let summary = pipeline::run(
         MemorySource::new(events, 333),
-        model.estimator(SENSOR, 1000).unwrap(),
+        Estimator::for_model(&model, SENSOR, 1000).unwrap(),
         &PipelineConfig::default(),
         |_| ControlFlow::Continue(()),
     )
@@ -358,7 +359,7 @@ fn a_stop_ends_the_run_with_its_summary_while_the_input_blocks() {
         let run = scope.spawn(|| {
             pipeline::run_until(
                 silent(),
-                model.estimator(SENSOR, 1000).unwrap(),
+                Estimator::for_model(&model, SENSOR, 1000).unwrap(),
                 &PipelineConfig::default(),
                 &stop,
                 |out| {
@@ -396,7 +397,7 @@ fn busy_polling_gives_the_same_estimates() {
     };
     let summary = pipeline::run(
         MemorySource::new(events.clone(), 700),
-        model.estimator(SENSOR, 1000).unwrap(),
+        Estimator::for_model(&model, SENSOR, 1000).unwrap(),
         &config,
         |out| {
             if let Output::Estimate(e) = out {

@@ -4,9 +4,10 @@
 use crate::support::{self, SENSOR};
 use evtac_events::aedat::Compression;
 use evtac_events::{Event, Resolution, Roi};
+use evtac_learn::Model;
 use evtac_online::input::{self, MemorySource, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Estimate, Model};
+use evtac_online::{Estimate, Estimator};
 use evtac_repr::extract_features;
 use evtac_sim::{Protocol, Scale, SimParams, Simulator, plan};
 use std::ops::ControlFlow;
@@ -40,14 +41,8 @@ fn offline(model: &Model, events: &[Event], times: &[i64]) -> Vec<[f32; 2]> {
     let roi = Roi::centered(SENSOR, crop).unwrap();
     let mut cropped = Vec::new();
     roi.crop_into(events, &mut cropped);
-    let features = extract_features(
-        std::slice::from_ref(&model.representation),
-        crop,
-        model.mask.as_ref(),
-        &cropped,
-        times,
-    )
-    .unwrap();
+    let features =
+        extract_features(&[model.repr_config()], crop, model.mask(), &cropped, times).unwrap();
     features[0]
         .chunks_exact(900)
         .map(|row| model.predictor.predict_one(row))
@@ -55,7 +50,7 @@ fn offline(model: &Model, events: &[Event], times: &[i64]) -> Vec<[f32; 2]> {
 }
 
 fn run_online(model: &Model, source: impl input::EventSource + 'static) -> Vec<Estimate> {
-    let estimator = model.estimator(SENSOR, 1000).unwrap();
+    let estimator = Estimator::for_model(model, SENSOR, 1000).unwrap();
     let mut estimates = Vec::new();
     let summary = pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
         if let Output::Estimate(e) = out {
@@ -102,13 +97,12 @@ fn replayed_simulated_trial_matches_the_offline_pipeline_at_every_interval() {
     let mut rest_cropped = Vec::new();
     roi.crop_into(&rest.events, &mut rest_cropped);
     let mask = evtac_repr::Mask::from_no_contact(crop, &Default::default(), &rest_cropped).unwrap();
-    let mask = ndarray::Array2::from_shape_vec((240, 240), mask.pixels().to_vec()).unwrap();
 
     for (name, repr) in support::representations() {
         let model_dir = dir.path().join(name);
         support::seeded_bundle(&model_dir, 11, &repr, Some(mask.clone()));
         let model = Model::load(&model_dir).unwrap();
-        assert!(model.mask.is_some());
+        assert!(model.mask().is_some());
 
         let opened = input::open(
             &SourceSpec::File(file.clone()),

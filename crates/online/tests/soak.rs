@@ -7,7 +7,8 @@
 
 mod support;
 
-use evtac_online::Model;
+use evtac_learn::Model;
+use evtac_online::Estimator;
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ops::ControlFlow;
@@ -67,7 +68,7 @@ fn memory_stays_flat_and_estimates_do_not_allocate() {
     let model = Model::load(dir.path()).unwrap();
     // 100k events/s in 1 ms packets keeps the default run to a few seconds in the dev profile.
     let source = support::Synthetic::new(5, 100_000.0, 1000, seconds * 1_000_000);
-    let estimator = model.estimator(support::SENSOR, 1000).unwrap();
+    let estimator = Estimator::for_model(&model, support::SENSOR, 1000).unwrap();
 
     // Samples of (estimates so far, allocations so far, live bytes), taken on the calling
     // thread at fixed estimate counts into a preallocated buffer.

@@ -48,6 +48,7 @@ pub mod accumulator;
 mod check;
 pub mod combine;
 pub mod config;
+mod crop;
 mod error;
 pub mod expf;
 pub mod extractor;
@@ -63,6 +64,7 @@ pub use config::{
     AccumulatorParams, Comparison, Decay, DynamicConfig, Polarity, ReprConfig, StaticConfig,
     ThresholdSpace,
 };
+pub use crop::{CROP, SensorTooSmall, centered_crop};
 pub use error::ReprError;
 pub use extractor::{FeatureExtractor, extract_features};
 pub use mask::Mask;

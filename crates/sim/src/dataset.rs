@@ -14,6 +14,7 @@
 //! seed (see [`crate::protocol::trial_seed`]), so the same seed gives the same bytes whatever
 //! the number of threads.
 
+use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE, TRUTH_DIR};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -127,7 +128,7 @@ pub fn simulate_dataset(
         let path = path.to_path_buf();
         move |source| DatasetError::Io { path, source }
     };
-    let truth_dir = out_dir.join("truth");
+    let truth_dir = out_dir.join(TRUTH_DIR);
     std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
     let sim = Simulator::new(config.params.clone(), camera_seed(config.seed));
     let mut trials = plan(
@@ -142,7 +143,7 @@ pub fn simulate_dataset(
     let camera = &config.params.camera;
     let resolution = Resolution::new(camera.width, camera.height);
     write_recording(
-        &out_dir.join("no_contact.aedat4"),
+        &out_dir.join(NO_CONTACT_FILE),
         &rest,
         resolution,
         config.compression,
@@ -154,7 +155,7 @@ pub fn simulate_dataset(
         .map(|spec| {
             let recording = sim.simulate(spec);
             let file = format!("{}.aedat4", spec.name);
-            let truth = format!("truth/{}.csv", spec.name);
+            let truth = format!("{TRUTH_DIR}/{}.csv", spec.name);
             write_recording(
                 &out_dir.join(&file),
                 &recording,
@@ -169,7 +170,7 @@ pub fn simulate_dataset(
         .collect::<Result<Vec<_>, DatasetError>>()?;
     let manifest = Manifest { trials: metas };
 
-    write_json(&out_dir.join("calibration.json"), sim.calibration())?;
+    write_json(&out_dir.join(CALIBRATION_FILE), sim.calibration())?;
     write_json(
         &out_dir.join("simulator.json"),
         &SimulatorRecord {

@@ -7,7 +7,8 @@ use evtac_experiments::dataset::Dataset;
 use evtac_experiments::results::Mae;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::splits::Split;
-use evtac_experiments::training::{self, Model};
+use evtac_experiments::training;
+use evtac_learn::Model;
 use std::path::PathBuf;
 
 /// Arguments of `evtac evaluate`.
@@ -50,7 +51,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let cache = FeatureCache::new(&ds)?;
     let bar = crate::progress::bar(trials.len() as u64, "features");
-    let config = model.representation.config;
+    let config = model.repr_config();
     cache.ensure(&trials, std::slice::from_ref(&config), sampling, &|| {
         bar.inc(1)
     })?;
@@ -61,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "the {} split has no samples",
         args.split
     );
-    let pred = model.predict(&set)?;
+    let pred = training::predict(&model, &set)?;
     let mut rows: Vec<(&str, Mae, usize)> = vec![(
         "all",
         training::mae_in(&set, &pred, None),

@@ -90,7 +90,7 @@ fn print_text(dir: &std::path::Path, s: &DatasetLabels) {
     println!(
         "labelled {} trials into {}",
         s.trials.len(),
-        dir.join(evtac_labels::dataset::LABELS_DIR).display()
+        dir.join(evtac_events::layout::LABELS_DIR).display()
     );
     match &s.stop_error_deg {
         Some(stop) => println!(

@@ -3,9 +3,10 @@
 
 use anyhow::Context;
 use evtac_events::Resolution;
+use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Backoff, Model};
+use evtac_online::{Backoff, Estimator};
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -40,7 +41,7 @@ pub struct Args {
     #[arg(long)]
     pub sensor: Option<Resolution>,
     /// Chunks the queue between ingestion and estimation holds.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = PipelineConfig::default().queue_chunks)]
     pub queue_chunks: usize,
     /// Drop incoming chunks while the estimator is behind instead of waiting (counted in the
     /// summary).
@@ -52,16 +53,16 @@ pub struct Args {
     #[arg(long)]
     pub busy_poll: bool,
     /// Reconnection attempts in a row for a network input before the run ends.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = Backoff::default().attempts)]
     pub reconnect_attempts: u32,
     /// First reconnection delay in milliseconds (doubling up to `--reconnect-max-ms`).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = Backoff::default().initial.as_millis() as u64)]
     pub reconnect_initial_ms: u64,
     /// Longest reconnection delay in milliseconds.
-    #[arg(long, default_value_t = 5000)]
+    #[arg(long, default_value_t = Backoff::default().max.as_millis() as u64)]
     pub reconnect_max_ms: u64,
     /// Seconds without data after which a network stream counts as stalled and is reopened.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = NetworkOptions::default().stall_timeout.as_secs_f64())]
     pub stall_timeout_s: f64,
     /// Stop after this many seconds of wall-clock time (checked at each estimate).
     #[arg(long)]
@@ -127,8 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sensor = opened.resolution.with_context(|| {
         format!("{spec} does not state the sensor size: give it with --sensor WIDTHxHEIGHT")
     })?;
-    let estimator = model
-        .estimator(sensor, interval_us)
+    let estimator = Estimator::for_model(&model, sensor, interval_us)
         .with_context(|| format!("setting up the estimator for {}", args.model.display()))?;
 
     let to_stdout = args.output.is_none();

@@ -5,12 +5,12 @@
 
 use super::tune::Bars;
 use anyhow::Context;
-use evtac_events::manifest::Manifest;
-use evtac_experiments::jobs::{self, Progress};
+use evtac_experiments::jobs::Progress;
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
-use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
-use std::path::{Path, PathBuf};
+use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
+use evtac_sim::Scale;
+use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -40,95 +40,19 @@ pub struct Args {
     pub export_jobs: Option<PathBuf>,
 }
 
-const PROTOCOLS: [Protocol; 4] = [
-    Protocol::Exp1,
-    Protocol::Exp2,
-    Protocol::Exp3Speed,
-    Protocol::Exp3Depth,
-];
-
-/// Reference costs, in seconds on the 2-core development machine, measured in `evtac reproduce
-/// --scale small` (7.7 min): they weigh the stages of the overall progress bar, whose ETA then
-/// follows this machine's actual pace.
-mod cost {
-    /// Simulating one trial (52 s for 448 trials).
-    pub const SIMULATE_TRIAL: f64 = 0.116;
-    /// Features of one trial for every configuration of one pass.
-    pub const FEATURES_TRIAL: f64 = 0.03;
-    /// One training epoch of one run, per training trial (about 0.13 s per epoch for the 84
-    /// training trials of the small Experiment 1 dataset).
-    pub const EPOCH_TRAIN_TRIAL: f64 = 0.0015;
-    /// One latency measurement (representation x interval) per test trial.
-    pub const LATENCY_TRIAL: f64 = 0.033;
-    /// Share of a dataset's trials in its training split.
-    pub const TRAIN_SHARE: f64 = 0.7;
-}
-
-/// Trial counts of the datasets a reproduction will run on.
-#[derive(Debug, Clone, Copy, Default)]
-struct TrialCounts {
-    exp1: usize,
-    exp2: usize,
-    exp3: usize,
-    /// Trials still to simulate.
-    simulate: usize,
-}
-
-/// Estimated seconds of a stage that starts with `total` units, from its name.
-fn stage_cost(name: &str, total: u64, plan: &Plan, counts: &TrialCounts) -> f64 {
-    let total = total as f64;
-    let train = |n: usize| n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
-    if name.starts_with("simulating") {
-        total * cost::SIMULATE_TRIAL
-    } else if name.starts_with("tuning") {
-        total * plan.tuning_epochs as f64 * train(counts.exp1)
-    } else if name == "experiment 1 training" {
-        total * plan.epochs as f64 * train(counts.exp1)
-    } else if name == "experiment 2 training" {
-        total * plan.epochs as f64 * train(counts.exp2)
-    } else if name == "latency" {
-        let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
-        total * trials as f64 * cost::LATENCY_TRIAL
-    } else {
-        total * cost::FEATURES_TRIAL
-    }
-}
-
-/// Estimated seconds of the whole reproduction (the stages [`stage_cost`] will see).
-fn total_cost(plan: &Plan, counts: &TrialCounts) -> f64 {
-    let c = |name: &str, total: usize| stage_cost(name, total as u64, plan, counts);
-    let tuning_trials = (counts.exp1 as f64 * 0.85).round() as usize;
-    let mut sum = c("simulating", counts.simulate)
-        + c(
-            "features",
-            2 * tuning_trials + counts.exp1 + counts.exp2 + counts.exp3,
-        )
-        + c(
-            "tuning",
-            plan.static_grid().len() + plan.dynamic_grid().len(),
-        )
-        + c("experiment 1 training", 3 * plan.seeds)
-        + c("latency", 3 * plan.latency_intervals_ms.len());
-    if counts.exp2 > 0 {
-        sum += c("experiment 2 training", 9 * plan.exp2_seeds);
-    }
-    sum
-}
-
 /// The stage bars plus an overall bar over the estimated cost of every stage: its ETA is the
 /// estimate of the time left for the whole run.
 struct Overall<'a> {
     bars: &'a Bars,
     overall: indicatif::ProgressBar,
-    plan: &'a Plan,
-    counts: TrialCounts,
+    costs: CostModel,
     /// Milliseconds of estimated cost per unit of the current stage.
     per_unit: Mutex<f64>,
 }
 
 impl<'a> Overall<'a> {
-    fn new(bars: &'a Bars, plan: &'a Plan, counts: TrialCounts) -> Self {
-        let total_ms = (total_cost(plan, &counts) * 1000.0).round() as u64;
+    fn new(bars: &'a Bars, costs: CostModel) -> Self {
+        let total_ms = (costs.total_seconds() * 1000.0).round() as u64;
         let overall = bars.add(crate::progress::bar(total_ms.max(1), "overall"));
         overall.set_style(
             indicatif::ProgressStyle::with_template(
@@ -139,8 +63,7 @@ impl<'a> Overall<'a> {
         Self {
             bars,
             overall,
-            plan,
-            counts,
+            costs,
             per_unit: Mutex::new(0.0),
         }
     }
@@ -152,10 +75,10 @@ impl<'a> Overall<'a> {
 }
 
 impl Progress for Overall<'_> {
-    fn stage(&self, name: &str, total: u64) {
-        self.bars.stage(name, total);
+    fn stage(&self, stage: Stage, total: u64) {
+        self.bars.stage(stage, total);
         if let Ok(mut per_unit) = self.per_unit.lock() {
-            let cost = stage_cost(name, total, self.plan, &self.counts) * 1000.0;
+            let cost = self.costs.seconds(stage, total) * 1000.0;
             *per_unit = if total > 0 { cost / total as f64 } else { 0.0 };
         }
     }
@@ -170,66 +93,26 @@ impl Progress for Overall<'_> {
     }
 }
 
-/// Trial counts: from the simulation plans for datasets still to simulate, else from the
-/// datasets' manifests.
-fn trial_counts(data: Option<&Path>, dir: &Path, scale: Scale, seed: u64) -> TrialCounts {
-    let mut counts = TrialCounts::default();
-    for protocol in PROTOCOLS {
-        let n = match data {
-            Some(d) => Manifest::read(d.join(protocol.name())).map_or(0, |m| m.trials.len()),
-            None => {
-                let out = dir.join(protocol.name());
-                let config = DatasetConfig::new(protocol, scale, seed);
-                let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
-                if !jobs::is_done(&out) {
-                    counts.simulate += n;
-                }
-                n
-            }
-        };
-        match protocol {
-            Protocol::Exp1 => counts.exp1 = n,
-            Protocol::Exp2 => counts.exp2 = n,
-            _ => counts.exp3 += n,
-        }
-    }
-    counts
-}
-
-fn simulate_all(dir: &Path, scale: Scale, seed: u64, bars: &dyn Progress) -> anyhow::Result<()> {
-    for protocol in PROTOCOLS {
-        let out = dir.join(protocol.name());
-        if jobs::is_done(&out) {
-            continue;
-        }
-        let config = DatasetConfig::new(protocol, scale, seed);
-        let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
-        bars.stage(&format!("simulating {protocol}"), n as u64);
-        simulate_dataset(&config, &out, |_| bars.advance(1))
-            .with_context(|| format!("simulating {protocol} into {}", out.display()))?;
-        jobs::mark_done(&out)?;
-    }
-    Ok(())
-}
-
 /// Runs `evtac reproduce`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let plan = Plan::for_scale(args.scale.name())
-        .with_context(|| format!("no plan for scale {}", args.scale))?;
+    let plan = Plan::for_scale(args.scale);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
         .build()
         .context("starting worker threads")?;
     let bars = Bars::default();
     let sim_dir = args.out.join("data");
-    let counts = trial_counts(args.data.as_deref(), &sim_dir, args.scale, args.seed);
-    let bars = Overall::new(&bars, &plan, counts);
+    let counts = match &args.data {
+        Some(data) => TrialCounts::of_datasets(data),
+        None => TrialCounts::of_simulation(&sim_dir, args.scale, args.seed),
+    };
+    let bars = Overall::new(&bars, CostModel::new(&plan, counts));
     let data_dir = match &args.data {
         Some(d) => d.clone(),
         None => {
             let d = sim_dir;
-            pool.install(|| simulate_all(&d, args.scale, args.seed, &bars))?;
+            pool.install(|| pipeline::simulate_all(&d, args.scale, args.seed, &bars))?;
             bars.message(&format!(
                 "simulated datasets ready in {:.1} s",
                 started.elapsed().as_secs_f64()
@@ -239,7 +122,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let data = Datasets::in_dir(&data_dir);
     anyhow::ensure!(
-        data.exp1.join(evtac_events::manifest::FILE_NAME).is_file(),
+        data.exp1
+            .join(evtac_events::layout::MANIFEST_FILE)
+            .is_file(),
         "{} has no Experiment 1 dataset (exp1/trials.csv)",
         data_dir.display()
     );

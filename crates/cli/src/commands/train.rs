@@ -8,6 +8,7 @@ use evtac_experiments::dataset::Dataset;
 use evtac_experiments::jobs;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::training::{self, TrainSpec};
+use evtac_learn::TrainConfig;
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 use std::path::PathBuf;
 
@@ -28,17 +29,17 @@ pub struct ReprArgs {
     /// Representation: static, dynamic or combined.
     #[arg(long, value_enum)]
     pub repr: ReprKind,
-    /// Static decay constant tau in ms (the paper's choice: 1000).
-    #[arg(long, default_value_t = 1000.0)]
+    /// Static decay constant tau in ms (the default is the paper's choice).
+    #[arg(long, default_value_t = StaticConfig::default().tau_ms)]
     pub tau_ms: f64,
-    /// Static binarization threshold in event contributions (the paper's choice: 2).
-    #[arg(long, default_value_t = 2.0)]
+    /// Static binarization threshold in event contributions (the default is the paper's choice).
+    #[arg(long, default_value_t = StaticConfig::default().threshold)]
     pub threshold: f32,
-    /// Dynamic window length in ms (the paper's choice: 640).
-    #[arg(long, default_value_t = 640.0)]
+    /// Dynamic window length in ms (the default is the paper's choice).
+    #[arg(long, default_value_t = DynamicConfig::default().window_ms)]
     pub window_ms: f64,
-    /// Dynamic binarization threshold in events per pixel (the paper's choice: 0).
-    #[arg(long, default_value_t = 0)]
+    /// Dynamic binarization threshold in events per pixel (the default is the paper's choice).
+    #[arg(long, default_value_t = DynamicConfig::default().count_threshold)]
     pub count_threshold: u32,
     /// A full representation config as JSON (`evtac_repr::ReprConfig`), overriding the flags
     /// above (for the static accumulator's other settings).
@@ -87,8 +88,8 @@ pub struct Args {
     /// The representation.
     #[command(flatten)]
     pub repr: ReprArgs,
-    /// Training epochs (the paper: 100).
-    #[arg(long, default_value_t = 100)]
+    /// Training epochs (the default is the paper's).
+    #[arg(long, default_value_t = TrainConfig::default().epochs)]
     pub epochs: usize,
     /// Seed of the initial weights and the shuffling.
     #[arg(long, default_value_t = 0)]

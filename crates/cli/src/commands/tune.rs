@@ -6,7 +6,9 @@ use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
 use evtac_experiments::jobs::Progress;
 use evtac_experiments::plan::Plan;
+use evtac_experiments::stage::Stage;
 use evtac_experiments::tuning::{self, Kind};
+use evtac_sim::Scale;
 use std::path::PathBuf;
 
 /// The representation to tune.
@@ -28,7 +30,7 @@ pub struct Args {
     pub repr: TuneKind,
     /// Grid and epochs of this scale: tiny, small or paper (the paper's full grid, 100 epochs).
     #[arg(long, default_value = "paper")]
-    pub scale: String,
+    pub scale: Scale,
     /// Epochs per run (overrides the scale's).
     #[arg(long)]
     pub epochs: Option<usize>,
@@ -60,13 +62,14 @@ impl Default for Bars {
 }
 
 impl Progress for Bars {
-    fn stage(&self, name: &str, total: u64) {
+    fn stage(&self, stage: Stage, total: u64) {
         if let Ok(mut b) = self.bar.lock() {
             if let Some(old) = b.take() {
                 old.finish_and_clear();
                 self.multi.remove(&old);
             }
-            *b = Some(self.multi.add(crate::progress::bar(total, name)));
+            let name = stage.to_string();
+            *b = Some(self.multi.add(crate::progress::bar(total, &name)));
         }
     }
     fn advance(&self, n: u64) {
@@ -100,8 +103,7 @@ impl Bars {
 
 /// Runs `evtac tune`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let mut plan = Plan::for_scale(&args.scale)
-        .with_context(|| format!("unknown scale `{}` (tiny, small or paper)", args.scale))?;
+    let mut plan = Plan::for_scale(args.scale);
     if let Some(e) = args.epochs {
         plan.tuning_epochs = e;
     }

@@ -4,11 +4,10 @@
 #![allow(dead_code)]
 
 use evtac_events::{Event, Resolution};
-use evtac_learn::bundle::{BundleConfig, BundleMetrics, FORMAT_VERSION};
-use evtac_learn::{Mae, ModelBundle, Parameters, TrainConfig};
+use evtac_learn::{ModelBundle, Representation};
 use evtac_online::Notice;
 use evtac_online::input::{ChunkInfo, EventSource, InputError};
-use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use evtac_repr::{DynamicConfig, Mask, ReprConfig, StaticConfig};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -27,32 +26,10 @@ pub fn representations() -> [(&'static str, ReprConfig); 3] {
 
 /// A model bundle with weights initialised from `seed` (untrained: the tests compare online and
 /// offline predictions, which needs varied outputs, not accurate ones), saved in `dir`.
-pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<ndarray::Array2<u8>>) {
-    let parameters = Parameters::init(seed);
-    let bundle = ModelBundle {
-        parameters,
-        config: BundleConfig {
-            format_version: FORMAT_VERSION,
-            architecture: vec![900, 256, 128, 64, 2],
-            training: TrainConfig {
-                seed,
-                ..TrainConfig::default()
-            },
-            representation: serde_json::json!({ "config": repr, "frame": "240x240" }),
-            metrics: BundleMetrics {
-                best_epoch: 0,
-                validation: Mae {
-                    overall: 0.0,
-                    pitch: 0.0,
-                    roll: 0.0,
-                },
-                evaluations: Default::default(),
-            },
-        },
-        mask,
-        history: Vec::new(),
-    };
-    bundle.save(dir).expect("the bundle is saved");
+pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<Mask>) {
+    ModelBundle::untrained(seed, Representation::new(*repr), mask)
+        .save(dir)
+        .expect("the bundle is saved");
 }
 
 /// An endless, seeded stream of events at `rate` events per second of event time, shaped like

@@ -1,0 +1,31 @@
+//! The dataset folder: the one place its file and folder names are spelled.
+//!
+//! A dataset is a folder that `evtac simulate` (or an import of real recordings) writes and that
+//! `labels`, `tune`, `train`, `evaluate` and `reproduce` read:
+//!
+//! ```text
+//! DATASET/
+//!   trials.csv          the manifest: one row per trial (crate::manifest)
+//!   <trial files>       one recording per trial, named in trials.csv's `file` column
+//!   calibration.json    the IMU-to-sensor rotation (evtac-labels)
+//!   no_contact.aedat4   a recording without contact, for the static representation's mask
+//!   labels/<trial>.csv  (pitch, roll) over time, computed from the IMU (evtac-labels)
+//!   truth/<trial>.csv   the simulator's true angles (simulated datasets only)
+//!   splits.json         the train/validation/test trials (evtac-experiments)
+//!   cache/              features per representation config (evtac-experiments)
+//! ```
+
+/// The manifest, one row per trial.
+pub const MANIFEST_FILE: &str = "trials.csv";
+/// The IMU-to-sensor rotation.
+pub const CALIBRATION_FILE: &str = "calibration.json";
+/// The recording without contact that the no-contact mask is built from.
+pub const NO_CONTACT_FILE: &str = "no_contact.aedat4";
+/// The folder of label files, `<trial>.csv` each.
+pub const LABELS_DIR: &str = "labels";
+/// The folder of the simulator's true angles, `<trial>.csv` each.
+pub const TRUTH_DIR: &str = "truth";
+/// The train/validation/test split.
+pub const SPLITS_FILE: &str = "splits.json";
+/// The feature cache folder.
+pub const CACHE_DIR: &str = "cache";

@@ -1,0 +1,227 @@
+//! The stages of a reproduction, and what each is expected to cost.
+//!
+//! The library reports its progress stage by stage ([`crate::jobs::Progress`]); a front end
+//! shows a bar per stage and, with [`CostModel`], an overall bar whose ETA covers the whole run.
+//! The costs are reference figures from the 2-core development machine: they only weigh the
+//! stages against each other, so the ETA follows the actual machine's pace.
+
+use crate::plan::Plan;
+use crate::tuning::Kind;
+use evtac_events::manifest::Manifest;
+use evtac_sim::{DatasetConfig, Protocol, Scale};
+use std::path::Path;
+
+/// The simulated protocols of a reproduction, in the order they are simulated.
+pub const PROTOCOLS: [Protocol; 4] = [
+    Protocol::Exp1,
+    Protocol::Exp2,
+    Protocol::Exp3Speed,
+    Protocol::Exp3Depth,
+];
+
+/// The datasets features are computed for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeatureSet {
+    /// Experiment 1's train and validation trials, for tuning one representation.
+    Tuning(Kind),
+    /// Experiment 1.
+    Exp1,
+    /// Experiment 2.
+    Exp2,
+    /// Experiment 3's speed levels.
+    Exp3Speed,
+    /// Experiment 3's depth levels.
+    Exp3Depth,
+}
+
+/// One stage of a reproduction; its units of work are given with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Simulating a protocol's dataset (units: trials).
+    Simulating(Protocol),
+    /// Computing and caching features (units: trials).
+    Features(FeatureSet),
+    /// Training one run per grid point of a representation (units: runs).
+    Tuning(Kind),
+    /// Experiment 1's training runs (units: runs).
+    Exp1Training,
+    /// Experiment 2's training runs (units: runs).
+    Exp2Training,
+    /// The latency study (units: representation x interval).
+    Latency,
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Stage::Simulating(p) => write!(f, "simulating {p}"),
+            Stage::Features(FeatureSet::Tuning(k)) => write!(f, "features ({} tuning)", k.name()),
+            Stage::Features(FeatureSet::Exp1) => f.write_str("features (experiment 1)"),
+            Stage::Features(FeatureSet::Exp2) => f.write_str("features (experiment 2)"),
+            Stage::Features(FeatureSet::Exp3Speed) => f.write_str("features (experiment 3, speed)"),
+            Stage::Features(FeatureSet::Exp3Depth) => f.write_str("features (experiment 3, depth)"),
+            Stage::Tuning(k) => write!(f, "tuning {}", k.name()),
+            Stage::Exp1Training => f.write_str("experiment 1 training"),
+            Stage::Exp2Training => f.write_str("experiment 2 training"),
+            Stage::Latency => f.write_str("latency"),
+        }
+    }
+}
+
+/// Reference costs in seconds on the 2-core development machine, measured in `evtac reproduce
+/// --scale small` (7.7 min).
+mod cost {
+    /// Simulating one trial (52 s for 448 trials).
+    pub const SIMULATE_TRIAL: f64 = 0.116;
+    /// Features of one trial for every configuration of one pass.
+    pub const FEATURES_TRIAL: f64 = 0.03;
+    /// One training epoch of one run, per training trial (about 0.13 s per epoch for the 84
+    /// training trials of the small Experiment 1 dataset).
+    pub const EPOCH_TRAIN_TRIAL: f64 = 0.0015;
+    /// One latency measurement (representation x interval) per test trial.
+    pub const LATENCY_TRIAL: f64 = 0.033;
+    /// Share of a dataset's trials in its training split.
+    pub const TRAIN_SHARE: f64 = 0.7;
+    /// Share of Experiment 1's trials that tuning computes features for (train + validation).
+    pub const TUNING_SHARE: f64 = 0.85;
+}
+
+/// Trial counts of the datasets a reproduction runs on.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TrialCounts {
+    /// Experiment 1's trials.
+    pub exp1: usize,
+    /// Experiment 2's trials (0 when there is no Experiment 2 dataset).
+    pub exp2: usize,
+    /// Experiment 3's trials, both axes.
+    pub exp3: usize,
+    /// Trials still to simulate.
+    pub simulate: usize,
+}
+
+impl TrialCounts {
+    /// The counts of the datasets in `data` (their manifests; a missing one counts 0).
+    pub fn of_datasets(data: &Path) -> Self {
+        Self::count(|protocol| {
+            let n = Manifest::read(data.join(protocol.name())).map_or(0, |m| m.trials.len());
+            (n, 0)
+        })
+    }
+
+    /// The counts of the datasets [`crate::pipeline::simulate_all`] writes into `dir` (the
+    /// simulation plans; datasets already simulated there count as done).
+    pub fn of_simulation(dir: &Path, scale: Scale, seed: u64) -> Self {
+        Self::count(|protocol| {
+            let config = DatasetConfig::new(protocol, scale, seed);
+            let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
+            let done = crate::jobs::is_done(&dir.join(protocol.name()));
+            (n, if done { 0 } else { n })
+        })
+    }
+
+    fn count(mut trials: impl FnMut(Protocol) -> (usize, usize)) -> Self {
+        let mut counts = Self::default();
+        for protocol in PROTOCOLS {
+            let (n, to_simulate) = trials(protocol);
+            counts.simulate += to_simulate;
+            match protocol {
+                Protocol::Exp1 => counts.exp1 = n,
+                Protocol::Exp2 => counts.exp2 = n,
+                _ => counts.exp3 += n,
+            }
+        }
+        counts
+    }
+}
+
+/// Expected seconds of each stage of one reproduction.
+#[derive(Debug, Clone)]
+pub struct CostModel {
+    plan: Plan,
+    counts: TrialCounts,
+}
+
+impl CostModel {
+    /// The model of a reproduction running `plan` on datasets of `counts` trials.
+    pub fn new(plan: &Plan, counts: TrialCounts) -> Self {
+        Self {
+            plan: plan.clone(),
+            counts,
+        }
+    }
+
+    /// Expected seconds of `stage` when it starts with `units` units of work.
+    pub fn seconds(&self, stage: Stage, units: u64) -> f64 {
+        let (plan, counts) = (&self.plan, &self.counts);
+        let units = units as f64;
+        let train = |n: usize| n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
+        match stage {
+            Stage::Simulating(_) => units * cost::SIMULATE_TRIAL,
+            Stage::Features(_) => units * cost::FEATURES_TRIAL,
+            Stage::Tuning(_) => units * plan.tuning_epochs as f64 * train(counts.exp1),
+            Stage::Exp1Training => units * plan.epochs as f64 * train(counts.exp1),
+            Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
+            Stage::Latency => {
+                let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
+                units * trials as f64 * cost::LATENCY_TRIAL
+            }
+        }
+    }
+
+    /// Expected seconds of the whole reproduction: every stage it will report.
+    pub fn total_seconds(&self) -> f64 {
+        let (plan, counts) = (&self.plan, &self.counts);
+        let c = |stage: Stage, units: usize| self.seconds(stage, units as u64);
+        let tuning_trials = (counts.exp1 as f64 * cost::TUNING_SHARE).round() as usize;
+        let mut sum = c(Stage::Simulating(Protocol::Exp1), counts.simulate)
+            + c(
+                Stage::Features(FeatureSet::Exp1),
+                2 * tuning_trials + counts.exp1 + counts.exp2 + counts.exp3,
+            )
+            + c(
+                Stage::Tuning(Kind::Static),
+                plan.static_grid().len() + plan.dynamic_grid().len(),
+            )
+            + c(Stage::Exp1Training, 3 * plan.seeds)
+            + c(Stage::Latency, 3 * plan.latency_intervals_ms.len());
+        if counts.exp2 > 0 {
+            sum += c(Stage::Exp2Training, 9 * plan.exp2_seeds);
+        }
+        sum
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_names_read_as_the_bars_show_them() {
+        assert_eq!(
+            Stage::Simulating(Protocol::Exp3Speed).to_string(),
+            format!("simulating {}", Protocol::Exp3Speed)
+        );
+        assert_eq!(
+            Stage::Features(FeatureSet::Tuning(Kind::Dynamic)).to_string(),
+            "features (dynamic tuning)"
+        );
+        assert_eq!(Stage::Tuning(Kind::Static).to_string(), "tuning static");
+    }
+
+    #[test]
+    fn the_total_is_the_sum_of_the_stages_a_run_reports() {
+        let plan = Plan::for_scale(Scale::Tiny);
+        let counts = TrialCounts {
+            exp1: 60,
+            exp2: 0,
+            exp3: 20,
+            simulate: 80,
+        };
+        let model = CostModel::new(&plan, counts);
+        let training = model.seconds(Stage::Exp1Training, 3 * plan.seeds as u64);
+        assert!(training > 0.0);
+        let with_exp2 = CostModel::new(&plan, TrialCounts { exp2: 30, ..counts });
+        assert!(with_exp2.total_seconds() > model.total_seconds());
+        assert_eq!(model.seconds(Stage::Exp2Training, 0), 0.0);
+    }
+}
