@@ -6,6 +6,7 @@
 
 mod commands;
 mod progress;
+mod workers;
 
 /// mimalloc rather than glibc's malloc: burn allocates and frees megabyte tensors at every
 /// training step, and glibc hands them back to the kernel each time, so every step paid page

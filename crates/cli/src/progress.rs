@@ -1,5 +1,7 @@
 //! Progress bars on stderr, shown only when stderr is a terminal (so logs and CI stay clean).
 
+use evtac_experiments::jobs::Progress;
+use evtac_experiments::stage::Stage;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 
@@ -38,5 +40,61 @@ pub fn multi() -> MultiProgress {
         MultiProgress::new()
     } else {
         MultiProgress::with_draw_target(ProgressDrawTarget::hidden())
+    }
+}
+
+/// Progress bars for library stages: one bar per stage, replaced when the next starts, plus any
+/// bars added with [`Bars::add`] (drawn together, hidden when stderr is not a terminal).
+pub struct Bars {
+    multi: indicatif::MultiProgress,
+    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+}
+
+impl Default for Bars {
+    fn default() -> Self {
+        Self {
+            multi: multi(),
+            bar: std::sync::Mutex::new(None),
+        }
+    }
+}
+
+impl Progress for Bars {
+    fn stage(&self, stage: Stage, total: u64) {
+        if let Ok(mut b) = self.bar.lock() {
+            if let Some(old) = b.take() {
+                old.finish_and_clear();
+                self.multi.remove(&old);
+            }
+            let name = stage.to_string();
+            *b = Some(self.multi.add(bar(total, &name)));
+        }
+    }
+    fn advance(&self, n: u64) {
+        if let Ok(b) = self.bar.lock()
+            && let Some(b) = b.as_ref()
+        {
+            b.inc(n);
+        }
+    }
+    fn message(&self, text: &str) {
+        self.multi.suspend(|| eprintln!("{text}"));
+    }
+}
+
+impl Bars {
+    /// Draws `bar` with the stage bars (e.g. an overall one).
+    pub fn add(&self, bar: indicatif::ProgressBar) -> indicatif::ProgressBar {
+        self.multi.add(bar)
+    }
+
+    /// Clears the bars.
+    pub fn finish(&self) {
+        if let Ok(mut b) = self.bar.lock()
+            && let Some(old) = b.take()
+        {
+            old.finish_and_clear();
+        }
+        let _ = self.multi.clear();
     }
 }

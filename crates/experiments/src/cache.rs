@@ -14,6 +14,7 @@
 //! interrupted run resumes with the files it finished. Trials run in parallel (rayon).
 
 use crate::dataset::{self, Dataset};
+use crate::io::IoError;
 use crate::sampling::{Phase, SampleTime, Sampling};
 use evtac_events::Event;
 use evtac_events::layout::CACHE_DIR;
@@ -47,13 +48,8 @@ pub enum Error {
         source: evtac_repr::ReprError,
     },
     /// A cache file could not be written or read.
-    #[error("{path}: {message}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        message: String,
-    },
+    #[error(transparent)]
+    Io(#[from] IoError),
     /// A cache file does not have the expected shape.
     #[error("{path}: expected {expected_rows} x {FEATURES} features, found {rows} x {cols}")]
     Shape {
@@ -86,11 +82,8 @@ pub enum Error {
     },
 }
 
-fn io(path: &Path) -> impl Fn(String) -> Error + '_ {
-    move |message| Error::Io {
-        path: path.to_path_buf(),
-        message,
-    }
+fn io<E: Into<crate::io::Cause>>(path: &Path) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Io(IoError::at(path)(e))
 }
 
 /// One sample of a loaded set.
@@ -208,7 +201,7 @@ impl<'a> FeatureCache<'a> {
         for (s, l) in times.iter().zip(&labels) {
             let _ = writeln!(text, "{},{},{},{}", s.t_us, s.phase.as_str(), l[0], l[1]);
         }
-        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(|e| io(&path)(e.to_string()))?;
+        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(io(&path))?;
         Ok(TrialSamples { times, labels })
     }
 
@@ -238,8 +231,7 @@ impl<'a> FeatureCache<'a> {
                     "mask": dataset::mask_id(mask.as_ref()),
                     "sampling": sampling,
                 });
-                crate::jobs::write_atomic(&meta, json.to_string().as_bytes())
-                    .map_err(|e| io(&meta)(e.to_string()))?;
+                crate::jobs::write_atomic(&meta, json.to_string().as_bytes()).map_err(io(&meta))?;
             }
         }
         let computed = AtomicUsize::new(0);
@@ -293,12 +285,12 @@ impl<'a> FeatureCache<'a> {
         for (k, &i) in which.iter().enumerate() {
             let path = dirs[i].join(format!("{}.npy", meta.trial));
             let values = std::mem::take(&mut out[k]);
-            let array = Array2::from_shape_vec((times.len(), FEATURES), values)
-                .map_err(|e| io(&path)(e.to_string()))?;
-            std::fs::create_dir_all(&dirs[i]).map_err(|e| io(&dirs[i])(e.to_string()))?;
+            let array =
+                Array2::from_shape_vec((times.len(), FEATURES), values).map_err(io(&path))?;
+            std::fs::create_dir_all(&dirs[i]).map_err(io(&dirs[i]))?;
             let tmp = crate::jobs::tmp_path(&path);
-            ndarray_npy::write_npy(&tmp, &array).map_err(|e| io(&tmp)(e.to_string()))?;
-            std::fs::rename(&tmp, &path).map_err(|e| io(&path)(e.to_string()))?;
+            ndarray_npy::write_npy(&tmp, &array).map_err(io(&tmp))?;
+            std::fs::rename(&tmp, &path).map_err(io(&path))?;
         }
         Ok(())
     }
@@ -320,8 +312,7 @@ impl<'a> FeatureCache<'a> {
             .map(|(ti, meta)| -> Result<_, Error> {
                 let samples = self.samples(meta, sampling)?;
                 let path = dir.join(format!("{}.npy", meta.trial));
-                let array: Array2<f32> =
-                    ndarray_npy::read_npy(&path).map_err(|e| io(&path)(e.to_string()))?;
+                let array: Array2<f32> = ndarray_npy::read_npy(&path).map_err(io(&path))?;
                 let (rows, cols) = array.dim();
                 if rows != samples.times.len() || cols != FEATURES {
                     return Err(Error::Shape {
@@ -359,7 +350,7 @@ impl<'a> FeatureCache<'a> {
 }
 
 fn read_samples(path: &Path) -> Result<TrialSamples, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| io(path)(e.to_string()))?;
+    let text = std::fs::read_to_string(path).map_err(io(path))?;
     let bad = |line: usize, message: String| Error::Samples {
         path: path.to_path_buf(),
         line,

@@ -2,6 +2,7 @@
 //! `no_contact.aedat4` (for the static representation's mask), and what evtac adds to it:
 //! `labels/<trial>.csv` (computed from the IMU when missing), `splits.json` and `cache/`.
 
+use crate::io::IoError;
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
 use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR, NO_CONTACT_FILE};
@@ -21,13 +22,8 @@ pub enum Error {
     #[error(transparent)]
     Manifest(#[from] evtac_events::manifest::ManifestError),
     /// A file could not be read or written.
-    #[error("{path}: {message}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        message: String,
-    },
+    #[error(transparent)]
+    Io(#[from] IoError),
     /// `calibration.json` is not a calibration.
     #[error("{path}: not a calibration: {source}")]
     Calibration {
@@ -93,10 +89,7 @@ pub struct Dataset {
 }
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
-    move |e| Error::Io {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    }
+    move |e| Error::Io(IoError::at(path)(e))
 }
 
 /// Reads a recording's events (any format evtac reads) on the full sensor, with the sensor's resolution (the

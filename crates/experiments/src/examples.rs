@@ -150,46 +150,37 @@ pub fn overlays(
     let trials = &cache.dataset().manifest.trials;
     let depth = closest(trials.iter().map(|t| t.depth_mm), 2.0);
     let speed = closest(trials.iter().map(|t| t.speed_deg_s), 6.0);
-    let mut panels: Vec<(String, Overlay)> = Vec::new();
     let configs = [static_cfg, dynamic_cfg];
+    // One pair per axis: the trials at the extremes of the varied level, the other level fixed.
+    let mut pairs = Vec::new();
     if let Some(depth) = depth
         && let Some((a, b)) = pair(trials, |t| t.depth_mm == depth, |t| t.speed_deg_s)
     {
-        let fa = frames(cache, a, &configs)?;
-        let fb = frames(cache, b, &configs)?;
-        for (i, kind) in ["Static", "Dynamic"].into_iter().enumerate() {
-            panels.push((
-                format!("{kind}-speed"),
-                Overlay {
-                    title: format!(
-                        "{kind}: speed (depth {depth} mm, direction {} deg)",
-                        a.direction_deg
-                    ),
-                    first_label: format!("{} deg/s", a.speed_deg_s),
-                    second_label: format!("{} deg/s", b.speed_deg_s),
-                    width: usize::from(CROP.width),
-                    height: usize::from(CROP.height),
-                    first: fa[i].clone(),
-                    second: fb[i].clone(),
-                },
-            ));
-        }
+        let fixed = format!("depth {depth} mm");
+        let label = |t: &TrialMeta| format!("{} deg/s", t.speed_deg_s);
+        pairs.push(("speed", fixed, a, b, label(a), label(b)));
     }
     if let Some(speed) = speed
         && let Some((a, b)) = pair(trials, |t| t.speed_deg_s == speed, |t| t.depth_mm)
     {
+        let fixed = format!("speed {speed} deg/s");
+        let label = |t: &TrialMeta| format!("{} mm", t.depth_mm);
+        pairs.push(("depth", fixed, a, b, label(a), label(b)));
+    }
+    let mut panels: Vec<(String, Overlay)> = Vec::new();
+    for (axis, fixed, a, b, first_label, second_label) in pairs {
         let fa = frames(cache, a, &configs)?;
         let fb = frames(cache, b, &configs)?;
         for (i, kind) in ["Static", "Dynamic"].into_iter().enumerate() {
             panels.push((
-                format!("{kind}-depth"),
+                format!("{kind}-{axis}"),
                 Overlay {
                     title: format!(
-                        "{kind}: depth (speed {speed} deg/s, direction {} deg)",
+                        "{kind}: {axis} ({fixed}, direction {} deg)",
                         a.direction_deg
                     ),
-                    first_label: format!("{} mm", a.depth_mm),
-                    second_label: format!("{} mm", b.depth_mm),
+                    first_label: first_label.clone(),
+                    second_label: second_label.clone(),
                     width: usize::from(CROP.width),
                     height: usize::from(CROP.height),
                     first: fa[i].clone(),

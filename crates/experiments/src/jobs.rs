@@ -3,6 +3,7 @@
 //! jobs (folders with `done`); a half-written folder is redone. The same job list can be exported
 //! as one `evtac ...` command per line for a Slurm array or GNU parallel.
 
+use crate::io::IoError;
 use crate::stage::Stage;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -15,13 +16,8 @@ pub const DONE: &str = "done";
 #[non_exhaustive]
 pub enum Error {
     /// A job's folder or marker could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file or folder.
-        path: String,
-        /// The cause.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] IoError),
 }
 
 /// Progress of a long run, reported by the library and shown by the binary (libraries never
@@ -54,10 +50,9 @@ pub fn is_done(dir: &Path) -> bool {
 
 /// Marks the job writing to `dir` as finished (its outputs must be complete by now).
 pub fn mark_done(dir: &Path) -> Result<(), Error> {
-    write_atomic(&dir.join(DONE), b"").map_err(|source| Error::Io {
-        path: dir.join(DONE).display().to_string(),
-        source,
-    })
+    let marker = dir.join(DONE);
+    write_atomic(&marker, b"").map_err(IoError::at(&marker))?;
+    Ok(())
 }
 
 /// Writes `bytes` to `path` through a temporary file and a rename, so readers (and resumed runs)

@@ -34,6 +34,7 @@ pub mod examples;
 pub mod exp1;
 pub mod exp2;
 pub mod exp3;
+pub mod io;
 pub mod jobs;
 pub mod latency;
 pub mod pipeline;

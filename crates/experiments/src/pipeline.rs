@@ -54,14 +54,6 @@ pub enum Error {
     /// A tuning run's chosen config could not be read back.
     #[error("the {0} tuning chose no readable config")]
     NoChoice(&'static str),
-    /// The job list could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
 }
 
 /// The datasets of a reproduction (Experiment 1 is required).

@@ -6,9 +6,10 @@
 //! system fonts.
 
 use crate::results::{ExampleTrial, Exp2Cell, Exp3Point, LatencyCell, Overlay, Tuning};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The embedded font (DejaVu Sans, Bitstream Vera license).
@@ -42,18 +43,18 @@ pub enum Error {
     #[error("the embedded DejaVu Sans font could not be registered with plotters")]
     Font,
     /// Drawing or writing the PNG failed.
-    #[error("{path}: drawing failed: {message}")]
+    #[error("{}: drawing failed: {message}", path.display())]
     Draw {
         /// The figure file.
-        path: String,
+        path: PathBuf,
         /// plotters' message.
         message: String,
     },
     /// There is nothing to draw.
-    #[error("{path}: no data for this figure")]
+    #[error("{}: no data for this figure", path.display())]
     Empty {
         /// The figure file.
-        path: String,
+        path: PathBuf,
     },
 }
 
@@ -66,9 +67,40 @@ fn register_font() -> Result<(), Error> {
 
 fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Draw {
-        path: path.display().to_string(),
+        path: path.to_path_buf(),
         message: e.to_string(),
     }
+}
+
+/// A white canvas of `size` pixels for the figure at `path`, the font registered: where every
+/// figure starts (it ends with `present()`).
+fn canvas(path: &Path, size: (u32, u32)) -> Result<DrawingArea<BitMapBackend<'_>, Shift>, Error> {
+    register_font()?;
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err(path))?;
+    Ok(root)
+}
+
+/// The legend every figure uses: translucent white, framed, at `position` with labels of
+/// `font_size` (for the figure at `path`).
+fn legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_size: u32,
+    path: &Path,
+) -> Result<(), Error>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FAMILY, font_size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_err(path))
 }
 
 /// The color of a representation by name (`Static`, `Dynamic`, `Combined`).
@@ -186,16 +218,14 @@ fn tuning_panels(tuning: &[Tuning]) -> Vec<Curve> {
 /// Tuning curves (4 panels): validation MAE against decay tau and threshold (static), window and
 /// threshold (dynamic), each with the other parameter at its chosen value.
 pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
-    register_font()?;
     let panels = tuning_panels(tuning);
     if panels.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
-    let root = BitMapBackend::new(path, (1200, 900)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (1200, 900))?;
     let areas = root.split_evenly((2, 2));
     for (area, c) in areas.iter().zip(&panels) {
         let xr = padded(c.points.iter().map(|p| p.0), false);
@@ -241,15 +271,13 @@ pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
 
 /// Motion- and stop-phase MAE (mean ± std over seeds) per representation and training setting.
 pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) -> Result<(), Error> {
-    register_font()?;
     if cells.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
-    let root = BitMapBackend::new(path, (1300, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (1300, 520))?;
     let halves = root.split_evenly((1, 2));
     let names = ["Static", "Dynamic", "Combined"];
     for (pi, (area, phase)) in halves
@@ -330,14 +358,7 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
                     .map_err(&e)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 16))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(&e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight, 16, path)?;
     }
     root.present().map_err(&e)?;
     Ok(())
@@ -346,15 +367,13 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
 /// An example pause trial: estimated and true pitch (left) and roll (right) over time, with the
 /// stop phase shaded.
 pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
-    register_font()?;
     if ex.t_s.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
-    let root = BitMapBackend::new(path, (1300, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (1300, 520))?;
     let halves = root.split_evenly((1, 2));
     for (k, (area, what)) in halves.iter().zip(["Pitch", "Roll"]).enumerate() {
         let values = ex.truth.iter().map(|v| f64::from(v[k])).chain(
@@ -424,14 +443,7 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
                     PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FAMILY, 16))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(&e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 16, path)?;
     }
     root.present().map_err(&e)?;
     Ok(())
@@ -440,19 +452,16 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
 /// Contour overlays: in each panel the first condition's binary frame in red, the second's in
 /// orange, pixels set in both in white, on black (as the paper's figure).
 pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
-    register_font()?;
     if panels.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
     let cols = 2usize;
     let rows = panels.len().div_ceil(cols);
     let (cell_w, cell_h) = (540u32, 650u32);
-    let root =
-        BitMapBackend::new(path, (cell_w * cols as u32, cell_h * rows as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (cell_w * cols as u32, cell_h * rows as u32))?;
     let areas = root.split_evenly((rows, cols));
     let red = RGBColor(230, 30, 30);
     let orange = RGBColor(255, 165, 0);
@@ -518,15 +527,13 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
 /// Test MAE (mean ± std over the Experiment 1 models) against speed (left) and depth (right);
 /// unseen (interpolated) values drawn as hollow markers.
 pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Result<(), Error> {
-    register_font()?;
     if speed.is_empty() && depth.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
-    let root = BitMapBackend::new(path, (1300, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (1300, 520))?;
     let halves = root.split_evenly((1, 2));
     for (area, (points, desc)) in halves
         .iter()
@@ -611,14 +618,7 @@ pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Res
                 }))
                 .map_err(&e)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 16))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(&e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight, 16, path)?;
     }
     root.present().map_err(&e)?;
     Ok(())
@@ -636,15 +636,13 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// the 25th to the 75th percentile, the median, whiskers from min to max and the P99 as a
 /// diamond, on a log time axis, with the interval itself (dashed) and the paper's 10 ms bound.
 pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
-    register_font()?;
     if cells.is_empty() {
         return Err(Error::Empty {
-            path: path.display().to_string(),
+            path: path.to_path_buf(),
         });
     }
     let e = draw_err(path);
-    let root = BitMapBackend::new(path, (1500, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    let root = canvas(path, (1500, 520))?;
     let names = ["Static", "Dynamic", "Combined"];
     let areas = root.split_evenly((1, 3));
     let mut intervals: Vec<u32> = cells.iter().map(|c| c.interval_ms).collect();
@@ -760,14 +758,7 @@ pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
                 first = false;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FAMILY, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(&e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 14, path)?;
     }
     root.present().map_err(&e)?;
     Ok(())

@@ -2,6 +2,7 @@
 //! (every number) and the figures under `OUT/figures/`.
 
 use crate::exp2::SETTINGS;
+use crate::io::IoError;
 use crate::plots;
 use crate::results::{Exp3Point, MaeStats, Results};
 use std::fmt::Write as _;
@@ -25,13 +26,8 @@ pub const PAPER_EXP2_STATIC: (f64, f64) = (0.211, 0.251);
 #[non_exhaustive]
 pub enum Error {
     /// A file could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] IoError),
     /// A figure could not be drawn.
     #[error(transparent)]
     Plot(#[from] plots::Error),
@@ -281,9 +277,10 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(
             md,
             "Sequential, one thread, on this machine's CPU (the paper: an Intel Core Ultra 7 165H \
-             plus an RTX 2080 Ti for inference), from a step's new events to the MLP's output; the \
-             work known before they arrive (the dynamic window dropping what leaves it by the \
-             step) is done before timing starts, as `evtac online` does between estimates. \
+             plus an RTX 2080 Ti for inference), from a step's new events to the MLP's output, \
+             through the estimator `evtac online` runs; the work known before they arrive (the \
+             dynamic window dropping what leaves it by the step) is done before timing starts, \
+             as `evtac online` does between estimates. \
              Paper: every representation under 10 ms at every interval; static and dynamic \
              under the interval, combined over it for a few samples at 1 and 2 ms.\n"
         );
@@ -322,10 +319,7 @@ fn figure(md: &mut String, present: &[&str], i: usize) {
 /// Returns the figure files written.
 pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
     let fig_dir = out.join("figures");
-    std::fs::create_dir_all(&fig_dir).map_err(|source| Error::Io {
-        path: fig_dir.clone(),
-        source,
-    })?;
+    std::fs::create_dir_all(&fig_dir).map_err(IoError::at(&fig_dir))?;
     let mut written = Vec::new();
     let mut names = Vec::new();
     let mut draw = |name: &'static str, f: &dyn Fn(&Path) -> Result<(), plots::Error>| {
@@ -356,21 +350,11 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
         draw(FIGURES[5].0, &|p| plots::latency(p, &r.latency))?;
     }
     let json_path = out.join("results.json");
-    let json = serde_json::to_string_pretty(r).map_err(|e| Error::Io {
-        path: json_path.clone(),
-        source: std::io::Error::other(e),
-    })?;
-    crate::jobs::write_atomic(&json_path, json.as_bytes()).map_err(|source| Error::Io {
-        path: json_path.clone(),
-        source,
-    })?;
+    let json = serde_json::to_string_pretty(r).map_err(IoError::at(&json_path))?;
+    crate::jobs::write_atomic(&json_path, json.as_bytes()).map_err(IoError::at(&json_path))?;
     let md_path = out.join("report.md");
-    crate::jobs::write_atomic(&md_path, markdown(r, &names).as_bytes()).map_err(|source| {
-        Error::Io {
-            path: md_path.clone(),
-            source,
-        }
-    })?;
+    let markdown = markdown(r, &names);
+    crate::jobs::write_atomic(&md_path, markdown.as_bytes()).map_err(IoError::at(&md_path))?;
     Ok(written)
 }
 

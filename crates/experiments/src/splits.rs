@@ -7,6 +7,7 @@
 //! speed, depth and direction (and overall size), so every marginal ends within a trial or two of
 //! 70:15:15. A plain random split leaves marginals off by several trials at these sizes.
 
+use crate::io::IoError;
 use evtac_events::layout::SPLITS_FILE;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
@@ -14,6 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::Path;
+use std::path::PathBuf;
 
 /// Shares of the train, validation and test splits.
 pub const RATIOS: [f64; 3] = [0.70, 0.15, 0.15];
@@ -23,26 +25,21 @@ pub const RATIOS: [f64; 3] = [0.70, 0.15, 0.15];
 #[non_exhaustive]
 pub enum Error {
     /// The splits file could not be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The cause.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] IoError),
     /// The splits file is not valid JSON of the expected shape.
-    #[error("{path}: not a splits file: {source}")]
+    #[error("{}: not a splits file: {source}", path.display())]
     Json {
         /// The file.
-        path: String,
+        path: PathBuf,
         /// The cause.
         source: serde_json::Error,
     },
     /// The splits file names a trial the manifest does not have (or misses one it has).
-    #[error("{path}: splits do not match the manifest: {detail}")]
+    #[error("{}: splits do not match the manifest: {detail}", path.display())]
     Mismatch {
         /// The file.
-        path: String,
+        path: PathBuf,
         /// What differs.
         detail: String,
     },
@@ -203,32 +200,22 @@ impl Splits {
         let text = match std::fs::read_to_string(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(source) => {
-                return Err(Error::Io {
-                    path: path.display().to_string(),
-                    source,
-                });
-            }
+            Err(source) => return Err(IoError::at(&path)(source).into()),
         };
         serde_json::from_str(&text)
             .map(Some)
-            .map_err(|source| Error::Json {
-                path: path.display().to_string(),
-                source,
-            })
+            .map_err(|source| Error::Json { path, source })
     }
 
     /// Writes `DATASET/splits.json` (pretty JSON).
     pub fn write(&self, dataset_dir: &Path) -> Result<(), Error> {
         let path = dataset_dir.join(SPLITS_FILE);
         let text = serde_json::to_string_pretty(self).map_err(|source| Error::Json {
-            path: path.display().to_string(),
+            path: path.clone(),
             source,
         })?;
-        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(|source| Error::Io {
-            path: path.display().to_string(),
-            source,
-        })
+        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(IoError::at(&path))?;
+        Ok(())
     }
 
     /// Checks that the splits cover exactly the manifest's `trials`, each once.
@@ -238,7 +225,7 @@ impl Splits {
             *seen.entry(t.as_str()).or_default() += 1;
         }
         let mismatch = |detail: String| Error::Mismatch {
-            path: dataset_dir.join(SPLITS_FILE).display().to_string(),
+            path: dataset_dir.join(SPLITS_FILE),
             detail,
         };
         if let Some((t, _)) = seen.iter().find(|(_, c)| **c > 1) {

@@ -3,7 +3,7 @@
 //! (`OUT/report.md`, `OUT/results.json`, `OUT/figures/`). Interrupted runs resume from finished
 //! jobs; `--export-jobs` writes the ready training jobs as `evtac train` lines instead.
 
-use super::tune::Bars;
+use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::jobs::Progress;
 use evtac_experiments::pipeline::{self, Datasets};
@@ -30,9 +30,9 @@ pub struct Args {
     /// Output folder: models, report, figures.
     #[arg(long)]
     pub out: PathBuf,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub jobs: Option<usize>,
+    /// Worker threads.
+    #[command(flatten)]
+    pub workers: crate::workers::Workers,
     /// Write the training jobs that are ready (not finished) to FILE, one `evtac train` command
     /// per line (for a Slurm array or GNU parallel), and stop. Run them, then run `evtac
     /// reproduce` again with the same arguments: it resumes from the finished jobs.
@@ -97,10 +97,7 @@ impl Progress for Overall<'_> {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let plan = Plan::for_scale(args.scale);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.unwrap_or(0))
-        .build()
-        .context("starting worker threads")?;
+    let pool = args.workers.pool()?;
     let bars = Bars::default();
     let sim_dir = args.out.join("data");
     let counts = match &args.data {

@@ -20,9 +20,9 @@ pub struct Args {
     /// Output dataset folder (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub jobs: Option<usize>,
+    /// Worker threads.
+    #[command(flatten)]
+    pub workers: crate::workers::Workers,
     /// Simulator parameters as JSON (e.g. an edited `simulator.json`'s `params`); missing
     /// fields take their defaults.
     #[arg(long)]
@@ -56,10 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     )
     .len()
     .min(args.limit.unwrap_or(usize::MAX));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.unwrap_or(0))
-        .build()
-        .context("starting worker threads")?;
+    let pool = args.workers.pool()?;
     let bar = crate::progress::bar(trials as u64, "simulating");
     let started = std::time::Instant::now();
     let manifest = pool

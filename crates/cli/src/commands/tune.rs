@@ -4,9 +4,7 @@
 use anyhow::Context;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
-use evtac_experiments::jobs::Progress;
 use evtac_experiments::plan::Plan;
-use evtac_experiments::stage::Stage;
 use evtac_experiments::tuning::{self, Kind};
 use evtac_sim::Scale;
 use std::path::PathBuf;
@@ -40,65 +38,9 @@ pub struct Args {
     /// Output folder for the runs' models and `tuning-<repr>.json` (default: DATASET/tuning).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub jobs: Option<usize>,
-}
-
-/// Progress bars for library stages: one bar per stage, replaced when the next starts, plus any
-/// bars added with [`Bars::add`] (drawn together, hidden when stderr is not a terminal).
-pub struct Bars {
-    multi: indicatif::MultiProgress,
-    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
-}
-
-impl Default for Bars {
-    fn default() -> Self {
-        Self {
-            multi: crate::progress::multi(),
-            bar: std::sync::Mutex::new(None),
-        }
-    }
-}
-
-impl Progress for Bars {
-    fn stage(&self, stage: Stage, total: u64) {
-        if let Ok(mut b) = self.bar.lock() {
-            if let Some(old) = b.take() {
-                old.finish_and_clear();
-                self.multi.remove(&old);
-            }
-            let name = stage.to_string();
-            *b = Some(self.multi.add(crate::progress::bar(total, &name)));
-        }
-    }
-    fn advance(&self, n: u64) {
-        if let Ok(b) = self.bar.lock()
-            && let Some(b) = b.as_ref()
-        {
-            b.inc(n);
-        }
-    }
-    fn message(&self, text: &str) {
-        self.multi.suspend(|| eprintln!("{text}"));
-    }
-}
-
-impl Bars {
-    /// Draws `bar` with the stage bars (e.g. an overall one).
-    pub fn add(&self, bar: indicatif::ProgressBar) -> indicatif::ProgressBar {
-        self.multi.add(bar)
-    }
-
-    /// Clears the bars.
-    pub fn finish(&self) {
-        if let Ok(mut b) = self.bar.lock()
-            && let Some(old) = b.take()
-        {
-            old.finish_and_clear();
-        }
-        let _ = self.multi.clear();
-    }
+    /// Worker threads.
+    #[command(flatten)]
+    pub workers: crate::workers::Workers,
 }
 
 /// Runs `evtac tune`.
@@ -119,11 +61,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
     let splits = ds.splits(args.seed)?;
     let cache = FeatureCache::new(&ds)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.unwrap_or(0))
-        .build()
-        .context("starting worker threads")?;
-    let bars = Bars::default();
+    let pool = args.workers.pool()?;
+    let bars = crate::progress::Bars::default();
     let t = pool.install(|| tuning::tune(&cache, &splits, &plan, kind, args.seed, &out, &bars))?;
     bars.finish();
     let json_path = out.join(format!("tuning-{}.json", kind.name()));
