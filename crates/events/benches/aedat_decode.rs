@@ -9,7 +9,7 @@
 //! - `decompress_only/{lz4,zstd}`: the bare lz4_flex block decoder / zstd context alone on the same
 //!   packet payloads (the floor).
 //! - `aedat_range/{table,decode_all_then_filter}`: the events of a 10 ms window in the middle of
-//!   the LZ4 file (about 10 000 of the 3 million), read through the data table
+//!   the LZ4 file (about 20 000 of the 3 million), read through the data table
 //!   (`AedatReader::select_range`) against decoding the whole file and keeping the window.
 
 use std::hint::black_box;

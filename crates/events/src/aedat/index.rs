@@ -10,13 +10,23 @@
 //! to a scan instead of silently skipping data. What the table says about the packets it selects
 //! is checked again when they are decoded ([`AedatError::DataTableMismatch`]).
 //!
+//! What no check can see without reading every packet, a table damaged yet consistent (an
+//! entry's element count set to zero, an end time lowered within its neighbours' bounds), can
+//! make a range read miss that packet; what the read returns is still always the file's own
+//! elements in the range, in file order (the `damaged_files_never_panic_a_range_read` proptest).
+//!
 //! [`AedatError::DataTableMismatch`]: super::AedatError::DataTableMismatch
 
 use std::collections::VecDeque;
 
+use super::compression::MAX_PACKET_BYTES;
 use super::header::StreamKind;
 use super::packet::StreamState;
 use super::schema;
+
+/// Most elements a packet can hold: every element takes at least 8 bytes of its decompressed
+/// flatbuffer (a timestamp), which is at most [`MAX_PACKET_BYTES`] long.
+const MAX_ELEMENTS: u64 = MAX_PACKET_BYTES / 8;
 
 /// A packet the data table says overlaps the range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,7 +113,14 @@ pub(crate) fn plan(
             .position(|s| s.id == e.stream_id)
             .ok_or_else(|| format!("entry {i} names undeclared stream {}", e.stream_id))?;
         let elements = u64::try_from(e.num_elements)
-            .map_err(|_| format!("entry {i} counts {} elements", e.num_elements))?;
+            .ok()
+            .filter(|&n| n <= MAX_ELEMENTS)
+            .ok_or_else(|| {
+                format!(
+                    "entry {i} counts {} elements (a packet holds at most {MAX_ELEMENTS})",
+                    e.num_elements
+                )
+            })?;
         out.total += 1;
         if elements == 0 {
             continue;
@@ -133,7 +150,7 @@ pub(crate) fn plan(
                 t_end: e.timestamp_end,
             });
         }
-        seen[s] += elements;
+        seen[s] = seen[s].saturating_add(elements);
     }
     if cursor != position {
         return Err(format!(

@@ -590,7 +590,7 @@ impl<R: Read + Seek> AedatReader<R> {
     /// With a data table, only the packets it lists as overlapping the range are read: reading a
     /// few seconds of a multi-gigabyte recording touches a few megabytes, and memory holds the
     /// table's entries for the range only (the table itself, about 60 bytes a packet, is read
-    /// once and dropped). Without one, or when the table is unusable, the reader scans the file
+    /// once and its memory given back). Without one, or when the table is unusable, the reader scans the file
     /// from its first packet; the returned [`RangeIndex`] says which happened and why, so that
     /// the caller can warn once. The read starts over from the first packet whatever was read
     /// before.
@@ -694,14 +694,9 @@ impl<R: Read + Seek> AedatReader<R> {
             Ok(payload) => payload,
             Err(reason) => return Ok(Err(format!("it does not decompress: {reason}"))),
         };
-        Ok(index::plan(
-            payload,
-            self.data_start,
-            position,
-            &self.streams,
-            from,
-            to,
-        ))
+        let plan = index::plan(payload, self.data_start, position, &self.streams, from, to);
+        self.decompressor.shrink_to(1 << 20);
+        Ok(plan)
     }
 }
 
