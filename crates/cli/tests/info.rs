@@ -57,3 +57,28 @@ fn broken_file_is_an_error_naming_it() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("cut.npy") && err.contains("cut off"), "{err}");
 }
+
+#[test]
+fn triggers_are_counted() {
+    use evtac_events::aedat::{AedatWriter, WriterConfig};
+    use evtac_events::{Resolution, Trigger};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sync.aedat4");
+    let mut w =
+        AedatWriter::create(&path, WriterConfig::new(Resolution::new(8, 8), "cam")).unwrap();
+    let triggers: Vec<Trigger> = (0..150)
+        .map(|i| Trigger {
+            t: i * 700,
+            kind: 1,
+        })
+        .collect();
+    w.write_triggers(&triggers).unwrap();
+    w.finish().unwrap();
+    let out = run_ok(&["info", path.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["triggers"], 150);
+    assert_eq!(v["events"], 0);
+    let out = run_ok(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("triggers:    150"), "{text}");
+}

@@ -58,6 +58,16 @@ pub enum Error {
         /// The resolution in the file.
         found: Resolution,
     },
+    /// A range read was asked for an empty time range.
+    #[error("{}: the time range [{from}, {to}) us is empty: from must be smaller than to", path.display())]
+    EmptyRange {
+        /// The file.
+        path: PathBuf,
+        /// Start of the range (included), microseconds.
+        from: i64,
+        /// End of the range (excluded), microseconds.
+        to: i64,
+    },
     /// An AEDAT4 file is broken.
     #[error("{}: {error}", path.display())]
     Aedat {

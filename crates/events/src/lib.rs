@@ -5,7 +5,10 @@
 //! and `y` downwards; a [`Roi`] crops them (the paper uses the centered 240x240 region).
 //!
 //! [`open`] recognises a file's format and streams it in chunks that borrow reused buffers;
-//! [`read_recording`] reads it whole; [`EventWriter`] writes AEDAT4, CSV or NPY. Readers never
+//! [`read_recording`] reads it whole; [`read_recording_range`] (or
+//! [`EventReader::select_range`]) reads only a time range `[from, to)`, through an AEDAT4 file's
+//! data table when it has one ([`RangeIndex`] says how the range was found); [`EventWriter`]
+//! writes AEDAT4 (events, IMU samples and triggers), CSV or NPY. Readers never
 //! panic on bad input: a truncated or corrupt file, a bad header, an event outside the declared
 //! resolution or a timestamp going backwards is an [`Error`] naming the file, the byte offset or
 //! event index, and the broken limit.
@@ -32,11 +35,14 @@ pub mod evt;
 pub mod layout;
 pub mod manifest;
 pub mod npy;
+mod range;
 mod recording;
 mod types;
 
 pub use error::Error;
+pub use range::{RangeIndex, ScanReason};
 pub use recording::{
     Chunk, EventReader, EventWriter, Events, Format, Recording, open, read_recording,
+    read_recording_range,
 };
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

@@ -5,6 +5,10 @@
 //! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, EVT `%` header)
 //! and otherwise by its extension (`.csv`). Every reader validates what it decodes: events
 //! inside the declared resolution and timestamps that never go backwards.
+//!
+//! [`EventReader::select_range`] (and [`read_recording_range`]) read a time range `[from, to)`:
+//! AEDAT4 files through their data table, touching only the packets in the range; the other
+//! formats, which have no index, by reading up to the range's end.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read};
@@ -15,6 +19,7 @@ use crate::check::EventCheck;
 use crate::csv::{CsvReader, CsvWriter};
 use crate::evt::{EvtReader, EvtVersion};
 use crate::npy::{NpyReader, NpyWriter};
+use crate::range::{RangeIndex, ScanReason, within};
 use crate::{Error, Event, ImuSample, Resolution, Trigger};
 
 /// The event file formats evtac knows.
@@ -132,6 +137,7 @@ fn extension(path: &Path) -> String {
 }
 
 /// One chunk of a recording: views into the reader's reused buffers, valid until the next call.
+/// A chunk may be empty.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Chunk<'a> {
     /// Events, in time order.
@@ -140,6 +146,17 @@ pub struct Chunk<'a> {
     pub imu: &'a [ImuSample],
     /// Triggers (AEDAT4, EVT).
     pub triggers: &'a [Trigger],
+}
+
+impl<'a> Chunk<'a> {
+    /// The part of the chunk with `from <= t < to`.
+    fn within(self, from: i64, to: i64) -> Self {
+        Self {
+            events: &self.events[within(self.events, |e| e.t, from, to)],
+            imu: &self.imu[within(self.imu, |s| s.t, from, to)],
+            triggers: &self.triggers[within(self.triggers, |t| t.t, from, to)],
+        }
+    }
 }
 
 enum Inner {
@@ -158,6 +175,11 @@ pub struct EventReader {
     inner: Inner,
     /// Validation of AEDAT4 events (the other readers validate their own).
     aedat_check: EventCheck,
+    /// The selected time range, for the formats the reader filters itself (not AEDAT4, whose
+    /// reader does).
+    range: Option<(i64, i64)>,
+    /// Set once a range read of an unindexed format has passed the range's end.
+    past_range: bool,
 }
 
 impl std::fmt::Debug for EventReader {
@@ -232,6 +254,8 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
         len,
         inner,
         aedat_check,
+        range: None,
+        past_range: false,
     })
 }
 
@@ -300,66 +324,53 @@ impl EventReader {
         }
     }
 
-    /// The next chunk; `Ok(None)` at the end of the file.
-    pub fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
-        let path = &self.path;
+    /// Restricts the reader to the time range `[from, to)` (microseconds): from now on chunks
+    /// hold exactly the events, IMU samples and triggers with `from <= t < to`. Call it before
+    /// reading. An AEDAT4 file is read through its data table, touching only the packets in the
+    /// range ([`AedatReader::select_range`]); other formats have no index and are read from the
+    /// start up to the range's end. The returned [`RangeIndex`] says which happened;
+    /// [`RangeIndex::fallback`] gives the reason to warn about when an AEDAT4 file's data table
+    /// is missing or unusable.
+    pub fn select_range(&mut self, from: i64, to: i64) -> Result<RangeIndex, Error> {
+        if from >= to {
+            return Err(Error::EmptyRange {
+                path: self.path.clone(),
+                from,
+                to,
+            });
+        }
         match &mut self.inner {
             Inner::Aedat(r) => {
-                let chunk = r.next_chunk().map_err(|error| Error::Aedat {
-                    path: path.clone(),
+                self.aedat_check = EventCheck::new(self.aedat_check.resolution());
+                r.select_range(from, to).map_err(|error| Error::Aedat {
+                    path: self.path.clone(),
                     error,
-                })?;
-                let Some(chunk) = chunk else { return Ok(None) };
-                self.aedat_check
-                    .check(chunk.events)
-                    .map_err(|error| Error::Event {
-                        path: path.clone(),
-                        error,
-                    })?;
-                Ok(Some(Chunk {
-                    events: chunk.events,
-                    imu: chunk.imu,
-                    triggers: chunk.triggers,
+                })
+            }
+            _ => {
+                self.range = Some((from, to));
+                Ok(RangeIndex::Scan(ScanReason::NotIndexed {
+                    format: self.format.name(),
                 }))
             }
-            Inner::Evt(r) => r
-                .next_chunk()
-                .map(|c| {
-                    c.map(|c| Chunk {
-                        events: c.events,
-                        imu: &[],
-                        triggers: c.triggers,
-                    })
-                })
-                .map_err(|error| Error::Evt {
-                    path: path.clone(),
-                    error,
-                }),
-            Inner::Csv(r) => r
-                .next_chunk()
-                .map(|c| {
-                    c.map(|events| Chunk {
-                        events,
-                        ..Chunk::default()
-                    })
-                })
-                .map_err(|error| Error::Csv {
-                    path: path.clone(),
-                    error,
-                }),
-            Inner::Npy(r) => r
-                .next_chunk()
-                .map(|c| {
-                    c.map(|events| Chunk {
-                        events,
-                        ..Chunk::default()
-                    })
-                })
-                .map_err(|error| Error::Npy {
-                    path: path.clone(),
-                    error,
-                }),
         }
+    }
+
+    /// The next chunk; `Ok(None)` at the end of the file (or, after
+    /// [`select_range`](Self::select_range), of the range).
+    pub fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
+        if self.past_range {
+            return Ok(None);
+        }
+        let range = self.range;
+        let chunk = next_unfiltered(&self.path, &mut self.inner, &mut self.aedat_check)?;
+        let (Some((from, to)), Some(chunk)) = (range, chunk) else {
+            return Ok(chunk);
+        };
+        // Time never goes backwards in these formats: once an event reaches `to`, the range is
+        // over.
+        self.past_range = chunk.events.last().is_some_and(|e| e.t >= to);
+        Ok(Some(chunk.within(from, to)))
     }
 
     /// An iterator over the remaining events, one at a time (IMU samples and triggers are
@@ -389,6 +400,72 @@ impl EventReader {
             imu,
             triggers,
         })
+    }
+}
+
+/// The next chunk of `inner`, before any range filtering (AEDAT4 events checked with
+/// `aedat_check`).
+fn next_unfiltered<'a>(
+    path: &Path,
+    inner: &'a mut Inner,
+    aedat_check: &mut EventCheck,
+) -> Result<Option<Chunk<'a>>, Error> {
+    match inner {
+        Inner::Aedat(r) => {
+            let chunk = r.next_chunk().map_err(|error| Error::Aedat {
+                path: path.to_path_buf(),
+                error,
+            })?;
+            let Some(chunk) = chunk else { return Ok(None) };
+            aedat_check
+                .check(chunk.events)
+                .map_err(|error| Error::Event {
+                    path: path.to_path_buf(),
+                    error,
+                })?;
+            Ok(Some(Chunk {
+                events: chunk.events,
+                imu: chunk.imu,
+                triggers: chunk.triggers,
+            }))
+        }
+        Inner::Evt(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|c| Chunk {
+                    events: c.events,
+                    imu: &[],
+                    triggers: c.triggers,
+                })
+            })
+            .map_err(|error| Error::Evt {
+                path: path.to_path_buf(),
+                error,
+            }),
+        Inner::Csv(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|events| Chunk {
+                    events,
+                    ..Chunk::default()
+                })
+            })
+            .map_err(|error| Error::Csv {
+                path: path.to_path_buf(),
+                error,
+            }),
+        Inner::Npy(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|events| Chunk {
+                    events,
+                    ..Chunk::default()
+                })
+            })
+            .map_err(|error| Error::Npy {
+                path: path.to_path_buf(),
+                error,
+            }),
     }
 }
 
@@ -456,14 +533,36 @@ pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording, Error> {
     open(path)?.into_recording()
 }
 
+/// Reads the part `[from, to)` (microseconds) of the event file at `path`: the events, IMU
+/// samples and triggers with `from <= t < to`, and how they were found (see
+/// [`EventReader::select_range`]). Memory holds the range, not the file.
+///
+/// ```no_run
+/// let (trial, how) = evtac_events::read_recording_range("session.aedat4", 5_000_000, 9_000_000)?;
+/// if let Some(reason) = how.fallback() {
+///     eprintln!("warning: {reason}; scanned the whole file");
+/// }
+/// println!("{} events, {} triggers", trial.events.len(), trial.triggers.len());
+/// # Ok::<(), evtac_events::Error>(())
+/// ```
+pub fn read_recording_range(
+    path: impl AsRef<Path>,
+    from: i64,
+    to: i64,
+) -> Result<(Recording, RangeIndex), Error> {
+    let mut reader = open(path)?;
+    let index = reader.select_range(from, to)?;
+    Ok((reader.into_recording()?, index))
+}
+
 enum Sink {
     Aedat(Box<AedatWriter<BufWriter<File>>>),
     Csv(CsvWriter<BufWriter<File>>),
     Npy(NpyWriter<BufWriter<File>>),
 }
 
-/// Writes events (and, for AEDAT4, IMU samples) to a file whose extension picks the format:
-/// `.aedat4`, `.csv` or `.npy`.
+/// Writes events (and, for AEDAT4, IMU samples and triggers) to a file whose extension picks the
+/// format: `.aedat4`, `.csv` or `.npy`.
 pub struct EventWriter {
     path: PathBuf,
     format: Format,
@@ -525,6 +624,11 @@ impl EventWriter {
         matches!(self.sink, Sink::Aedat(_))
     }
 
+    /// Whether triggers are stored (AEDAT4 only).
+    pub fn stores_triggers(&self) -> bool {
+        matches!(self.sink, Sink::Aedat(_))
+    }
+
     /// Appends events.
     pub fn write_events(&mut self, events: &[Event]) -> Result<(), Error> {
         let path = &self.path;
@@ -549,6 +653,18 @@ impl EventWriter {
     pub fn write_imu(&mut self, samples: &[ImuSample]) -> Result<(), Error> {
         match &mut self.sink {
             Sink::Aedat(w) => w.write_imu(samples).map_err(|error| Error::Aedat {
+                path: self.path.clone(),
+                error,
+            }),
+            Sink::Csv(_) | Sink::Npy(_) => Ok(()),
+        }
+    }
+
+    /// Appends triggers when the format stores them ([`stores_triggers`](Self::stores_triggers));
+    /// CSV and NPY event files have no place for them and ignore them.
+    pub fn write_triggers(&mut self, triggers: &[Trigger]) -> Result<(), Error> {
+        match &mut self.sink {
+            Sink::Aedat(w) => w.write_triggers(triggers).map_err(|error| Error::Aedat {
                 path: self.path.clone(),
                 error,
             }),

@@ -32,12 +32,16 @@ pub struct ImuSample {
     pub temperature: f32,
 }
 
-/// An external trigger or special event, as AEDAT4 stores them.
+/// An external trigger or special event, as AEDAT4 stores them: DV records the camera's trigger
+/// input (e.g. a robot's sync pulses) as a `Trigger` stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct Trigger {
-    /// Timestamp in microseconds.
+    /// Timestamp in microseconds, on the same clock as the events.
     pub t: i64,
-    /// The AEDAT4 trigger type code.
+    /// The AEDAT4 trigger type code (dv-processing's `TriggerType`): 0 `TIMESTAMP_RESET`,
+    /// 1 / 2 / 3 external signal rising edge / falling edge / pulse, 4 / 5 external generator
+    /// rising / falling edge, 6 .. 9 APS frame start / end and exposure start / end. Prophesee
+    /// external triggers read from EVT files are 1 (rising) or 2 (falling).
     pub kind: i8,
 }
 

@@ -9,6 +9,9 @@ use evtac_events::aedat::{
 };
 use evtac_events::{Event, ImuSample, Resolution, Trigger};
 use proptest::prelude::*;
+use support::{Dribble, xorshift};
+
+mod support;
 
 /// Everything a reader produced, packet by packet.
 #[derive(Debug, Default, Clone, PartialEq)]
@@ -35,21 +38,6 @@ fn decode<R: Read>(mut reader: AedatReader<R>) -> Result<Decoded, AedatError> {
         out.push(&c);
     }
     Ok(out)
-}
-
-/// A reader that hands out at most `step` bytes per `read` call.
-struct Dribble<'a> {
-    bytes: &'a [u8],
-    step: usize,
-}
-
-impl Read for Dribble<'_> {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        let n = self.step.min(buf.len()).min(self.bytes.len());
-        buf[..n].copy_from_slice(&self.bytes[..n]);
-        self.bytes = &self.bytes[n..];
-        Ok(n)
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -113,11 +101,7 @@ fn read_size_does_not_change_the_output() {
     let bytes = std::fs::read(path).unwrap();
     let whole = decode(AedatReader::from_slice(&bytes).unwrap()).unwrap();
     for step in [1, 7, 65536] {
-        let r = AedatReader::new(Dribble {
-            bytes: &bytes,
-            step,
-        })
-        .unwrap();
+        let r = AedatReader::new(Dribble::new(&bytes, step)).unwrap();
         assert!(
             decode(r).unwrap() == whole,
             "read size {step} changed the output"
@@ -143,13 +127,7 @@ fn events_iterator_yields_every_event() {
 /// Deterministic test data (xorshift, seeded): `n` events on `res` with increasing timestamps
 /// (repeats included), and IMU samples at 1 kHz over the same span.
 fn synthetic(n: usize, res: Resolution, seed: u64) -> (Vec<Event>, Vec<ImuSample>) {
-    let mut s = seed.max(1);
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        s
-    };
+    let mut next = xorshift(seed);
     let mut t = 1_700_000_000_000_000i64;
     let events: Vec<Event> = (0..n)
         .map(|_| {
@@ -158,7 +136,7 @@ fn synthetic(n: usize, res: Resolution, seed: u64) -> (Vec<Event>, Vec<ImuSample
                 t,
                 x: (next() % u64::from(res.width)) as u16,
                 y: (next() % u64::from(res.height)) as u16,
-                polarity: next() % 2 == 0,
+                polarity: next().is_multiple_of(2),
             }
         })
         .collect();

@@ -1,5 +1,10 @@
 //! `evtac convert`: any readable event file to AEDAT4, CSV or NPY (by the output's extension),
-//! optionally cropped to a centered region and with the IMU written to a CSV file.
+//! optionally cut to a time range, cropped to a centered region and with the IMU written to a
+//! CSV file. AEDAT4 outputs keep the IMU samples and triggers.
+//!
+//! A time range (`--from-us`, `--to-us`) is read through an AEDAT4 input's data table, so
+//! cutting a trial out of a long session reads only that trial's packets; when the table is
+//! missing or damaged the whole file is scanned, with one warning saying why.
 
 use std::path::PathBuf;
 
@@ -25,6 +30,15 @@ pub struct Args {
     /// shifted into it, and the output's resolution is the region's.
     #[arg(long, value_name = "WxH")]
     pub roi: Option<Resolution>,
+    /// Keep only events, IMU samples and triggers at or after this time, in microseconds on the
+    /// file's own clock (as `evtac info` prints it); default: the start of the file.
+    #[arg(long, value_name = "US", allow_hyphen_values = true)]
+    pub from_us: Option<i64>,
+    /// Keep only what comes before this time (excluded), in microseconds on the file's clock;
+    /// default: the end of the file. An AEDAT4 input with a data table is read only where the
+    /// range lies.
+    #[arg(long, value_name = "US", allow_hyphen_values = true)]
+    pub to_us: Option<i64>,
 }
 
 /// What a conversion wrote.
@@ -36,6 +50,8 @@ pub struct Counts {
     pub events_out: u64,
     /// IMU samples read.
     pub imu: u64,
+    /// Triggers read.
+    pub triggers: u64,
 }
 
 /// Runs `evtac convert`.
@@ -55,6 +71,25 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
     let mut reader = evtac_events::open(&args.input)?;
     if let Some(resolution) = args.resolution {
         reader.set_resolution(resolution)?;
+    }
+    if args.from_us.is_some() || args.to_us.is_some() {
+        let (from, to) = (
+            args.from_us.unwrap_or(i64::MIN),
+            args.to_us.unwrap_or(i64::MAX),
+        );
+        if from >= to {
+            bail!(
+                "{}: --from-us {from} is not before --to-us {to}: the time range [from, to) is empty",
+                args.input.display()
+            );
+        }
+        let index = reader.select_range(from, to)?;
+        if let Some(reason) = index.fallback() {
+            eprintln!(
+                "warning: {}: {reason}; reading the whole file to find the range",
+                args.input.display()
+            );
+        }
     }
     let Some(sensor) = reader.resolution() else {
         bail!(
@@ -83,6 +118,7 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         roi.crop_into(chunk.events, &mut cropped);
         writer.write_events(&cropped)?;
         writer.write_imu(chunk.imu)?;
+        writer.write_triggers(chunk.triggers)?;
         if let Some((w, path)) = &mut imu_writer {
             w.write_imu(chunk.imu)
                 .with_context(|| format!("writing {}", path.display()))?;
@@ -90,10 +126,12 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         counts.events_in += chunk.events.len() as u64;
         counts.events_out += cropped.len() as u64;
         counts.imu += chunk.imu.len() as u64;
+        counts.triggers += chunk.triggers.len() as u64;
         bar.set_position(reader.position());
     }
     bar.finish_and_clear();
     let stores_imu = writer.stores_imu();
+    let stores_triggers = writer.stores_triggers();
     writer.finish()?;
     if let Some((w, path)) = imu_writer {
         w.finish()
@@ -103,6 +141,13 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         eprintln!(
             "note: {} IMU samples were not written ({} files hold events only); use --imu FILE.csv",
             counts.imu,
+            writer_format_name(&args.output)
+        );
+    }
+    if counts.triggers > 0 && !stores_triggers {
+        eprintln!(
+            "note: {} triggers were not written ({} files hold events only); write .aedat4 to keep them",
+            counts.triggers,
             writer_format_name(&args.output)
         );
     }

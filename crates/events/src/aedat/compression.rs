@@ -127,6 +127,16 @@ impl Decompressor {
         &mut self.input
     }
 
+    /// Gives back the buffers' memory beyond `bytes` (after an unusually large input, such as a
+    /// long recording's data table, so that it is not kept for the reader's lifetime).
+    pub fn shrink_to(&mut self, bytes: usize) {
+        self.input.clear();
+        self.input.shrink_to(bytes);
+        // Only `..returned` of `out` is ever meaningful: the rest may go.
+        self.out.truncate(bytes);
+        self.out.shrink_to(bytes);
+    }
+
     /// Decompresses the bytes put into [`Self::input`] and returns the packet's flatbuffer.
     pub fn decompress(&mut self) -> Result<&[u8], String> {
         let input = &self.input;

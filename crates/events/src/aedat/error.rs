@@ -152,6 +152,30 @@ pub enum AedatError {
         /// The offending timestamp (microseconds).
         current: i64,
     },
+    /// A range read was asked for an empty time range.
+    #[error("the time range [{from}, {to}) us is empty: from must be smaller than to")]
+    EmptyRange {
+        /// Start of the range (included), microseconds.
+        from: i64,
+        /// End of the range (excluded), microseconds.
+        to: i64,
+    },
+    /// A packet that a range read located through the data table is not what the table says
+    /// (the table passed every check that needs no packet, so it is damaged in a way only the
+    /// packet shows; a full read does not use the table).
+    #[error(
+        "the data table disagrees with the packet at byte {offset}: its {field} is {found}, the table says {table}"
+    )]
+    DataTableMismatch {
+        /// Byte offset of the packet header.
+        offset: u64,
+        /// The table field (`StreamID`, `Size`, `NumElements`, `TimestampStart`, `TimestampEnd`).
+        field: &'static str,
+        /// What the table says.
+        table: i64,
+        /// What the packet holds.
+        found: i64,
+    },
     /// The writer was given data it cannot store (e.g. coordinates outside its resolution).
     #[error("cannot write {what}: {reason}")]
     InvalidInput {

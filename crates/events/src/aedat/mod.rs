@@ -9,11 +9,18 @@
 //! the magic and the data table. The schemas are in `crates/events/schema/`.
 //!
 //! [`AedatReader`] streams packets from any `Read` with bounded memory; [`AedatWriter`] writes
-//! events and IMU samples that dv-processing reads back exactly.
+//! events, IMU samples and triggers (DV's `Trigger` stream: the camera's sync input) that
+//! dv-processing reads back exactly, and ends seekable outputs with the data table as DV does.
+//!
+//! The data table is an index: each packet's offset, stream, element count and first and last
+//! timestamps. [`AedatReader::select_range`] uses it to read a time range `[from, to)` of a
+//! long recording by seeking to the packets that overlap it, so reading a trial out of a
+//! multi-gigabyte session touches only that trial's packets; without a usable table it scans
+//! the file instead and says why.
 //!
 //! ```
 //! use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
-//! use evtac_events::{Event, ImuSample, Resolution};
+//! use evtac_events::{Event, ImuSample, Resolution, Trigger};
 //!
 //! let config = WriterConfig {
 //!     resolution: Resolution::new(640, 480),
@@ -23,22 +30,25 @@
 //! let mut writer = AedatWriter::new(Vec::new(), config)?;
 //! writer.write_events(&[Event { t: 10, x: 320, y: 240, polarity: false }])?;
 //! writer.write_imu(&[ImuSample { t: 12, accelerometer: [0.0, -1.0, 0.0], ..Default::default() }])?;
+//! writer.write_triggers(&[Trigger { t: 15, kind: 1 }])?; // EXTERNAL_SIGNAL_RISING_EDGE
 //! let bytes = writer.finish()?;
 //!
 //! let mut reader = AedatReader::from_slice(&bytes)?;
 //! assert_eq!(reader.source(), Some("DVXplorer_DXA00000"));
-//! let (mut events, mut imu) = (0, 0);
+//! let (mut events, mut imu, mut triggers) = (0, 0, 0);
 //! while let Some(chunk) = reader.next_chunk()? {
 //!     events += chunk.events.len();
 //!     imu += chunk.imu.len();
+//!     triggers += chunk.triggers.len();
 //! }
-//! assert_eq!((events, imu), (1, 1));
+//! assert_eq!((events, imu, triggers), (1, 1, 1));
 //! # Ok::<(), evtac_events::aedat::AedatError>(())
 //! ```
 
 mod compression;
 mod error;
 mod header;
+mod index;
 mod packet;
 mod reader;
 pub mod schema;
@@ -48,7 +58,10 @@ pub use compression::MAX_PACKET_BYTES;
 pub use error::{AedatError, Result};
 pub use header::{AedatHeader, Compression, MAGIC, StreamInfo, StreamKind, parse_description};
 pub use reader::{AedatChunk, AedatReader, Events};
-pub use writer::{AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, WriterConfig};
+pub use writer::{
+    AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, TRIGGERS_PER_PACKET,
+    WriterConfig,
+};
 
 /// Whether the size-prefixed flatbuffer `buf` carries `identifier`. flatbuffers'
 /// `buffer_has_identifier` asserts (panics) on a buffer too short to hold a prefix, a root

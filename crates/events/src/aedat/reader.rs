@@ -1,14 +1,17 @@
 //! The streaming AEDAT 4.0 reader: files (magic, header, packets, data table) and DV network
-//! streams (header and packets only), from any `Read`.
+//! streams (header and packets only), from any `Read`; with `Seek` too, a time range read
+//! through the data table ([`AedatReader::select_range`]).
 
 use std::fs::File;
-use std::io::{self, BufReader, Read};
+use std::io::{self, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use super::compression::{Decompressor, MAX_PACKET_BYTES};
 use super::error::{AedatError, Result};
 use super::header::{AedatHeader, Compression, MAGIC, StreamKind};
+use super::index::{self, Plan, PlannedPacket};
 use super::packet::{self, StreamState};
+use crate::range::{RangeIndex, ScanReason, retain_within};
 use crate::{Event, ImuSample, Resolution, Trigger};
 
 /// Largest `IOHeader` accepted (DV's are a few KiB: the XML description of a handful of streams).
@@ -37,6 +40,32 @@ enum Mode {
     Network,
 }
 
+/// Moves a seekable input to a byte offset (kept as a function pointer so that reading, which
+/// needs only `Read`, can follow a plan made where `Seek` was available).
+type SeekTo<R> = fn(&mut R, u64) -> io::Result<()>;
+
+fn seek_to<R: Seek>(reader: &mut R, offset: u64) -> io::Result<()> {
+    reader.seek(SeekFrom::Start(offset)).map(drop)
+}
+
+/// A range read in progress (see [`AedatReader::select_range`]).
+struct RangeRead<R> {
+    from: i64,
+    to: i64,
+    /// The packets the data table selected, or `None` while scanning.
+    plan: Option<(Plan, SeekTo<R>)>,
+}
+
+/// What reading one packet gave.
+enum Packet {
+    /// The end of the input, at a packet boundary.
+    End,
+    /// A packet of a stream that is not decoded (frames, unknown types).
+    Skipped,
+    /// A decoded packet: stream id, offset, index into the reader's streams.
+    Decoded(i32, u64, usize),
+}
+
 /// Reads AEDAT 4.0 packet by packet, handing out chunks that borrow reused buffers: memory stays
 /// bounded by the largest packet whatever the file size. Works with any [`Read`], including one
 /// that returns a single byte per call; wrap unbuffered sources (files, sockets) in a
@@ -60,11 +89,20 @@ pub struct AedatReader<R> {
     header: AedatHeader,
     /// Bytes consumed so far.
     offset: u64,
+    /// Offset of the first packet (just past the header).
+    data_start: u64,
+    /// Where the packets end: the data table, when there is one.
+    table_end: Option<u64>,
+    /// Whether to verify the data table on reaching it (not when a range read already found it
+    /// unusable and said so).
+    check_table: bool,
     decompressor: Decompressor,
     streams: Vec<StreamState>,
     events: Vec<Event>,
     imu: Vec<ImuSample>,
     triggers: Vec<Trigger>,
+    /// The selected time range, if any.
+    range: Option<RangeRead<R>>,
     /// Set at the end of the data or after an error: the reader then yields nothing more.
     finished: bool,
 }
@@ -178,12 +216,16 @@ impl<R: Read> AedatReader<R> {
             reader,
             mode,
             decompressor: Decompressor::new(header.compression),
+            table_end: header.data_table_position,
+            check_table: true,
             header,
             offset: offset + 4 + size,
+            data_start: offset + 4 + size,
             streams,
             events: Vec::new(),
             imu: Vec::new(),
             triggers: Vec::new(),
+            range: None,
             finished: false,
         })
     }
@@ -222,34 +264,74 @@ impl<R: Read> AedatReader<R> {
     /// types are skipped). `Ok(None)` at the end of the data: the data table in a file, or the
     /// end of input at a packet boundary. Truncation or corruption is an error; after an error
     /// the reader is finished and returns `Ok(None)`.
+    ///
+    /// After [`Self::select_range`], only elements inside the range are handed out, and packets
+    /// with none are passed over: every chunk is non-empty.
     pub fn next_chunk(&mut self) -> Result<Option<AedatChunk<'_>>> {
         if self.finished {
             return Ok(None);
         }
-        match self.next_packet() {
-            Ok(Some((stream_id, offset, index))) => {
-                let kind = &self.streams[index].kind;
-                let (events, imu, triggers): (&[Event], &[ImuSample], &[Trigger]) = match kind {
-                    StreamKind::Events => (&self.events, &[], &[]),
-                    StreamKind::Imu => (&[], &self.imu, &[]),
-                    _ => (&[], &[], &self.triggers),
-                };
-                Ok(Some(AedatChunk {
-                    stream_id,
-                    offset,
-                    events,
-                    imu,
-                    triggers,
-                }))
+        loop {
+            let next = if self.range.as_ref().is_some_and(|r| r.plan.is_some()) {
+                self.next_planned()
+            } else {
+                self.next_packet()
+            };
+            match next {
+                Ok(Some((stream_id, offset, index))) => {
+                    if self.keep_range(index) {
+                        return Ok(Some(self.chunk(stream_id, offset, index)));
+                    }
+                }
+                Ok(None) => {
+                    self.finished = true;
+                    return Ok(None);
+                }
+                Err(e) => {
+                    self.finished = true;
+                    return Err(e);
+                }
             }
-            Ok(None) => {
-                self.finished = true;
-                Ok(None)
+        }
+    }
+
+    /// Cuts the just-decoded elements of stream `index` to the selected range; whether any are
+    /// left (always true without a range).
+    fn keep_range(&mut self, index: usize) -> bool {
+        let Some(range) = &self.range else {
+            return true;
+        };
+        let (from, to) = (range.from, range.to);
+        match self.streams[index].kind {
+            StreamKind::Events => {
+                retain_within(&mut self.events, |e| e.t, from, to);
+                !self.events.is_empty()
             }
-            Err(e) => {
-                self.finished = true;
-                Err(e)
+            StreamKind::Imu => {
+                retain_within(&mut self.imu, |s| s.t, from, to);
+                !self.imu.is_empty()
             }
+            _ => {
+                retain_within(&mut self.triggers, |t| t.t, from, to);
+                !self.triggers.is_empty()
+            }
+        }
+    }
+
+    /// The chunk of the packet just decoded.
+    fn chunk(&self, stream_id: i32, offset: u64, index: usize) -> AedatChunk<'_> {
+        let (events, imu, triggers): (&[Event], &[ImuSample], &[Trigger]) =
+            match self.streams[index].kind {
+                StreamKind::Events => (&self.events, &[], &[]),
+                StreamKind::Imu => (&[], &self.imu, &[]),
+                _ => (&[], &[], &self.triggers),
+            };
+        AedatChunk {
+            stream_id,
+            offset,
+            events,
+            imu,
+            triggers,
         }
     }
 
@@ -258,99 +340,209 @@ impl<R: Read> AedatReader<R> {
     fn next_packet(&mut self) -> Result<Option<(i32, u64, usize)>> {
         loop {
             let offset = self.offset;
-            if self.header.data_table_position == Some(offset) {
-                self.check_data_table(offset)?;
+            if self.table_end == Some(offset) {
+                if self.check_table {
+                    self.check_data_table(offset)?;
+                }
                 return Ok(None);
             }
-            let mut head = [0u8; 8];
-            let n = read_up_to(&mut self.reader, &mut head)
-                .map_err(|source| AedatError::Io { offset, source })?;
-            if n == 0 {
-                return match self.header.data_table_position {
-                    Some(table) if self.mode == Mode::File => Err(AedatError::MissingDataTable {
-                        offset,
-                        data_table: table,
-                    }),
-                    _ => Ok(None),
-                };
-            }
-            let [s0, s1, s2, s3, z0, z1, z2, z3] = head;
-            let stream_id = i32::from_le_bytes([s0, s1, s2, s3]);
-            if n < 8 {
-                return Err(AedatError::TruncatedPacket {
-                    offset,
-                    stream_id: -1,
-                    expected: 8,
-                    got: n as u64,
-                });
-            }
-            let size = i32::from_le_bytes([z0, z1, z2, z3]);
-            let size = u64::try_from(size).map_err(|_| AedatError::BadSize {
-                field: "packet size",
-                offset,
-                value: size.into(),
-                limit: MAX_PACKET_BYTES,
-            })?;
-            if let Some(table) = self.header.data_table_position
-                && offset + 8 + size > table
-            {
-                return Err(AedatError::PacketOverlapsDataTable {
-                    offset,
-                    stream_id,
-                    size,
-                    data_table: table,
-                });
-            }
-            let index = self
-                .streams
-                .iter()
-                .position(|s| s.id == stream_id)
-                .ok_or(AedatError::UnknownStream { offset, stream_id })?;
-            // `take` + `read_to_end` grows the buffer as bytes arrive, so a corrupt size cannot
-            // allocate more than the input actually holds.
-            let input = self.decompressor.input();
-            input.reserve(size.min(1 << 20) as usize);
-            let got = (&mut self.reader)
-                .take(size)
-                .read_to_end(input)
-                .map_err(|source| AedatError::Io {
-                    offset: offset + 8,
-                    source,
-                })? as u64;
-            self.offset = offset + 8 + got;
-            if got < size {
-                return Err(AedatError::TruncatedPacket {
-                    offset,
-                    stream_id,
-                    expected: size + 8,
-                    got: got + 8,
-                });
-            }
-            let state = &mut self.streams[index];
-            if !matches!(
-                state.kind,
-                StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
-            ) {
-                continue;
-            }
-            let payload =
-                self.decompressor
-                    .decompress()
-                    .map_err(|reason| AedatError::Decompression {
-                        offset,
-                        stream_id,
-                        compression: self.header.compression.name(),
-                        reason,
-                    })?;
-            match state.kind {
-                StreamKind::Events => {
-                    packet::decode_events(payload, state, offset, &mut self.events)?
+            match self.read_packet(None)? {
+                Packet::Decoded(stream_id, offset, index) => {
+                    return Ok(Some((stream_id, offset, index)));
                 }
-                StreamKind::Imu => packet::decode_imu(payload, state, offset, &mut self.imu)?,
-                _ => packet::decode_triggers(payload, state, offset, &mut self.triggers)?,
+                Packet::Skipped => {}
+                Packet::End => {
+                    return match self.table_end {
+                        Some(table) if self.mode == Mode::File => {
+                            Err(AedatError::MissingDataTable {
+                                offset,
+                                data_table: table,
+                            })
+                        }
+                        _ => Ok(None),
+                    };
+                }
             }
-            return Ok(Some((stream_id, offset, index)));
         }
+    }
+
+    /// Reads and decodes the next packet the data table selected, checking it against its
+    /// table entry.
+    fn next_planned(&mut self) -> Result<Option<(i32, u64, usize)>> {
+        let Some((plan, seek)) = self.range.as_mut().and_then(|r| r.plan.as_mut()) else {
+            return Ok(None);
+        };
+        let Some(p) = plan.packets.pop_front() else {
+            return Ok(None);
+        };
+        if self.offset != p.offset {
+            seek(&mut self.reader, p.offset).map_err(|source| AedatError::Io {
+                offset: p.offset,
+                source,
+            })?;
+            self.offset = p.offset;
+        }
+        match self.read_packet(Some(&p))? {
+            Packet::Decoded(stream_id, offset, index) => {
+                self.check_planned(&p, index)?;
+                Ok(Some((stream_id, offset, index)))
+            }
+            // The plan holds decoded streams only, and `read_packet` reports a cut.
+            Packet::Skipped | Packet::End => Err(AedatError::TruncatedPacket {
+                offset: p.offset,
+                stream_id: p.stream_id,
+                expected: p.size + 8,
+                got: 0,
+            }),
+        }
+    }
+
+    /// Checks what the data table said about a packet against what it decoded to.
+    fn check_planned(&self, p: &PlannedPacket, index: usize) -> Result<()> {
+        let ts = |first: Option<i64>, last: Option<i64>, n: usize| (n, first, last);
+        let (n, first, last) = match self.streams[index].kind {
+            StreamKind::Events => ts(
+                self.events.first().map(|e| e.t),
+                self.events.last().map(|e| e.t),
+                self.events.len(),
+            ),
+            StreamKind::Imu => ts(
+                self.imu.first().map(|s| s.t),
+                self.imu.last().map(|s| s.t),
+                self.imu.len(),
+            ),
+            _ => ts(
+                self.triggers.first().map(|t| t.t),
+                self.triggers.last().map(|t| t.t),
+                self.triggers.len(),
+            ),
+        };
+        let mismatch = |field: &'static str, table: i64, found: i64| {
+            Err(AedatError::DataTableMismatch {
+                offset: p.offset,
+                field,
+                table,
+                found,
+            })
+        };
+        if n as u64 != p.elements {
+            return mismatch("NumElements", p.elements as i64, n as i64);
+        }
+        if let Some(first) = first
+            && first != p.t_start
+        {
+            return mismatch("TimestampStart", p.t_start, first);
+        }
+        if let Some(last) = last
+            && last != p.t_end
+        {
+            return mismatch("TimestampEnd", p.t_end, last);
+        }
+        Ok(())
+    }
+
+    /// Reads the packet at the current offset and decodes it when its stream is decoded. With
+    /// `planned`, its header must match the data table's entry.
+    fn read_packet(&mut self, planned: Option<&PlannedPacket>) -> Result<Packet> {
+        let offset = self.offset;
+        let mut head = [0u8; 8];
+        let n = read_up_to(&mut self.reader, &mut head)
+            .map_err(|source| AedatError::Io { offset, source })?;
+        if n == 0 && planned.is_none() {
+            return Ok(Packet::End);
+        }
+        let [s0, s1, s2, s3, z0, z1, z2, z3] = head;
+        let stream_id = i32::from_le_bytes([s0, s1, s2, s3]);
+        if n < 8 {
+            return Err(AedatError::TruncatedPacket {
+                offset,
+                stream_id: -1,
+                expected: 8,
+                got: n as u64,
+            });
+        }
+        let size = i32::from_le_bytes([z0, z1, z2, z3]);
+        if let Some(p) = planned {
+            if stream_id != p.stream_id {
+                return Err(AedatError::DataTableMismatch {
+                    offset,
+                    field: "StreamID",
+                    table: p.stream_id.into(),
+                    found: stream_id.into(),
+                });
+            }
+            if i64::from(size) != p.size as i64 {
+                return Err(AedatError::DataTableMismatch {
+                    offset,
+                    field: "Size",
+                    table: p.size as i64,
+                    found: size.into(),
+                });
+            }
+        }
+        let size = u64::try_from(size).map_err(|_| AedatError::BadSize {
+            field: "packet size",
+            offset,
+            value: size.into(),
+            limit: MAX_PACKET_BYTES,
+        })?;
+        if let Some(table) = self.table_end
+            && offset + 8 + size > table
+        {
+            return Err(AedatError::PacketOverlapsDataTable {
+                offset,
+                stream_id,
+                size,
+                data_table: table,
+            });
+        }
+        let index = self
+            .streams
+            .iter()
+            .position(|s| s.id == stream_id)
+            .ok_or(AedatError::UnknownStream { offset, stream_id })?;
+        // `take` + `read_to_end` grows the buffer as bytes arrive, so a corrupt size cannot
+        // allocate more than the input actually holds.
+        let input = self.decompressor.input();
+        input.reserve(size.min(1 << 20) as usize);
+        let got = (&mut self.reader)
+            .take(size)
+            .read_to_end(input)
+            .map_err(|source| AedatError::Io {
+                offset: offset + 8,
+                source,
+            })? as u64;
+        self.offset = offset + 8 + got;
+        if got < size {
+            return Err(AedatError::TruncatedPacket {
+                offset,
+                stream_id,
+                expected: size + 8,
+                got: got + 8,
+            });
+        }
+        let state = &mut self.streams[index];
+        if !matches!(
+            state.kind,
+            StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
+        ) {
+            return Ok(Packet::Skipped);
+        }
+        let payload =
+            self.decompressor
+                .decompress()
+                .map_err(|reason| AedatError::Decompression {
+                    offset,
+                    stream_id,
+                    compression: self.header.compression.name(),
+                    reason,
+                })?;
+        match state.kind {
+            StreamKind::Events => packet::decode_events(payload, state, offset, &mut self.events)?,
+            StreamKind::Imu => packet::decode_imu(payload, state, offset, &mut self.imu)?,
+            _ => packet::decode_triggers(payload, state, offset, &mut self.triggers)?,
+        }
+        Ok(Packet::Decoded(stream_id, offset, index))
     }
 
     /// Reads the data table at `offset` (the rest of the file) and verifies it, so that a file
@@ -387,6 +579,124 @@ impl<R: Read> AedatReader<R> {
             reader: self,
             pos: 0,
         }
+    }
+}
+
+impl<R: Read + Seek> AedatReader<R> {
+    /// Restricts the reader to the time range `[from, to)` (microseconds): from now on
+    /// [`Self::next_chunk`] hands out exactly the events, IMU samples and triggers with
+    /// `from <= t < to`, in file order, as if the whole file had been read and then filtered.
+    ///
+    /// With a data table, only the packets it lists as overlapping the range are read: reading a
+    /// few seconds of a multi-gigabyte recording touches a few megabytes, and memory holds the
+    /// table's entries for the range only (the table itself, about 60 bytes a packet, is read
+    /// once and its memory given back). Without one, or when the table is unusable, the reader scans the file
+    /// from its first packet; the returned [`RangeIndex`] says which happened and why, so that
+    /// the caller can warn once. The read starts over from the first packet whatever was read
+    /// before.
+    ///
+    /// ```
+    /// use std::io::Cursor;
+    /// use evtac_events::aedat::{AedatReader, AedatWriter, WriterConfig};
+    /// use evtac_events::{Event, RangeIndex, Resolution};
+    ///
+    /// let config = WriterConfig::new(Resolution::new(64, 48), "cam");
+    /// let mut writer = AedatWriter::new_seekable(Cursor::new(Vec::new()), config)?;
+    /// let events: Vec<Event> = (0..100_000).map(|t| Event { t, x: 1, y: 2, polarity: true }).collect();
+    /// writer.write_events(&events)?;
+    /// let file = writer.finish()?.into_inner();
+    ///
+    /// let mut reader = AedatReader::new(Cursor::new(&file))?;
+    /// let how = reader.select_range(50_000, 50_010)?;
+    /// assert!(matches!(how, RangeIndex::DataTable { packets: 1, .. }));
+    /// let chunk = reader.next_chunk()?.unwrap();
+    /// assert_eq!(chunk.events, &events[50_000..50_010]);
+    /// assert!(reader.next_chunk()?.is_none());
+    /// # Ok::<(), evtac_events::aedat::AedatError>(())
+    /// ```
+    pub fn select_range(&mut self, from: i64, to: i64) -> Result<RangeIndex> {
+        if from >= to {
+            return Err(AedatError::EmptyRange { from, to });
+        }
+        self.range = None;
+        self.finished = false;
+        self.table_end = self.header.data_table_position;
+        self.check_table = true;
+        for s in &mut self.streams {
+            s.count = 0;
+            s.last_t = i64::MIN;
+        }
+        let index = match self.header.data_table_position {
+            None => RangeIndex::Scan(ScanReason::NoDataTable),
+            Some(position) => match self.load_plan(position, from, to)? {
+                Ok(plan) => {
+                    for (s, &first) in self.streams.iter_mut().zip(&plan.first_index) {
+                        s.count = first;
+                    }
+                    let index = RangeIndex::DataTable {
+                        packets: plan.packets.len(),
+                        total: plan.total,
+                    };
+                    self.range = Some(RangeRead {
+                        from,
+                        to,
+                        plan: Some((plan, seek_to::<R>)),
+                    });
+                    return Ok(index);
+                }
+                Err(reason) => {
+                    // Said once, here; the scan then stops at the table without verifying it.
+                    self.check_table = false;
+                    RangeIndex::Scan(ScanReason::DamagedDataTable { position, reason })
+                }
+            },
+        };
+        seek_to(&mut self.reader, self.data_start).map_err(|source| AedatError::Io {
+            offset: self.data_start,
+            source,
+        })?;
+        self.offset = self.data_start;
+        self.range = Some(RangeRead {
+            from,
+            to,
+            plan: None,
+        });
+        Ok(index)
+    }
+
+    /// Reads and checks the data table at `position` and selects the packets overlapping
+    /// `[from, to)`. The outer error is an I/O failure; the inner one says why the table cannot
+    /// be used.
+    fn load_plan(
+        &mut self,
+        position: u64,
+        from: i64,
+        to: i64,
+    ) -> Result<std::result::Result<Plan, String>> {
+        let io = |offset| move |source| AedatError::Io { offset, source };
+        let len = self.reader.seek(SeekFrom::End(0)).map_err(io(position))?;
+        if position >= len || position < self.data_start {
+            // The position itself is wrong: the scan runs to the end of the input.
+            self.table_end = None;
+            return Ok(Err(format!(
+                "it lies outside the file's packets (bytes {} .. {len})",
+                self.data_start
+            )));
+        }
+        seek_to(&mut self.reader, position).map_err(io(position))?;
+        let input = self.decompressor.input();
+        (&mut self.reader)
+            .take(MAX_PACKET_BYTES)
+            .read_to_end(input)
+            .map_err(io(position))?;
+        self.offset = position + input.len() as u64;
+        let payload = match self.decompressor.decompress() {
+            Ok(payload) => payload,
+            Err(reason) => return Ok(Err(format!("it does not decompress: {reason}"))),
+        };
+        let plan = index::plan(payload, self.data_start, position, &self.streams, from, to);
+        self.decompressor.shrink_to(1 << 20);
+        Ok(plan)
     }
 }
 

@@ -445,6 +445,27 @@ pub fn size_prefixed_root_as_trigger_packet(
     flatbuffers::size_prefixed_root::<TriggerPacket>(buf)
 }
 
+/// Builds a finished, size-prefixed `TriggerPacket` buffer into `fbb` from `(timestamp, type)`
+/// pairs, fields added largest-first as flatc's builder does (dv-processing's layout).
+pub fn build_trigger_packet(fbb: &mut FlatBufferBuilder, triggers: &[(i64, i8)]) {
+    let mut tables = Vec::with_capacity(triggers.len());
+    for &(timestamp, type_) in triggers {
+        let start = fbb.start_table();
+        fbb.push_slot::<i64>(FbTrigger::VT_TIMESTAMP, timestamp, 0);
+        fbb.push_slot::<i8>(FbTrigger::VT_TYPE, type_, 0);
+        let t = fbb.end_table(start);
+        tables.push(WIPOffset::<FbTrigger>::new(t.value()));
+    }
+    let elements = fbb.create_vector(&tables);
+    let start = fbb.start_table();
+    fbb.push_slot_always::<WIPOffset<_>>(TriggerPacket::VT_ELEMENTS, elements);
+    let root = fbb.end_table(start);
+    fbb.finish_size_prefixed(
+        WIPOffset::<TriggerPacket>::new(root.value()),
+        Some(TRIGGER_PACKET_IDENTIFIER),
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // FileDataTable.fbs
 // ---------------------------------------------------------------------------------------------

@@ -1,10 +1,13 @@
-//! The AEDAT 4.0 writer: events (stream 0, `EVTS`) and IMU samples (stream 1, `IMUS`), laid out
-//! as dv-processing's `MonoCameraWriter` does, so DV tools open the result and list both streams
-//! with the camera name and resolution.
+//! The AEDAT 4.0 writer: events (stream 0, `EVTS`), IMU samples (stream 1, `IMUS`) and triggers
+//! (stream 2, `TRIG`), laid out as dv-processing's `MonoCameraWriter` does with
+//! `addEventStream`, `addImuStream` and `addTriggerStream`, so DV tools open the result and list
+//! the streams with the camera name and resolution. The trigger stream is always declared, even
+//! when empty, as in DV's own recordings of a DVXplorer: a file's layout does not depend on
+//! whether the robot sent sync pulses.
 //!
 //! Packets are cut by content, not by how the caller slices its calls (at most
-//! [`EVENTS_PER_PACKET`] events or [`PACKET_SPAN_US`] of time per packet, likewise for IMU), so
-//! the same data gives the same bytes.
+//! [`EVENTS_PER_PACKET`] events or [`PACKET_SPAN_US`] of time per packet, likewise for IMU and
+//! triggers), so the same data gives the same bytes.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
@@ -16,18 +19,22 @@ use super::compression::Compressor;
 use super::error::{AedatError, Result};
 use super::header::{Compression, DeclaredStream, MAGIC, write_description};
 use super::schema::{self, DataTableEntry, FbEvent, ImuFields};
-use crate::{Event, ImuSample, Resolution};
+use crate::{Event, ImuSample, Resolution, Trigger};
 
 /// Most events per packet (DV cameras send packets of a few thousand events).
 pub const EVENTS_PER_PACKET: usize = 4096;
 /// Most IMU samples per packet.
 pub const IMU_PER_PACKET: usize = 64;
+/// Most triggers per packet.
+pub const TRIGGERS_PER_PACKET: usize = 64;
 /// Longest time a packet spans, in microseconds.
 pub const PACKET_SPAN_US: i64 = 10_000;
 
-/// Stream ids, as `MonoCameraWriter` numbers an events + IMU configuration.
+/// Stream ids, as `MonoCameraWriter` numbers an events + IMU + triggers configuration (what DV
+/// records from a DVXplorer).
 const EVENT_STREAM: i32 = 0;
 const IMU_STREAM: i32 = 1;
+const TRIGGER_STREAM: i32 = 2;
 
 /// How to write a file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -95,9 +102,11 @@ pub struct AedatWriter<W: Write> {
     offset: u64,
     events: Vec<FbEvent>,
     imu: Vec<(i64, ImuFields)>,
+    triggers: Vec<(i64, i8)>,
     /// Last timestamps written (or buffered), to reject time going backwards.
     last_event_t: i64,
     last_imu_t: i64,
+    last_trigger_t: i64,
     /// Timestamp of the first buffered event.
     packet_start_t: i64,
     /// How to rewrite the header at the end (seekable outputs only).
@@ -111,6 +120,7 @@ pub struct AedatWriter<W: Write> {
     /// Elements accepted so far, for error messages.
     event_count: u64,
     imu_count: u64,
+    trigger_count: u64,
 }
 
 impl AedatWriter<BufWriter<File>> {
@@ -153,8 +163,10 @@ impl<W: Write> AedatWriter<W> {
             offset: 0,
             events: Vec::with_capacity(EVENTS_PER_PACKET),
             imu: Vec::with_capacity(IMU_PER_PACKET),
+            triggers: Vec::with_capacity(TRIGGERS_PER_PACKET),
             last_event_t: i64::MIN,
             last_imu_t: i64::MIN,
+            last_trigger_t: i64::MIN,
             packet_start_t: 0,
             patch,
             table: Vec::new(),
@@ -162,6 +174,7 @@ impl<W: Write> AedatWriter<W> {
             header_len: 0,
             event_count: 0,
             imu_count: 0,
+            trigger_count: 0,
             config,
         };
         let description = write_description(
@@ -178,6 +191,13 @@ impl<W: Write> AedatWriter<W> {
                     output_name: "imu",
                     type_identifier: "IMUS",
                     type_description: "Inertial Measurement Unit data samples.",
+                    resolution: None,
+                },
+                DeclaredStream {
+                    id: TRIGGER_STREAM,
+                    output_name: "triggers",
+                    type_identifier: "TRIG",
+                    type_description: "External triggers and special signals.",
                     resolution: None,
                 },
             ],
@@ -289,6 +309,32 @@ impl<W: Write> AedatWriter<W> {
         Ok(())
     }
 
+    /// Appends triggers (timestamps must not decrease). `kind` is stored as the `TriggerType`
+    /// code unchanged (dv-processing's `TriggerType` enum: 0 `TIMESTAMP_RESET` .. 9
+    /// `APS_EXPOSURE_END`).
+    pub fn write_triggers(&mut self, triggers: &[Trigger]) -> Result<()> {
+        for tr in triggers {
+            if tr.t < self.last_trigger_t {
+                return Err(AedatError::InvalidInput {
+                    what: format!("trigger {}", self.trigger_count),
+                    reason: format!("timestamp {} after {}", tr.t, self.last_trigger_t),
+                });
+            }
+            if self.triggers.len() >= TRIGGERS_PER_PACKET
+                || self
+                    .triggers
+                    .first()
+                    .is_some_and(|f| tr.t.saturating_sub(f.0) >= PACKET_SPAN_US)
+            {
+                self.flush_triggers()?;
+            }
+            self.last_trigger_t = tr.t;
+            self.trigger_count += 1;
+            self.triggers.push((tr.t, tr.kind));
+        }
+        Ok(())
+    }
+
     fn flush_events(&mut self) -> Result<()> {
         if self.events.is_empty() {
             return Ok(());
@@ -318,6 +364,18 @@ impl<W: Write> AedatWriter<W> {
         let n = self.imu.len();
         self.imu.clear();
         self.write_packet(IMU_STREAM, n, span)
+    }
+
+    fn flush_triggers(&mut self) -> Result<()> {
+        let (Some(first), Some(last)) = (self.triggers.first(), self.triggers.last()) else {
+            return Ok(());
+        };
+        let span = (first.0, last.0);
+        self.fbb.reset();
+        schema::build_trigger_packet(&mut self.fbb, &self.triggers);
+        let n = self.triggers.len();
+        self.triggers.clear();
+        self.write_packet(TRIGGER_STREAM, n, span)
     }
 
     /// Compresses the finished flatbuffer in `fbb` and writes it with its packet header.
@@ -390,6 +448,7 @@ impl<W: Write> AedatWriter<W> {
     pub fn finish(mut self) -> Result<W> {
         self.flush_events()?;
         self.flush_imu()?;
+        self.flush_triggers()?;
         if let Some(patch) = self.patch {
             self.write_data_table(patch)?;
         }
