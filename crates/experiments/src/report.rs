@@ -69,10 +69,59 @@ fn paper(v: (f64, f64)) -> String {
     format!("{:.3} ± {:.3}", v.0, v.1)
 }
 
-fn exp3_table(md: &mut String, points: &[Exp3Point], unit: &str) {
+/// One sentence on an Experiment 3 axis's design: the seen and unseen levels of `axis` (e.g.
+/// `speed`) in `unit`, and how far each unseen level is from the nearest seen one, against the
+/// paper's `paper_gap` (1 deg/s, 0.25 mm).
+fn exp3_design(values: &[(f64, bool)], axis: &str, unit: &str, paper_gap: f64) -> String {
+    let list = |seen: bool| {
+        let v: Vec<String> = values
+            .iter()
+            .filter(|&&(_, s)| s == seen)
+            .map(|(v, _)| v.to_string())
+            .collect();
+        if v.is_empty() {
+            "none".into()
+        } else {
+            v.join(", ")
+        }
+    };
+    let nearest_seen = |v: f64| {
+        values
+            .iter()
+            .filter(|&&(_, seen)| seen)
+            .map(|&(s, _)| (s - v).abs())
+            .min_by(f64::total_cmp)
+    };
+    let widest = values
+        .iter()
+        .filter(|&&(_, seen)| !seen)
+        .filter_map(|&(v, _)| nearest_seen(v))
+        .fold(None, |m: Option<f64>, g| Some(m.map_or(g, |m| m.max(g))));
+    let spacing = match widest {
+        None => String::new(),
+        Some(w) if (w - paper_gap).abs() < 1e-9 => {
+            format!(" Each unseen {axis} is {w} {unit} from the nearest seen one, as in the paper.")
+        }
+        Some(w) => format!(
+            " Unseen {axis}s are up to {w} {unit} from the nearest seen one (the paper: \
+             {paper_gap} {unit}), so interpolation here is {} than in the paper.",
+            if w > paper_gap { "harder" } else { "easier" }
+        ),
+    };
+    format!(
+        "Seen {axis}s (in the training set, {unit}): {}; unseen: {}.{spacing}",
+        list(true),
+        list(false)
+    )
+}
+
+/// An Experiment 3 table, after the sentence on its design.
+fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str), paper_gap: f64) {
     let mut values: Vec<(f64, bool)> = points.iter().map(|p| (p.value, p.seen)).collect();
     values.sort_by(|a, b| a.0.total_cmp(&b.0));
     values.dedup_by(|a, b| a.0 == b.0);
+    let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit, paper_gap));
+    let unit = format!("{axis} ({unit})");
     let _ = writeln!(
         md,
         "| {unit} | seen | trials | Static | Dynamic | Combined |"
@@ -259,11 +308,11 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(md, "Not run: no speed-wise or depth-wise dataset.\n");
     } else {
         if !r.exp3_speed.is_empty() {
-            exp3_table(&mut md, &r.exp3_speed, "speed (deg/s)");
+            exp3_table(&mut md, &r.exp3_speed, ("speed", "deg/s"), 1.0);
             let _ = writeln!(md);
         }
         if !r.exp3_depth.is_empty() {
-            exp3_table(&mut md, &r.exp3_depth, "depth (mm)");
+            exp3_table(&mut md, &r.exp3_depth, ("depth", "mm"), 0.25);
             let _ = writeln!(md);
         }
     }
@@ -361,4 +410,31 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
 /// Statistics shown for a representation in Experiment 1, if present.
 pub fn exp1_stats<'a>(r: &'a Results, name: &str) -> Option<&'a MaeStats> {
     r.exp1.iter().find(|e| e.name == name).map(|e| &e.test)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_exp3_design_sentence_compares_the_spacing_with_the_paper() {
+        let paper = [
+            (2.0, true),
+            (3.0, false),
+            (4.0, true),
+            (5.0, false),
+            (6.0, true),
+        ];
+        let s = exp3_design(&paper, "speed", "deg/s", 1.0);
+        assert!(s.starts_with("Seen speeds (in the training set, deg/s): 2, 4, 6; unseen: 3, 5."));
+        assert!(
+            s.ends_with("1 deg/s from the nearest seen one, as in the paper."),
+            "{s}"
+        );
+        let coarse = [(1.0, true), (1.5, false), (2.0, true)];
+        let s = exp3_design(&coarse, "depth", "mm", 0.25);
+        assert!(s.contains("up to 0.5 mm") && s.contains("harder"), "{s}");
+        let none = [(1.0, true)];
+        assert!(exp3_design(&none, "depth", "mm", 0.25).ends_with("unseen: none."));
+    }
 }

@@ -112,6 +112,12 @@ impl Scale {
     }
 
     /// The levels and trial counts of this scale.
+    ///
+    /// Every scale keeps the paper's Experiment 3 design: the unseen speeds lie halfway between
+    /// seen ones, 1 deg/s from the nearest (seen 2, 4, ..., 10; unseen 3, 5, ..., 9), and the
+    /// unseen depths 0.25 mm from the nearest (seen 1.0, 1.5, ..., 3.0; unseen the quarter
+    /// steps), so an unseen level is as far from training data as in the paper. Smaller scales
+    /// take fewer levels or directions, never a coarser spacing.
     pub fn design(self) -> Design {
         let directions = |n: usize| (0..n).map(|i| 360.0 * i as f64 / n as f64).collect();
         match self {
@@ -126,24 +132,27 @@ impl Scale {
                 exp3_depth_trials: 30,
                 no_contact_trials: 10,
             },
+            // The paper's speeds and depths in 5 directions (125 trials, about the 120 of 8
+            // directions x 3 depths before, whose unseen depths were 0.5 mm from a seen one).
             Scale::Small => Design {
-                directions: directions(8),
+                directions: directions(5),
                 speeds: vec![2.0, 4.0, 6.0, 8.0, 10.0],
-                depths: vec![1.0, 2.0, 3.0],
+                depths: vec![1.0, 1.5, 2.0, 2.5, 3.0],
                 repeats: 1,
                 exp3_speeds: (2..=10).map(f64::from).collect(),
-                exp3_depths: vec![1.0, 1.5, 2.0, 2.5, 3.0],
+                exp3_depths: (0..=8).map(|i| 1.0 + 0.25 * f64::from(i)).collect(),
                 exp3_speed_trials: 12,
-                exp3_depth_trials: 20,
+                exp3_depth_trials: 12,
                 no_contact_trials: 4,
             },
+            // Two neighbouring seen levels per axis and the unseen one between them.
             Scale::Tiny => Design {
                 directions: directions(4),
-                speeds: vec![5.0, 10.0],
-                depths: vec![1.5, 3.0],
+                speeds: vec![6.0, 8.0],
+                depths: vec![1.5, 2.0],
                 repeats: 1,
-                exp3_speeds: vec![5.0, 7.5, 10.0],
-                exp3_depths: vec![1.5, 2.25, 3.0],
+                exp3_speeds: vec![6.0, 7.0, 8.0],
+                exp3_depths: vec![1.5, 1.75, 2.0],
                 exp3_speed_trials: 4,
                 exp3_depth_trials: 4,
                 no_contact_trials: 2,
@@ -479,8 +488,39 @@ mod tests {
         assert_eq!(count(Protocol::Exp2, Scale::Paper), 1000);
         assert_eq!(count(Protocol::Exp3Speed, Scale::Paper), 270);
         assert_eq!(count(Protocol::Exp3Depth, Scale::Paper), 270);
-        assert_eq!(count(Protocol::Exp1, Scale::Small), 120);
+        assert_eq!(count(Protocol::Exp1, Scale::Small), 125);
         assert_eq!(count(Protocol::Exp1, Scale::Tiny), 16);
+    }
+
+    /// At every scale each unseen level of Experiment 3 lies between two seen ones, at the
+    /// paper's distance from the nearest: 1 deg/s, 0.25 mm.
+    #[test]
+    fn unseen_levels_are_at_the_paper_s_spacing_at_every_scale() {
+        let check = |seen: &[f64], all: &[f64], gap: f64, what: &str, scale: Scale| {
+            let unseen: Vec<f64> = all.iter().copied().filter(|v| !seen.contains(v)).collect();
+            assert!(!unseen.is_empty(), "{scale}: no unseen {what}");
+            for v in unseen {
+                let below = seen
+                    .iter()
+                    .copied()
+                    .filter(|&s| s < v)
+                    .fold(f64::NAN, f64::max);
+                let above = seen
+                    .iter()
+                    .copied()
+                    .filter(|&s| s > v)
+                    .fold(f64::NAN, f64::min);
+                assert!(
+                    (v - below - gap).abs() < 1e-9 && (above - v - gap).abs() < 1e-9,
+                    "{scale}: unseen {what} {v} is not {gap} from seen {below} and {above}"
+                );
+            }
+        };
+        for scale in Scale::ALL {
+            let d = scale.design();
+            check(&d.speeds, &d.exp3_speeds, 1.0, "speed", scale);
+            check(&d.depths, &d.exp3_depths, 0.25, "depth", scale);
+        }
     }
 
     #[test]
