@@ -257,26 +257,37 @@ fn time_range_of_the_real_recording_and_of_a_csv() {
 }
 
 #[test]
-fn time_range_without_a_data_table_warns_once_and_gives_the_same_result() {
+fn time_range_without_a_usable_data_table_warns_once_and_gives_the_same_result() {
     let dir = tempfile::tempdir().unwrap();
-    let (src, out) = (
+    let (missing, damaged, out) = (
         dir.path().join("notable.aedat4"),
+        dir.path().join("damaged.aedat4"),
         dir.path().join("cut.aedat4"),
     );
-    let original = with_triggers(&src, false);
+    let original = with_triggers(&missing, false);
+    // The same data with a table, whose LZ4 frame is then broken.
+    with_triggers(&damaged, true);
+    let mut bytes = std::fs::read(&damaged).unwrap();
+    let table = evtac_events::aedat::AedatReader::from_slice(&bytes)
+        .unwrap()
+        .header()
+        .data_table_position
+        .unwrap() as usize;
+    bytes[table..table + 4].copy_from_slice(b"junk");
+    std::fs::write(&damaged, bytes).unwrap();
     let (from, to) = (
         original.events[0].t + 100_000,
         original.events[0].t + 200_000,
     );
-    let err = convert_range(&src, &out, from, to, &[]);
-    assert_eq!(err.matches("warning").count(), 1, "{err}");
-    assert!(
-        err.contains("notable.aedat4") && err.contains("no data table"),
-        "{err}"
-    );
     let expected = filtered(&original, from, to);
     assert_eq!(expected.triggers.len(), 10);
-    assert_eq!(read_recording(&out).unwrap(), expected);
+    for (src, why) in [(&missing, "no data table"), (&damaged, "is unusable")] {
+        let err = convert_range(src, &out, from, to, &[]);
+        assert_eq!(err.matches("warning").count(), 1, "{err}");
+        let name = src.file_name().unwrap().to_str().unwrap();
+        assert!(err.contains(name) && err.contains(why), "{err}");
+        assert_eq!(read_recording(&out).unwrap(), expected);
+    }
 }
 
 #[test]

@@ -73,11 +73,17 @@ pub(crate) fn has_identifier(buf: &[u8], identifier: &str) -> bool {
         && flatbuffers::buffer_has_identifier(buf, identifier, true)
 }
 
-/// Decodes `data` completely, as a file and as a network stream, discarding the results: the
-/// entry point of the `aedat` cargo-fuzz target. It must never panic, whatever the bytes.
+/// Decodes `data` completely, as a file (sequentially, and through its data table as a range
+/// read) and as a network stream, discarding the results: the entry point of the `aedat`
+/// cargo-fuzz target. It must never panic, whatever the bytes.
 #[doc(hidden)]
 pub fn fuzz_decode(data: &[u8]) {
     if let Ok(mut reader) = AedatReader::from_slice(data) {
+        while let Ok(Some(_)) = reader.next_chunk() {}
+    }
+    if let Ok(mut reader) = AedatReader::new(std::io::Cursor::new(data))
+        && reader.select_range(i64::MIN, i64::MAX).is_ok()
+    {
         while let Ok(Some(_)) = reader.next_chunk() {}
     }
     if let Ok(mut reader) = AedatReader::network(data) {

@@ -1,7 +1,10 @@
 //! The whole-file API: format detection, `read_recording` on every fixture (the `EXPECTED.md`
 //! figures), writers by extension.
 
-use evtac_events::{Error, EventWriter, Format, ImuSample, Resolution, open, read_recording};
+use evtac_events::{
+    Error, EventWriter, Format, ImuSample, RangeIndex, Resolution, open, read_recording,
+    read_recording_range,
+};
 use evtac_testkit::real_fixture;
 
 use crate::common::synthetic_events;
@@ -146,4 +149,79 @@ fn unknown_empty_and_unwritable_files_are_named_errors() {
         EventWriter::create(dir.path().join("x.aedat4"), None, None),
         Err(Error::MissingResolution { .. })
     ));
+}
+
+/// `recording` with only what lies in `[from, to)`.
+fn cut(recording: &evtac_events::Recording, from: i64, to: i64) -> evtac_events::Recording {
+    let inside = |t: i64| from <= t && t < to;
+    evtac_events::Recording {
+        events: recording
+            .events
+            .iter()
+            .copied()
+            .filter(|e| inside(e.t))
+            .collect(),
+        imu: recording
+            .imu
+            .iter()
+            .copied()
+            .filter(|s| inside(s.t))
+            .collect(),
+        triggers: recording
+            .triggers
+            .iter()
+            .copied()
+            .filter(|t| inside(t.t))
+            .collect(),
+        ..recording.clone()
+    }
+}
+
+#[test]
+fn time_ranges_of_every_fixture_equal_the_filtered_whole() {
+    for (name, indexed) in [
+        ("dvxplorer_320x240_imu.aedat4", true),
+        ("prophesee_gen3_640x480.evt2.raw", false),
+    ] {
+        let Some(path) = real_fixture(name) else {
+            return;
+        };
+        let whole = read_recording(&path).unwrap();
+        let (first, last) = (whole.events[0].t, whole.events.last().unwrap().t);
+        let mid = first + (last - first) / 3;
+        for (from, to) in [(mid, mid + 20_000), (i64::MIN, first + 1), (last, i64::MAX)] {
+            let (part, how) = read_recording_range(&path, from, to).unwrap();
+            assert_eq!(
+                matches!(how, RangeIndex::DataTable { .. }),
+                indexed,
+                "{name}: {how:?}"
+            );
+            assert_eq!(how.fallback(), None, "{name}");
+            assert!(part == cut(&whole, from, to), "{name}: [{from}, {to})");
+            assert!(!part.events.is_empty(), "{name}: [{from}, {to})");
+        }
+    }
+}
+
+#[test]
+fn empty_time_range_names_the_file() {
+    let Some(path) = real_fixture("prophesee_gen3_640x480.evt2.raw") else {
+        return;
+    };
+    let err = read_recording_range(&path, 10, 5).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::EmptyRange {
+                from: 10,
+                to: 5,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(
+        err.to_string().contains("prophesee_gen3_640x480.evt2.raw"),
+        "{err}"
+    );
 }
