@@ -3,6 +3,7 @@
 //! as mean ± std over seeds.
 
 use crate::cache::FeatureCache;
+use crate::context::RunContext;
 use crate::jobs::{self, Progress};
 use crate::plan::Plan;
 use crate::results::{Exp1Repr, Mae, MaeStats};
@@ -130,11 +131,14 @@ pub fn run(
     cache: &FeatureCache<'_>,
     splits: &Splits,
     reprs: &[(&'static str, ReprConfig)],
-    plan: &Plan,
-    seed: u64,
-    out: &Path,
-    progress: &dyn Progress,
+    run: &RunContext<'_>,
 ) -> Result<Vec<Exp1Repr>, Error> {
+    let RunContext {
+        plan,
+        seed,
+        models: out,
+        progress,
+    } = *run;
     let jobs = jobs(reprs, plan, seed, out);
     let stages = (FeatureSet::Exp1, Stage::Exp1Training);
     features_then_training(

@@ -4,8 +4,8 @@
 //! motion-phase samples of pause trials) and `pause-motion-stop` (motion and stop samples).
 
 use crate::cache::FeatureCache;
+use crate::context::RunContext;
 use crate::exp1::{self, SeedJob};
-use crate::jobs::Progress;
 use crate::plan::Plan;
 use crate::results::{Exp2Cell, MaeStats};
 use crate::sampling::{Phase, Sampling};
@@ -68,11 +68,14 @@ pub fn run(
     cache: &FeatureCache<'_>,
     splits: &Splits,
     reprs: &[(&'static str, ReprConfig)],
-    plan: &Plan,
-    seed: u64,
-    out: &Path,
-    progress: &dyn Progress,
+    run: &RunContext<'_>,
 ) -> Result<Vec<Exp2Cell>, Error> {
+    let RunContext {
+        plan,
+        seed,
+        models: out,
+        progress,
+    } = *run;
     let jobs = jobs(reprs, plan, seed, out);
     let stages = (FeatureSet::Exp2, Stage::Exp2Training);
     let sampling = Sampling::WITH_STOP;

@@ -7,6 +7,7 @@
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
 //!   computed in one pass for many configs, reused.
+//! - [`context`]: the plan, seed, model folder and progress an experiment run shares.
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
@@ -29,6 +30,7 @@
 //! ```
 
 pub mod cache;
+pub mod context;
 pub mod dataset;
 pub mod examples;
 pub mod exp1;

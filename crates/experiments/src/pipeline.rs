@@ -3,6 +3,7 @@
 //! that are ready to run as `evtac train` command lines for an external scheduler.
 
 use crate::cache::FeatureCache;
+use crate::context::RunContext;
 use crate::dataset::{self, Dataset};
 use crate::exp3::Axis;
 use crate::jobs::{self, Progress};
@@ -156,29 +157,19 @@ pub fn reproduce(
     let cache1 = FeatureCache::new(&ds1)?;
     let mut datasets = vec![("exp1".to_string(), ds1.manifest.trials.len())];
 
-    let st = tuning::tune(
-        &cache1,
-        &splits1,
+    let run = RunContext {
         plan,
-        Kind::Static,
         seed,
-        &models,
+        models: &models,
         progress,
-    )?;
+    };
+    let st = tuning::tune(&cache1, &splits1, Kind::Static, &run)?;
     stages.done("tuning (static)");
-    let dt = tuning::tune(
-        &cache1,
-        &splits1,
-        plan,
-        Kind::Dynamic,
-        seed,
-        &models,
-        progress,
-    )?;
+    let dt = tuning::tune(&cache1, &splits1, Kind::Dynamic, &run)?;
     stages.done("tuning (dynamic)");
     let reprs = exp1::representations(chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
 
-    let e1 = exp1::run(&cache1, &splits1, &reprs, plan, seed, &models, progress)?;
+    let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
     stages.done("experiment 1");
 
     let mut e2 = Vec::new();
@@ -188,7 +179,7 @@ pub fn reproduce(
         datasets.push(("exp2".into(), ds2.manifest.trials.len()));
         let splits2 = ds2.splits(seed)?;
         let cache2 = FeatureCache::new(&ds2)?;
-        e2 = exp2::run(&cache2, &splits2, &reprs, plan, seed, &models, progress)?;
+        e2 = exp2::run(&cache2, &splits2, &reprs, &run)?;
         // The example: the first test trial with a stop, with the motion + stop models.
         let test = ds2.trials(splits2.get(Split::Test))?;
         if let Some(meta) = test.iter().find(|t| t.stop_start_us.is_some()) {

@@ -72,9 +72,19 @@ fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     }
 }
 
-/// A white canvas of `size` pixels for the figure at `path`, the font registered: where every
-/// figure starts (it ends with `present()`).
-fn canvas(path: &Path, size: (u32, u32)) -> Result<DrawingArea<BitMapBackend<'_>, Shift>, Error> {
+/// A white canvas of `size` pixels for the figure at `path`, the font registered, or
+/// [`Error::Empty`] when there is no data to draw: where every figure starts (it ends with
+/// `present()`).
+fn canvas(
+    path: &Path,
+    size: (u32, u32),
+    has_data: bool,
+) -> Result<DrawingArea<BitMapBackend<'_>, Shift>, Error> {
+    if !has_data {
+        return Err(Error::Empty {
+            path: path.to_path_buf(),
+        });
+    }
     register_font()?;
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err(path))?;
@@ -219,13 +229,8 @@ fn tuning_panels(tuning: &[Tuning]) -> Vec<Curve> {
 /// threshold (dynamic), each with the other parameter at its chosen value.
 pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
     let panels = tuning_panels(tuning);
-    if panels.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
-    let root = canvas(path, (1200, 900))?;
+    let root = canvas(path, (1200, 900), !panels.is_empty())?;
     let areas = root.split_evenly((2, 2));
     for (area, c) in areas.iter().zip(&panels) {
         let xr = padded(c.points.iter().map(|p| p.0), false);
@@ -271,13 +276,8 @@ pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
 
 /// Motion- and stop-phase MAE (mean ± std over seeds) per representation and training setting.
 pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) -> Result<(), Error> {
-    if cells.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
-    let root = canvas(path, (1300, 520))?;
+    let root = canvas(path, (1300, 520), !cells.is_empty())?;
     let halves = root.split_evenly((1, 2));
     let names = ["Static", "Dynamic", "Combined"];
     for (pi, (area, phase)) in halves
@@ -367,13 +367,8 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
 /// An example pause trial: estimated and true pitch (left) and roll (right) over time, with the
 /// stop phase shaded.
 pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
-    if ex.t_s.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
-    let root = canvas(path, (1300, 520))?;
+    let root = canvas(path, (1300, 520), !ex.t_s.is_empty())?;
     let halves = root.split_evenly((1, 2));
     for (k, (area, what)) in halves.iter().zip(["Pitch", "Roll"]).enumerate() {
         let values = ex.truth.iter().map(|v| f64::from(v[k])).chain(
@@ -452,16 +447,15 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
 /// Contour overlays: in each panel the first condition's binary frame in red, the second's in
 /// orange, pixels set in both in white, on black (as the paper's figure).
 pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
-    if panels.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
     let cols = 2usize;
     let rows = panels.len().div_ceil(cols);
     let (cell_w, cell_h) = (540u32, 650u32);
-    let root = canvas(path, (cell_w * cols as u32, cell_h * rows as u32))?;
+    let root = canvas(
+        path,
+        (cell_w * cols as u32, cell_h * rows as u32),
+        !panels.is_empty(),
+    )?;
     let areas = root.split_evenly((rows, cols));
     let red = RGBColor(230, 30, 30);
     let orange = RGBColor(255, 165, 0);
@@ -527,13 +521,8 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
 /// Test MAE (mean ± std over the Experiment 1 models) against speed (left) and depth (right);
 /// unseen (interpolated) values drawn as hollow markers.
 pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Result<(), Error> {
-    if speed.is_empty() && depth.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
-    let root = canvas(path, (1300, 520))?;
+    let root = canvas(path, (1300, 520), !(speed.is_empty() && depth.is_empty()))?;
     let halves = root.split_evenly((1, 2));
     for (area, (points, desc)) in halves
         .iter()
@@ -636,13 +625,8 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// the 25th to the 75th percentile, the median, whiskers from min to max and the P99 as a
 /// diamond, on a log time axis, with the interval itself (dashed) and the paper's 10 ms bound.
 pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
-    if cells.is_empty() {
-        return Err(Error::Empty {
-            path: path.to_path_buf(),
-        });
-    }
     let e = draw_err(path);
-    let root = canvas(path, (1500, 520))?;
+    let root = canvas(path, (1500, 520), !cells.is_empty())?;
     let names = ["Static", "Dynamic", "Combined"];
     let areas = root.split_evenly((1, 3));
     let mut intervals: Vec<u32> = cells.iter().map(|c| c.interval_ms).collect();

@@ -3,7 +3,8 @@
 //! best validation epoch; the setting with the lowest validation MAE is chosen.
 
 use crate::cache::FeatureCache;
-use crate::jobs::{self, Progress};
+use crate::context::RunContext;
+use crate::jobs;
 use crate::plan::{self, Plan};
 use crate::results::{Mae, Tuning, TuningRun};
 use crate::sampling::{Phase, Sampling};
@@ -91,12 +92,15 @@ pub fn spec(config: ReprConfig, plan: &Plan, seed: u64) -> TrainSpec {
 pub fn tune(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    plan: &Plan,
     kind: Kind,
-    seed: u64,
-    out: &Path,
-    progress: &dyn Progress,
+    run: &RunContext<'_>,
 ) -> Result<Tuning, Error> {
+    let RunContext {
+        plan,
+        seed,
+        models: out,
+        progress,
+    } = *run;
     let points = grid(plan, kind);
     let ds = cache.dataset();
     let trials = ds.trials(&[splits.get(Split::Train), splits.get(Split::Val)].concat())?;

@@ -183,9 +183,22 @@ pub fn run_until<S: EventSource + 'static>(
                 estimate(estimator, msg_rx, pool_tx, out_tx, [stop, quit], busy_poll)
             });
         let mut connections = 0u32;
+        let mut deliver = |output: Output| {
+            if let Output::Notice(Notice::Connected { .. }) = &output {
+                connections += 1;
+            }
+            on_output(output)
+        };
         loop {
             if stop.load(Ordering::Relaxed) {
                 quit.store(true, Ordering::Relaxed);
+                // What the estimation thread has already made (it ends after its current
+                // chunk) is still delivered, so the summary counts what the caller was given.
+                while let Ok(output) = out_rx.recv() {
+                    if deliver(output).is_break() {
+                        break;
+                    }
+                }
                 break;
             }
             let output = match out_rx.recv_timeout(STOP_POLL) {
@@ -193,10 +206,7 @@ pub fn run_until<S: EventSource + 'static>(
                 Err(RecvTimeoutError::Timeout) => continue,
                 Err(RecvTimeoutError::Disconnected) => break,
             };
-            if let Output::Notice(Notice::Connected { .. }) = &output {
-                connections += 1;
-            }
-            if on_output(output).is_break() {
+            if deliver(output).is_break() {
                 quit.store(true, Ordering::Relaxed);
                 break;
             }

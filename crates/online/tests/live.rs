@@ -4,7 +4,7 @@
 
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_learn::Model;
-use evtac_online::input::{self, MemorySource, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::{Backoff, Estimate, Estimator, Notice};
 use std::io::{BufRead, BufReader, Write};
@@ -158,24 +158,6 @@ fn estimates_arrive_while_a_dv_network_writer_streams() {
         estimates.len()
     );
     // The same values as a replay of the same events.
-    let mut reference = Vec::new();
-    pipeline::run(
-        MemorySource::new(events.clone(), 4096),
-        Estimator::for_model(&model, SENSOR, 1000).unwrap(),
-        &PipelineConfig::default(),
-        |out| {
-            if let Output::Estimate(e) = out {
-                reference.push(e);
-            }
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
-    assert_eq!(estimates.len(), reference.len());
-    for ((e, _), r) in estimates.iter().zip(&reference) {
-        assert_eq!(
-            (e.t_us, e.pitch_deg.to_bits(), e.roll_deg.to_bits()),
-            (r.t_us, r.pitch_deg.to_bits(), r.roll_deg.to_bits())
-        );
-    }
+    let live: Vec<Estimate> = estimates.iter().map(|(e, _)| *e).collect();
+    support::assert_same_estimates(&live, &support::replayed(&model, &events, 4096));
 }

@@ -23,6 +23,16 @@ struct Stream {
     packets: Vec<Vec<u8>>,
 }
 
+impl Stream {
+    /// Sends the header and then `packets` on `connection`, as DV does to a new client.
+    fn send(&self, connection: &mut impl Write, packets: &[Vec<u8>]) {
+        connection.write_all(&self.header).unwrap();
+        for p in packets {
+            connection.write_all(p).unwrap();
+        }
+    }
+}
+
 fn network_stream(events: &[Event]) -> Stream {
     let config = WriterConfig {
         resolution: SENSOR,
@@ -100,35 +110,6 @@ fn run_tcp(
     (estimates, notices, summary)
 }
 
-/// Offline estimates of the same events, all in one chunk.
-fn reference(model: &Model, events: &[Event]) -> Vec<Estimate> {
-    let mut estimates = Vec::new();
-    let estimator = Estimator::for_model(model, SENSOR, 1000).unwrap();
-    pipeline::run(
-        MemorySource::new(events.to_vec(), usize::MAX),
-        estimator,
-        &PipelineConfig::default(),
-        |out| {
-            if let Output::Estimate(e) = out {
-                estimates.push(e);
-            }
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
-    estimates
-}
-
-fn same_values(a: &[Estimate], b: &[Estimate]) {
-    assert_eq!(a.len(), b.len(), "number of estimates");
-    for (x, y) in a.iter().zip(b) {
-        assert_eq!(
-            (x.t_us, x.pitch_deg.to_bits(), x.roll_deg.to_bits()),
-            (y.t_us, y.pitch_deg.to_bits(), y.roll_deg.to_bits())
-        );
-    }
-}
-
 #[test]
 fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
     let events = Synthetic::new(1, 300_000.0, 1000, 200_000).collect();
@@ -139,17 +120,11 @@ fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
     let server = std::thread::spawn(move || {
         // First connection: the first half of the packets, then the server hangs up.
         let (mut c, _) = listener.accept().unwrap();
-        c.write_all(&stream.header).unwrap();
-        for p in &stream.packets[..half] {
-            c.write_all(p).unwrap();
-        }
+        stream.send(&mut c, &stream.packets[..half]);
         drop(c);
         // The camera comes back: the second half, then the server goes away for good.
         let (mut c, _) = listener.accept().unwrap();
-        c.write_all(&stream.header).unwrap();
-        for p in &stream.packets[half..] {
-            c.write_all(p).unwrap();
-        }
+        stream.send(&mut c, &stream.packets[half..]);
     });
     let dir = tempfile::tempdir().unwrap();
     let model = model(dir.path());
@@ -169,7 +144,7 @@ fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
             .iter()
             .any(|n| matches!(n, Notice::GaveUp { attempts: 3, .. }))
     );
-    same_values(&estimates, &reference(&model, &events));
+    support::assert_same_estimates(&estimates, &support::replayed(&model, &events, usize::MAX));
 }
 
 #[test]
@@ -181,17 +156,11 @@ fn a_stalled_stream_is_reported_and_reopened() {
     let port = listener.local_addr().unwrap().port();
     let server = std::thread::spawn(move || {
         let (mut c, _) = listener.accept().unwrap();
-        c.write_all(&stream.header).unwrap();
-        for p in &stream.packets[..half] {
-            c.write_all(p).unwrap();
-        }
+        stream.send(&mut c, &stream.packets[..half]);
         // Silent, connection open: the client must give up on it and reconnect.
         let (mut c2, _) = listener.accept().unwrap();
         drop(c);
-        c2.write_all(&stream.header).unwrap();
-        for p in &stream.packets[half..] {
-            c2.write_all(p).unwrap();
-        }
+        stream.send(&mut c2, &stream.packets[half..]);
     });
     let dir = tempfile::tempdir().unwrap();
     let model = model(dir.path());
@@ -204,7 +173,7 @@ fn a_stalled_stream_is_reported_and_reopened() {
         "{notices:?}"
     );
     assert_eq!(summary.reconnects, 1);
-    same_values(&estimates, &reference(&model, &events));
+    support::assert_same_estimates(&estimates, &support::replayed(&model, &events, usize::MAX));
 }
 
 #[test]
@@ -258,6 +227,38 @@ fn break_after(source: impl EventSource + 'static, model: &Model, n: u64) -> Sum
     summary
 }
 
+/// A stop (Ctrl-C in `evtac online`) while estimates wait for a slow consumer: the estimates
+/// already made are still delivered, so the summary counts exactly what the caller was given
+/// (it used to count estimates that were dropped undelivered).
+#[test]
+fn a_stop_delivers_the_estimates_already_made() {
+    let events: Vec<Event> = Synthetic::new(4, 300_000.0, 1000, 200_000).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let stop = AtomicBool::new(false);
+    let mut delivered = 0u64;
+    let summary = pipeline::run_until(
+        MemorySource::new(events, 256),
+        Estimator::for_model(&model, SENSOR, 1000).unwrap(),
+        &PipelineConfig::default(),
+        &stop,
+        |out| {
+            if let Output::Estimate(_) = out {
+                delivered += 1;
+                if delivered == 1 {
+                    // A slow consumer: the estimator runs ahead meanwhile. Then stop.
+                    std::thread::sleep(Duration::from_millis(50));
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert!(summary.estimates > 1, "the estimator ran ahead: {summary}");
+    assert_eq!(summary.estimates, delivered);
+}
+
 #[test]
 fn stopping_early_and_dropping_when_behind() {
     let events: Vec<Event> = Synthetic::new(3, 300_000.0, 1000, 300_000).collect();
@@ -296,7 +297,10 @@ fn stopping_early_and_dropping_when_behind() {
             assert!(summary.events_dropped > 0 && notices > 0, "{summary}");
         } else {
             assert_eq!(summary.events_dropped, 0);
-            assert_eq!(summary.estimates, reference(&model, &events).len() as u64);
+            assert_eq!(
+                summary.estimates,
+                support::replayed(&model, &events, usize::MAX).len() as u64
+            );
         }
     }
 }
@@ -407,6 +411,6 @@ fn busy_polling_gives_the_same_estimates() {
         },
     )
     .unwrap();
-    same_values(&estimates, &reference(&model, &events));
+    support::assert_same_estimates(&estimates, &support::replayed(&model, &events, usize::MAX));
     assert_eq!(summary.estimates, estimates.len() as u64);
 }

@@ -266,6 +266,7 @@ fn random_mask(seed: u64) -> Mask {
 }
 
 /// A random stream with its sample times, mask and chunk boundaries, from the proptest inputs.
+#[derive(Debug)]
 struct Case {
     events: Vec<Event>,
     samples: Vec<i64>,
@@ -282,6 +283,14 @@ impl Case {
             cuts: random_batches(seed, events.len(), chunks),
             events,
         }
+    }
+
+    /// The proptest strategy: up to 600 events with gaps up to 40 us, up to 40 samples, up to
+    /// 30 chunks.
+    fn any() -> impl Strategy<Value = Case> {
+        (any::<u64>(), 0usize..600, 0i64..40, 1usize..40, 1usize..30).prop_map(
+            |(seed, n, max_gap, samples, chunks)| Case::new(seed, n, max_gap, samples, chunks),
+        )
     }
 
     fn reference(&self, configs: &[ReprConfig]) -> Outputs {
@@ -316,14 +325,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
     #[test]
-    fn extractor_matches_reference_for_any_chunking(
-        seed in any::<u64>(),
-        n in 0usize..600,
-        max_gap in 0i64..40,
-        samples in 1usize..40,
-        chunks in 1usize..30,
-    ) {
-        let case = Case::new(seed, n, max_gap, samples, chunks);
+    fn extractor_matches_reference_for_any_chunking(case in Case::any()) {
         let configs = configs();
         let got = case.streamed(&configs, &case.cuts, Feed::Push, false);
         check_outputs(&got, &case.reference(&configs))?;
@@ -338,14 +340,7 @@ proptest! {
     }
 
     #[test]
-    fn deferred_accumulation_matches_reference(
-        seed in any::<u64>(),
-        n in 0usize..600,
-        max_gap in 0i64..40,
-        samples in 1usize..40,
-        chunks in 1usize..30,
-    ) {
-        let case = Case::new(seed, n, max_gap, samples, chunks);
+    fn deferred_accumulation_matches_reference(case in Case::any()) {
         let configs = deferrable_configs();
         let expected = case.reference(&configs);
         for feed in [Feed::Push, Feed::PushThenPrepare, Feed::PushAndPrepare] {

@@ -458,12 +458,7 @@ mod tests {
     use super::*;
 
     fn quiet() -> DvsParams {
-        DvsParams {
-            leak_rate_hz: 0.0,
-            shot_noise_rate_hz: 0.0,
-            hot_pixels: 0,
-            ..DvsParams::default()
-        }
+        DvsParams::noiseless()
     }
 
     fn pin(x: f32) -> PinImage {

@@ -218,6 +218,19 @@ impl Default for DvsParams {
     }
 }
 
+impl DvsParams {
+    /// The default pixels without background activity (no leak or shot noise, no hot pixels):
+    /// the events a contact causes, and nothing else.
+    pub fn noiseless() -> Self {
+        Self {
+            leak_rate_hz: 0.0,
+            shot_noise_rate_hz: 0.0,
+            hot_pixels: 0,
+            ..Self::default()
+        }
+    }
+}
+
 /// The IMU: gyroscope and accelerometer with the usual error terms.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]

@@ -295,12 +295,7 @@ mod tests {
 
     fn quiet_sim() -> Simulator {
         let params = SimParams {
-            dvs: DvsParams {
-                leak_rate_hz: 0.0,
-                shot_noise_rate_hz: 0.0,
-                hot_pixels: 0,
-                ..DvsParams::default()
-            },
+            dvs: DvsParams::noiseless(),
             ..SimParams::default()
         };
         Simulator::new(params, 1)

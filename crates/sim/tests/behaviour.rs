@@ -9,12 +9,7 @@ use evtac_sim::{Protocol, Scale, SimParams, Simulator, TrialRecording, TrialSpec
 /// keep the tests fast.
 fn quiet() -> Simulator {
     let mut params = SimParams {
-        dvs: DvsParams {
-            leak_rate_hz: 0.0,
-            shot_noise_rate_hz: 0.0,
-            hot_pixels: 0,
-            ..DvsParams::default()
-        },
+        dvs: DvsParams::noiseless(),
         ..SimParams::default()
     };
     params.timeline.total_deg = 10.0;

@@ -3,6 +3,7 @@
 
 use anyhow::Context;
 use evtac_experiments::cache::FeatureCache;
+use evtac_experiments::context::RunContext;
 use evtac_experiments::dataset::Dataset;
 use evtac_experiments::plan::Plan;
 use evtac_experiments::tuning::{self, Kind};
@@ -63,7 +64,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cache = FeatureCache::new(&ds)?;
     let pool = args.workers.pool()?;
     let bars = crate::progress::Bars::default();
-    let t = pool.install(|| tuning::tune(&cache, &splits, &plan, kind, args.seed, &out, &bars))?;
+    let run = RunContext {
+        plan: &plan,
+        seed: args.seed,
+        models: &out,
+        progress: &bars,
+    };
+    let t = pool.install(|| tuning::tune(&cache, &splits, kind, &run))?;
     bars.finish();
     let json_path = out.join(format!("tuning-{}.json", kind.name()));
     std::fs::write(&json_path, serde_json::to_string_pretty(&t)?)

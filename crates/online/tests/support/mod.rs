@@ -4,12 +4,14 @@
 #![allow(dead_code)]
 
 use evtac_events::{Event, Resolution};
-use evtac_learn::{ModelBundle, Representation};
-use evtac_online::Notice;
-use evtac_online::input::{ChunkInfo, EventSource, InputError};
+use evtac_learn::{Model, ModelBundle, Representation};
+use evtac_online::input::{ChunkInfo, EventSource, InputError, MemorySource};
+use evtac_online::pipeline::{self, Output, PipelineConfig};
+use evtac_online::{Estimate, Estimator, Notice};
 use evtac_repr::{DynamicConfig, Mask, ReprConfig, StaticConfig};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 /// The simulated sensor (DVXplorer).
@@ -30,6 +32,37 @@ pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<Mask
     ModelBundle::untrained(seed, Representation::new(*repr), mask)
         .save(dir)
         .expect("the bundle is saved");
+}
+
+/// The estimates of `events` replayed from memory in chunks of `chunk_len` events: what a live,
+/// interrupted or reconnected run over the same events must give.
+pub fn replayed(model: &Model, events: &[Event], chunk_len: usize) -> Vec<Estimate> {
+    let mut estimates = Vec::new();
+    pipeline::run(
+        MemorySource::new(events.to_vec(), chunk_len),
+        Estimator::for_model(model, SENSOR, 1000).unwrap(),
+        &PipelineConfig::default(),
+        |out| {
+            if let Output::Estimate(e) = out {
+                estimates.push(e);
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    estimates
+}
+
+/// Asserts that two runs made the same estimates: the same times and the same values, bit for
+/// bit (latencies differ).
+pub fn assert_same_estimates(a: &[Estimate], b: &[Estimate]) {
+    assert_eq!(a.len(), b.len(), "number of estimates");
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(
+            (x.t_us, x.pitch_deg.to_bits(), x.roll_deg.to_bits()),
+            (y.t_us, y.pitch_deg.to_bits(), y.roll_deg.to_bits())
+        );
+    }
 }
 
 /// An endless, seeded stream of events at `rate` events per second of event time, shaped like
