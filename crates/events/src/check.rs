@@ -40,6 +40,16 @@ pub enum CheckError {
     },
 }
 
+impl CheckError {
+    /// Zero-based index in the file of the event the error is about (readers turn it into a
+    /// byte offset or line number).
+    pub fn index(&self) -> u64 {
+        match *self {
+            Self::OutOfBounds { index, .. } | Self::TimeBackwards { index, .. } => index,
+        }
+    }
+}
+
 /// Running validation state over a stream of event chunks.
 #[derive(Debug, Clone, Default)]
 pub struct EventCheck {
