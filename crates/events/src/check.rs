@@ -50,6 +50,41 @@ impl CheckError {
     }
 }
 
+/// What validating a chunk needs besides its first and last timestamps: the largest
+/// coordinates and whether the timestamps never decrease within it. A reader may gather it while
+/// decoding (see [`EventCheck::check_summarized`]) to spare a second pass over the events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ChunkSummary {
+    /// Largest `x` of the chunk.
+    pub max_x: u16,
+    /// Largest `y` of the chunk.
+    pub max_y: u16,
+    /// Whether every timestamp is at least the one before it (within the chunk).
+    pub ordered: bool,
+}
+
+impl ChunkSummary {
+    /// The summary of no events.
+    pub const EMPTY: Self = Self {
+        max_x: 0,
+        max_y: 0,
+        ordered: true,
+    };
+
+    /// Computes the summary of `events` (branch-free reductions the compiler vectorises).
+    fn of(events: &[Event]) -> Self {
+        let mut summary = Self::EMPTY;
+        let mut previous = events.first().map_or(0, |e| e.t);
+        for e in events {
+            summary.max_x = summary.max_x.max(e.x);
+            summary.max_y = summary.max_y.max(e.y);
+            summary.ordered &= e.t >= previous;
+            previous = e.t;
+        }
+        summary
+    }
+}
+
 /// Running validation state over a stream of event chunks.
 #[derive(Debug, Clone, Default)]
 pub struct EventCheck {
@@ -86,29 +121,28 @@ impl EventCheck {
 
     /// Validates the next chunk of the stream.
     pub fn check(&mut self, events: &[Event]) -> Result<(), CheckError> {
-        let Some(first) = events.first() else {
+        self.check_summarized(events, ChunkSummary::of(events))
+    }
+
+    /// Validates the next chunk given its `summary`, which the caller computed from exactly
+    /// these events.
+    pub(crate) fn check_summarized(
+        &mut self,
+        events: &[Event],
+        summary: ChunkSummary,
+    ) -> Result<(), CheckError> {
+        let (Some(first), Some(last)) = (events.first(), events.last()) else {
             return Ok(());
         };
-        // Branch-free reductions over the chunk; the slow search below only runs on failure.
-        let mut max_x = 0u16;
-        let mut max_y = 0u16;
-        let mut ordered = true;
-        let mut previous = self.last_t.unwrap_or(first.t).min(first.t);
-        for e in events {
-            max_x = max_x.max(e.x);
-            max_y = max_y.max(e.y);
-            ordered &= e.t >= previous;
-            previous = e.t;
-        }
         let in_bounds = self
             .resolution
-            .is_none_or(|r| max_x < r.width && max_y < r.height);
-        let in_order = ordered && self.last_t.is_none_or(|t| first.t >= t);
+            .is_none_or(|r| summary.max_x < r.width && summary.max_y < r.height);
+        let in_order = summary.ordered && self.last_t.is_none_or(|t| first.t >= t);
         if !(in_bounds && in_order) {
             return Err(self.locate(events));
         }
         self.count += events.len() as u64;
-        self.last_t = Some(previous);
+        self.last_t = Some(last.t);
         Ok(())
     }
 
