@@ -50,15 +50,14 @@ impl CheckError {
     }
 }
 
-/// What validating a chunk needs besides its first and last timestamps: the largest
-/// coordinates and whether the timestamps never decrease within it. A reader may gather it while
-/// decoding (see [`EventCheck::check_summarized`]) to spare a second pass over the events.
+/// What validating a chunk needs besides its first and last timestamps: whether its events lie
+/// inside the resolution checked against, and whether their timestamps never decrease within
+/// it. A reader may gather it while decoding (see [`EventCheck::check_summarized`]) to spare a
+/// second pass over the events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct ChunkSummary {
-    /// Largest `x` of the chunk.
-    pub max_x: u16,
-    /// Largest `y` of the chunk.
-    pub max_y: u16,
+    /// Whether every event lies inside the resolution (`true` when there is none).
+    pub in_bounds: bool,
     /// Whether every timestamp is at least the one before it (within the chunk).
     pub ordered: bool,
 }
@@ -66,22 +65,26 @@ pub(crate) struct ChunkSummary {
 impl ChunkSummary {
     /// The summary of no events.
     pub const EMPTY: Self = Self {
-        max_x: 0,
-        max_y: 0,
+        in_bounds: true,
         ordered: true,
     };
 
-    /// Computes the summary of `events` (branch-free reductions the compiler vectorises).
-    fn of(events: &[Event]) -> Self {
-        let mut summary = Self::EMPTY;
+    /// Computes the summary of `events` against `resolution` (branch-free reductions the
+    /// compiler vectorises).
+    fn of(events: &[Event], resolution: Option<Resolution>) -> Self {
+        let (mut max_x, mut max_y) = (0u16, 0u16);
+        let mut ordered = true;
         let mut previous = events.first().map_or(0, |e| e.t);
         for e in events {
-            summary.max_x = summary.max_x.max(e.x);
-            summary.max_y = summary.max_y.max(e.y);
-            summary.ordered &= e.t >= previous;
+            max_x = max_x.max(e.x);
+            max_y = max_y.max(e.y);
+            ordered &= e.t >= previous;
             previous = e.t;
         }
-        summary
+        Self {
+            in_bounds: resolution.is_none_or(|r| max_x < r.width && max_y < r.height),
+            ordered,
+        }
     }
 }
 
@@ -121,11 +124,11 @@ impl EventCheck {
 
     /// Validates the next chunk of the stream.
     pub fn check(&mut self, events: &[Event]) -> Result<(), CheckError> {
-        self.check_summarized(events, ChunkSummary::of(events))
+        self.check_summarized(events, ChunkSummary::of(events, self.resolution))
     }
 
     /// Validates the next chunk given its `summary`, which the caller computed from exactly
-    /// these events.
+    /// these events and against [`resolution`](Self::resolution).
     pub(crate) fn check_summarized(
         &mut self,
         events: &[Event],
@@ -134,11 +137,8 @@ impl EventCheck {
         let (Some(first), Some(last)) = (events.first(), events.last()) else {
             return Ok(());
         };
-        let in_bounds = self
-            .resolution
-            .is_none_or(|r| summary.max_x < r.width && summary.max_y < r.height);
         let in_order = summary.ordered && self.last_t.is_none_or(|t| first.t >= t);
-        if !(in_bounds && in_order) {
+        if !(summary.in_bounds && in_order) {
             return Err(self.locate(events));
         }
         self.count += events.len() as u64;

@@ -7,7 +7,7 @@
 //! `id` bits 8..12, `ts` at 22). Other types carry nothing evtac uses.
 
 use crate::check::ChunkSummary;
-use crate::{Event, Trigger};
+use crate::{Event, Resolution, Trigger};
 
 /// Bits of the timestamp carried by CD and trigger words.
 const LSB_BITS: u32 = 6;
@@ -38,7 +38,7 @@ pub(crate) struct Evt2Decoder {
 impl Evt2Decoder {
     /// Decodes whole words from `bytes` (a multiple of 4 bytes long), appending to the outputs;
     /// returns what [`EventCheck`](crate::check::EventCheck) needs to validate the events
-    /// appended, gathered on the way so that they need no second pass.
+    /// appended against `resolution`, gathered on the way so that they need no second pass.
     ///
     /// Nearly every word of a recording is a CD event, so the loop writes an event for every
     /// word into the spare capacity and keeps it (advances the count) only for CD words; the
@@ -49,6 +49,7 @@ impl Evt2Decoder {
         bytes: &[u8],
         events: &mut Vec<Event>,
         triggers: &mut Vec<Trigger>,
+        resolution: Option<Resolution>,
     ) -> ChunkSummary {
         let (mut words, _) = bytes.as_chunks::<4>();
         if !self.base_time_set {
@@ -66,9 +67,15 @@ impl Evt2Decoder {
         events.reserve(words.len());
         let spare = &mut events.spare_capacity_mut()[..words.len()];
         let mut kept = 0;
-        // The time high and the summary live in registers for the loop.
+        // The time high and the summary live in registers for the loop. An event is inside
+        // when `x - width` and `y - height` are both negative: their sign bits, and-ed over the
+        // chunk, are one register (a running maximum of x and y took two, and spilled).
+        let (width, height) = resolution.map_or((1 << 16, 1 << 16), |r| {
+            (i32::from(r.width), i32::from(r.height))
+        });
         let mut base = self.base_time;
-        let mut summary = ChunkSummary::EMPTY;
+        let mut inside = -1i32;
+        let mut ordered = true;
         let mut last = i64::MIN;
         for w in words {
             let word = u32::from_le_bytes(*w);
@@ -84,10 +91,9 @@ impl Evt2Decoder {
                 polarity: kind == 1,
             });
             if kind < 2 {
-                summary.ordered &= t >= last;
+                ordered &= t >= last;
                 last = t;
-                summary.max_x = summary.max_x.max(x);
-                summary.max_y = summary.max_y.max(y);
+                inside &= (i32::from(x) - width) & (i32::from(y) - height);
                 kept += 1;
             } else if kind == 0x8 {
                 base = self.time_high(word, base);
@@ -106,7 +112,10 @@ impl Evt2Decoder {
         // SAFETY: `spare[..kept]` was initialised above (each `kept += 1` follows the write of
         // `spare[kept]`), and `reserve` made room for `words.len() >= kept` events after `start`.
         unsafe { events.set_len(start + kept) };
-        summary
+        ChunkSummary {
+            in_bounds: inside < 0,
+            ordered,
+        }
     }
 
     /// The new time high (us, wraps included) after a TIME_HIGH word, `base` being the current
@@ -141,7 +150,7 @@ mod tests {
             0xA000_0001 | 3 << 22,
         ]);
         let (mut events, mut triggers) = (Vec::new(), Vec::new());
-        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers);
+        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers, None);
         assert_eq!(
             events,
             vec![
@@ -169,10 +178,32 @@ mod tests {
     }
 
     #[test]
+    fn the_summary_sees_the_last_pixel_inside_and_the_first_outside() {
+        let cd = |ts: u32, x: u32, y: u32| ts << 22 | x << 11 | y;
+        let summary = |ws: &[u32], resolution| {
+            let (mut events, mut triggers) = (Vec::new(), Vec::new());
+            Evt2Decoder::default().decode(&words(ws), &mut events, &mut triggers, resolution)
+        };
+        let r = Some(Resolution::new(640, 480));
+        let inside = summary(&[0x8000_0001, cd(0, 639, 479), cd(1, 0, 0)], r);
+        assert_eq!(inside, ChunkSummary::EMPTY);
+        for (x, y) in [(640, 0), (0, 480), (2047, 2047)] {
+            let outside = summary(&[0x8000_0001, cd(0, 1, 1), cd(1, x, y)], r);
+            assert!(!outside.in_bounds && outside.ordered, "({x}, {y})");
+            assert!(summary(&[0x8000_0001, cd(1, x, y)], None).in_bounds);
+        }
+        let back = summary(&[0x8000_0001, cd(5, 1, 1), cd(4, 1, 1)], r);
+        assert!(back.in_bounds && !back.ordered);
+        // A time high going back, not far enough to be a wrap.
+        let back = summary(&[0x8000_0002, cd(0, 1, 1), 0x8000_0001, cd(63, 1, 1)], r);
+        assert!(!back.ordered);
+    }
+
+    #[test]
     fn time_high_wrap_continues_the_clock() {
         let bytes = words(&[0x8FFF_FFFF, 1 << 22, 0x8000_0000, 1 << 22]);
         let (mut events, mut triggers) = (Vec::new(), Vec::new());
-        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers);
+        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers, None);
         assert_eq!(events[0].t, MAX_TIMESTAMP + 1);
         assert_eq!(events[1].t, TIME_LOOP + 1);
     }

@@ -252,8 +252,11 @@ impl<R: Read> EvtReader<R> {
                 let bytes = &self.buf[self.start..self.start + whole];
                 // `events` is empty before each decode (the loop goes round again only when
                 // nothing was decoded), so an EVT2 summary covers every event checked.
+                let resolution = self.check.resolution();
                 let summary = match &mut self.decoder {
-                    Decoder::Evt2(d) => Some(d.decode(bytes, &mut self.events, &mut self.triggers)),
+                    Decoder::Evt2(d) => {
+                        Some(d.decode(bytes, &mut self.events, &mut self.triggers, resolution))
+                    }
                     Decoder::Evt3(d) => {
                         d.decode(bytes, &mut self.events, &mut self.triggers);
                         None
