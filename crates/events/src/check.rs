@@ -40,6 +40,54 @@ pub enum CheckError {
     },
 }
 
+impl CheckError {
+    /// Zero-based index in the file of the event the error is about (readers turn it into a
+    /// byte offset or line number).
+    pub fn index(&self) -> u64 {
+        match *self {
+            Self::OutOfBounds { index, .. } | Self::TimeBackwards { index, .. } => index,
+        }
+    }
+}
+
+/// What validating a chunk needs besides its first and last timestamps: whether its events lie
+/// inside the resolution checked against, and whether their timestamps never decrease within
+/// it. A reader may gather it while decoding (see [`EventCheck::check_summarized`]) to spare a
+/// second pass over the events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ChunkSummary {
+    /// Whether every event lies inside the resolution (`true` when there is none).
+    pub in_bounds: bool,
+    /// Whether every timestamp is at least the one before it (within the chunk).
+    pub ordered: bool,
+}
+
+impl ChunkSummary {
+    /// The summary of no events.
+    pub const EMPTY: Self = Self {
+        in_bounds: true,
+        ordered: true,
+    };
+
+    /// Computes the summary of `events` against `resolution` (branch-free reductions the
+    /// compiler vectorises).
+    fn of(events: &[Event], resolution: Option<Resolution>) -> Self {
+        let (mut max_x, mut max_y) = (0u16, 0u16);
+        let mut ordered = true;
+        let mut previous = events.first().map_or(0, |e| e.t);
+        for e in events {
+            max_x = max_x.max(e.x);
+            max_y = max_y.max(e.y);
+            ordered &= e.t >= previous;
+            previous = e.t;
+        }
+        Self {
+            in_bounds: resolution.is_none_or(|r| max_x < r.width && max_y < r.height),
+            ordered,
+        }
+    }
+}
+
 /// Running validation state over a stream of event chunks.
 #[derive(Debug, Clone, Default)]
 pub struct EventCheck {
@@ -76,29 +124,25 @@ impl EventCheck {
 
     /// Validates the next chunk of the stream.
     pub fn check(&mut self, events: &[Event]) -> Result<(), CheckError> {
-        let Some(first) = events.first() else {
+        self.check_summarized(events, ChunkSummary::of(events, self.resolution))
+    }
+
+    /// Validates the next chunk given its `summary`, which the caller computed from exactly
+    /// these events and against [`resolution`](Self::resolution).
+    pub(crate) fn check_summarized(
+        &mut self,
+        events: &[Event],
+        summary: ChunkSummary,
+    ) -> Result<(), CheckError> {
+        let (Some(first), Some(last)) = (events.first(), events.last()) else {
             return Ok(());
         };
-        // Branch-free reductions over the chunk; the slow search below only runs on failure.
-        let mut max_x = 0u16;
-        let mut max_y = 0u16;
-        let mut ordered = true;
-        let mut previous = self.last_t.unwrap_or(first.t).min(first.t);
-        for e in events {
-            max_x = max_x.max(e.x);
-            max_y = max_y.max(e.y);
-            ordered &= e.t >= previous;
-            previous = e.t;
-        }
-        let in_bounds = self
-            .resolution
-            .is_none_or(|r| max_x < r.width && max_y < r.height);
-        let in_order = ordered && self.last_t.is_none_or(|t| first.t >= t);
-        if !(in_bounds && in_order) {
+        let in_order = summary.ordered && self.last_t.is_none_or(|t| first.t >= t);
+        if !(summary.in_bounds && in_order) {
             return Err(self.locate(events));
         }
         self.count += events.len() as u64;
-        self.last_t = Some(previous);
+        self.last_t = Some(last.t);
         Ok(())
     }
 

@@ -42,7 +42,7 @@ pub enum CsvError {
     #[error("the file is empty (expected the header `{EVENT_HEADER}`)")]
     Empty,
     /// The first line is not the expected header.
-    #[error("the header is `{found}`, expected `{EVENT_HEADER}`")]
+    #[error("the header (line 1) is `{found}`, expected `{EVENT_HEADER}`")]
     BadHeader {
         /// The first line as found.
         found: String,
@@ -58,12 +58,14 @@ pub enum CsvError {
         reason: String,
     },
     /// A parsed event is invalid (outside the sensor, or earlier than its predecessor).
-    #[error("{error} (read up to line {line})")]
+    #[error("{error} (line {line}, byte offset {offset})")]
     Event {
         /// What is wrong with it.
         error: CheckError,
-        /// One-based number of the last line read.
+        /// One-based number of the line holding the event.
         line: u64,
+        /// Offset of that line's first byte.
+        offset: u64,
     },
 }
 
@@ -85,6 +87,9 @@ pub struct CsvReader<R> {
     /// Bytes read so far.
     offset: u64,
     events: Vec<Event>,
+    /// Line number and offset of each event of `events`, so that a check failure can name the
+    /// line (blank lines make it differ from the event index).
+    places: Vec<(u64, u64)>,
     check: EventCheck,
 }
 
@@ -176,6 +181,7 @@ impl<R: BufRead> CsvReader<R> {
             line: 1,
             offset: n as u64,
             events: Vec::with_capacity(CHUNK),
+            places: Vec::with_capacity(CHUNK),
             check: EventCheck::new(None),
         })
     }
@@ -198,6 +204,7 @@ impl<R: BufRead> CsvReader<R> {
     /// The next chunk of events; `Ok(None)` at the end of the file. Blank lines are skipped.
     pub fn next_chunk(&mut self) -> Result<Option<&[Event]>, CsvError> {
         self.events.clear();
+        self.places.clear();
         while self.events.len() < CHUNK {
             self.line_buf.clear();
             let n = self.source.read_until(b'\n', &mut self.line_buf)?;
@@ -217,11 +224,21 @@ impl<R: BufRead> CsvReader<R> {
                 reason,
             })?;
             self.events.push(event);
+            self.places.push((self.line, start));
         }
-        let line = self.line;
-        self.check
-            .check(&self.events)
-            .map_err(|error| CsvError::Event { error, line })?;
+        let (count, places, last) = (self.check.count(), &self.places, (self.line, self.offset));
+        self.check.check(&self.events).map_err(|error| {
+            // The failing event is in this chunk, so its index is at least `count`.
+            let (line, offset) = usize::try_from(error.index().saturating_sub(count))
+                .ok()
+                .and_then(|i| places.get(i).copied())
+                .unwrap_or(last);
+            CsvError::Event {
+                error,
+                line,
+                offset,
+            }
+        })?;
         Ok((!self.events.is_empty()).then_some(self.events.as_slice()))
     }
 }

@@ -118,8 +118,13 @@ pub enum NpyError {
         reason: String,
     },
     /// A decoded event is invalid (outside the sensor, or earlier than its predecessor).
-    #[error(transparent)]
-    Event(#[from] CheckError),
+    #[error("{error} (record at byte offset {offset})")]
+    Event {
+        /// What is wrong with it.
+        error: CheckError,
+        /// Offset of the record holding the event.
+        offset: u64,
+    },
     /// An event to write has a coordinate that `<i2` cannot hold.
     #[error("event {index} at (x={x}, y={y}) cannot be written: NPY coordinates must be <= 32767")]
     CoordinateTooLarge {
@@ -227,23 +232,28 @@ impl<R: Read> NpyReader<R> {
         // A header this long is not one numpy writes for a record of four fields.
         if header_len > 1 << 20 {
             return Err(NpyError::BadHeader(format!(
-                "the header claims {header_len} bytes"
+                "the header length field (byte offset 8) claims {header_len} bytes"
             )));
         }
-        let mut text = vec![0u8; header_len as usize];
-        let got = read_full(&mut source, &mut text)?;
+        // Read through `take`: the buffer grows with the bytes present, not with the claim.
+        let mut text = Vec::new();
+        let got = (&mut source).take(header_len).read_to_end(&mut text)?;
         if (got as u64) < header_len {
             return Err(NpyError::TruncatedHeader {
                 offset: start + got as u64,
                 needed: start + header_len,
             });
         }
-        let text = std::str::from_utf8(&text)
-            .map_err(|_| NpyError::BadHeader("the header is not valid text".into()))?;
+        let text = std::str::from_utf8(&text).map_err(|e| {
+            NpyError::BadHeader(format!(
+                "the header is not valid UTF-8 text (bad byte at byte offset {})",
+                start + e.valid_up_to() as u64
+            ))
+        })?;
         let (layout, declared) = header::parse(text)?;
         Ok(Self {
             source,
-            buf: vec![0u8; layout.itemsize * CHUNK],
+            buf: Vec::new(),
             layout,
             declared,
             done: 0,
@@ -301,7 +311,12 @@ impl<R: Read> NpyReader<R> {
         }
         let records = remaining.min(CHUNK as u64) as usize;
         let bytes = records * size;
-        let got = read_full(&mut self.source, &mut self.buf[..bytes])?;
+        // Grown by the bytes actually read, so a record count the data does not back costs
+        // nothing; after the first chunk the capacity is reused.
+        self.buf.clear();
+        let got = (&mut self.source)
+            .take(bytes as u64)
+            .read_to_end(&mut self.buf)?;
         if got < bytes {
             return Err(NpyError::Truncated {
                 declared: self.declared,
@@ -324,7 +339,13 @@ impl<R: Read> NpyReader<R> {
             }
         }
         self.done += records as u64;
-        self.check.check(&self.events)?;
+        let (start, size) = (self.data_start, size as u64);
+        self.check
+            .check(&self.events)
+            .map_err(|error| NpyError::Event {
+                offset: start + error.index() * size,
+                error,
+            })?;
         Ok(Some(&self.events))
     }
 }

@@ -110,12 +110,21 @@ impl Format {
                 path: path.to_path_buf(),
                 reason: "the file is empty".into(),
             }),
-            "aedat4" | "aedat" | "npy" | "raw" => Err(Error::UnknownFormat {
-                path: path.to_path_buf(),
-                reason: format!(
-                    "the extension says `.{extension}` but the file does not start like one"
-                ),
-            }),
+            "aedat4" | "aedat" | "npy" | "raw" => {
+                let signature = match extension.as_str() {
+                    "npy" => "the NPY magic `\\x93NUMPY`",
+                    "raw" => "a `%` EVT text header line",
+                    _ => "the AEDAT 4.0 magic `#!AER-DAT4.0\\r\\n`",
+                };
+                let first = String::from_utf8_lossy(&head[..head.len().min(14)]).into_owned();
+                Err(Error::UnknownFormat {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "the extension says `.{extension}` but the first bytes (at byte offset \
+                         0) are {first:?}, not {signature}"
+                    ),
+                })
+            }
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
                 reason: "no AEDAT4, NPY or EVT signature, and the extension is not .csv".into(),

@@ -14,6 +14,10 @@ use super::header::Compression;
 /// Largest decompressed packet accepted (DV writes packets of a few hundred KiB at most); a
 /// limit keeps a corrupt or hostile size from exhausting memory.
 pub const MAX_PACKET_BYTES: u64 = 1 << 30;
+/// A zstd frame declaring more than this many times its own size is decoded as a stream rather
+/// than into a buffer reserved at the declared size (DV's event and IMU packets compress a few
+/// times at most).
+const MAX_BULK_RATIO: u64 = 64;
 
 /// LZ4 frame magic number (little-endian `04 22 4D 18`).
 const LZ4_MAGIC: u32 = 0x184D_2204;
@@ -150,8 +154,19 @@ impl Decompressor {
                 self.out.clear();
                 let size = zstd::zstd_safe::get_frame_content_size(input)
                     .map_err(|_| "not a zstd frame (bad frame header)".to_owned())?;
+                if let Some(size) = size
+                    && size > MAX_PACKET_BYTES
+                {
+                    return Err(format!(
+                        "frame declares {size} bytes, more than the {MAX_PACKET_BYTES} accepted"
+                    ));
+                }
+                // Reserve the declared size only when the compressed bytes could plausibly hold
+                // it: a 20-byte frame declaring 1 GiB must not allocate 1 GiB (found by the
+                // bad-input matrix). Anything else is streamed, growing with the bytes produced.
+                let plausible = (input.len() as u64).saturating_mul(MAX_BULK_RATIO);
                 match size {
-                    Some(size) if size <= MAX_PACKET_BYTES => {
+                    Some(size) if size <= plausible => {
                         let dctx = match &mut self.zstd {
                             Some(d) => d,
                             None => self.zstd.insert(
@@ -167,22 +182,24 @@ impl Decompressor {
                             return Err(format!("frame says {size} bytes, decoded {n}"));
                         }
                     }
-                    Some(size) => {
-                        return Err(format!(
-                            "frame declares {size} bytes, more than the {MAX_PACKET_BYTES} accepted"
-                        ));
-                    }
-                    None => {
-                        // Frames written without a content size: stream them, bounded.
+                    _ => {
+                        // Frames written without a content size, or declaring more than their
+                        // bytes plausibly hold: stream them, bounded.
                         zstd::stream::read::Decoder::with_buffer(input.as_slice())
                             .map_err(|e| e.to_string())?
                             .take(MAX_PACKET_BYTES + 1)
                             .read_to_end(&mut self.out)
                             .map_err(|e| e.to_string())?;
-                        if self.out.len() as u64 > MAX_PACKET_BYTES {
+                        let n = self.out.len() as u64;
+                        if n > MAX_PACKET_BYTES {
                             return Err(format!(
                                 "decompresses to more than the {MAX_PACKET_BYTES} bytes accepted"
                             ));
+                        }
+                        if let Some(size) = size
+                            && n != size
+                        {
+                            return Err(format!("frame says {size} bytes, decoded {n}"));
                         }
                     }
                 }

@@ -6,7 +6,8 @@
 //! `0x8` TIME_HIGH (the upper 28 bits of the timestamp), `0xA` EXT_TRIGGER (`value` bit 0,
 //! `id` bits 8..12, `ts` at 22). Other types carry nothing evtac uses.
 
-use crate::{Event, Trigger};
+use crate::check::ChunkSummary;
+use crate::{Event, Resolution, Trigger};
 
 /// Bits of the timestamp carried by CD and trigger words.
 const LSB_BITS: u32 = 6;
@@ -35,56 +36,98 @@ pub(crate) struct Evt2Decoder {
 }
 
 impl Evt2Decoder {
-    /// Decodes whole words from `bytes` (a multiple of 4 bytes long), appending to the outputs.
+    /// Decodes whole words from `bytes` (a multiple of 4 bytes long), appending to the outputs;
+    /// returns what [`EventCheck`](crate::check::EventCheck) needs to validate the events
+    /// appended against `resolution`, gathered on the way so that they need no second pass.
+    ///
+    /// Nearly every word of a recording is a CD event, so the loop writes an event for every
+    /// word into the spare capacity and keeps it (advances the count) only for CD words; the
+    /// other types go through a separate, rarely taken branch. That avoids `push`'s capacity
+    /// check and length update per event, and with the fused check halves the decoding time.
     pub(crate) fn decode(
         &mut self,
         bytes: &[u8],
         events: &mut Vec<Event>,
         triggers: &mut Vec<Trigger>,
-    ) {
-        let mut words = bytes.chunks_exact(4);
+        resolution: Option<Resolution>,
+    ) -> ChunkSummary {
+        let (mut words, _) = bytes.as_chunks::<4>();
         if !self.base_time_set {
-            for w in words.by_ref() {
-                let word = u32::from_le_bytes([w[0], w[1], w[2], w[3]]);
-                if word >> 28 == 0x8 {
-                    self.base_time = i64::from(word & 0x0FFF_FFFF) << LSB_BITS;
-                    self.base_time_set = true;
-                    break;
-                }
-            }
+            let Some(i) = words
+                .iter()
+                .position(|w| u32::from_le_bytes(*w) >> 28 == 0x8)
+            else {
+                return ChunkSummary::EMPTY;
+            };
+            self.base_time = i64::from(u32::from_le_bytes(words[i]) & 0x0FFF_FFFF) << LSB_BITS;
+            self.base_time_set = true;
+            words = &words[i + 1..];
         }
-        events.reserve(bytes.len() / 4);
+        let start = events.len();
+        events.reserve(words.len());
+        let spare = &mut events.spare_capacity_mut()[..words.len()];
+        let mut kept = 0;
+        // The time high and the summary live in registers for the loop. An event is inside
+        // when `x - width` and `y - height` are both negative: their sign bits, and-ed over the
+        // chunk, are one register (a running maximum of x and y took two, and spilled).
+        let (width, height) = resolution.map_or((1 << 16, 1 << 16), |r| {
+            (i32::from(r.width), i32::from(r.height))
+        });
+        let mut base = self.base_time;
+        let mut inside = -1i32;
+        let mut ordered = true;
+        let mut last = i64::MIN;
         for w in words {
-            let word = u32::from_le_bytes([w[0], w[1], w[2], w[3]]);
-            let ts = i64::from((word >> 22) & 0x3F);
-            match word >> 28 {
-                kind @ (0x0 | 0x1) => events.push(Event {
-                    t: self.base_time + ts,
-                    x: ((word >> 11) & 0x7FF) as u16,
-                    y: (word & 0x7FF) as u16,
-                    polarity: kind == 1,
-                }),
-                0x8 => {
-                    let mut high = (i64::from(word & 0x0FFF_FFFF) << LSB_BITS) + self.loop_shift;
-                    if high < self.base_time
-                        && self.base_time - high >= MAX_TIMESTAMP - LOOP_THRESHOLD
-                    {
-                        self.loop_shift += TIME_LOOP;
-                        high += TIME_LOOP;
-                    }
-                    self.base_time = high;
-                }
-                0xA => triggers.push(Trigger {
-                    t: self.base_time + ts,
+            let word = u32::from_le_bytes(*w);
+            let kind = word >> 28;
+            let t = base + i64::from((word >> 22) & 0x3F);
+            let x = ((word >> 11) & 0x7FF) as u16;
+            let y = (word & 0x7FF) as u16;
+            // `kept` <= the words seen so far < `words.len()`: always inside `spare`.
+            spare[kept].write(Event {
+                t,
+                x,
+                y,
+                polarity: kind == 1,
+            });
+            if kind < 2 {
+                ordered &= t >= last;
+                last = t;
+                inside &= (i32::from(x) - width) & (i32::from(y) - height);
+                kept += 1;
+            } else if kind == 0x8 {
+                base = self.time_high(word, base);
+            } else if kind == 0xA {
+                triggers.push(Trigger {
+                    t,
                     kind: if word & 1 == 1 {
                         TRIGGER_RISING
                     } else {
                         TRIGGER_FALLING
                     },
-                }),
-                _ => {}
+                });
             }
         }
+        self.base_time = base;
+        // SAFETY: `spare[..kept]` was initialised above (each `kept += 1` follows the write of
+        // `spare[kept]`), and `reserve` made room for `words.len() >= kept` events after `start`.
+        unsafe { events.set_len(start + kept) };
+        ChunkSummary {
+            in_bounds: inside < 0,
+            ordered,
+        }
+    }
+
+    /// The new time high (us, wraps included) after a TIME_HIGH word, `base` being the current
+    /// one: a jump far back is the 34-bit counter wrapping around.
+    #[inline(always)]
+    fn time_high(&mut self, word: u32, base: i64) -> i64 {
+        let high = (i64::from(word & 0x0FFF_FFFF) << LSB_BITS) + self.loop_shift;
+        if high < base && base - high >= MAX_TIMESTAMP - LOOP_THRESHOLD {
+            self.loop_shift += TIME_LOOP;
+            return high + TIME_LOOP;
+        }
+        high
     }
 }
 
@@ -107,7 +150,7 @@ mod tests {
             0xA000_0001 | 3 << 22,
         ]);
         let (mut events, mut triggers) = (Vec::new(), Vec::new());
-        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers);
+        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers, None);
         assert_eq!(
             events,
             vec![
@@ -135,10 +178,32 @@ mod tests {
     }
 
     #[test]
+    fn the_summary_sees_the_last_pixel_inside_and_the_first_outside() {
+        let cd = |ts: u32, x: u32, y: u32| ts << 22 | x << 11 | y;
+        let summary = |ws: &[u32], resolution| {
+            let (mut events, mut triggers) = (Vec::new(), Vec::new());
+            Evt2Decoder::default().decode(&words(ws), &mut events, &mut triggers, resolution)
+        };
+        let r = Some(Resolution::new(640, 480));
+        let inside = summary(&[0x8000_0001, cd(0, 639, 479), cd(1, 0, 0)], r);
+        assert_eq!(inside, ChunkSummary::EMPTY);
+        for (x, y) in [(640, 0), (0, 480), (2047, 2047)] {
+            let outside = summary(&[0x8000_0001, cd(0, 1, 1), cd(1, x, y)], r);
+            assert!(!outside.in_bounds && outside.ordered, "({x}, {y})");
+            assert!(summary(&[0x8000_0001, cd(1, x, y)], None).in_bounds);
+        }
+        let back = summary(&[0x8000_0001, cd(5, 1, 1), cd(4, 1, 1)], r);
+        assert!(back.in_bounds && !back.ordered);
+        // A time high going back, not far enough to be a wrap.
+        let back = summary(&[0x8000_0002, cd(0, 1, 1), 0x8000_0001, cd(63, 1, 1)], r);
+        assert!(!back.ordered);
+    }
+
+    #[test]
     fn time_high_wrap_continues_the_clock() {
         let bytes = words(&[0x8FFF_FFFF, 1 << 22, 0x8000_0000, 1 << 22]);
         let (mut events, mut triggers) = (Vec::new(), Vec::new());
-        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers);
+        Evt2Decoder::default().decode(&bytes, &mut events, &mut triggers, None);
         assert_eq!(events[0].t, MAX_TIMESTAMP + 1);
         assert_eq!(events[1].t, TIME_LOOP + 1);
     }

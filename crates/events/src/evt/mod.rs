@@ -250,16 +250,26 @@ impl<R: Read> EvtReader<R> {
             let whole = available - available % word;
             if whole > 0 {
                 let bytes = &self.buf[self.start..self.start + whole];
-                match &mut self.decoder {
-                    Decoder::Evt2(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
-                    Decoder::Evt3(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
-                }
+                // `events` is empty before each decode (the loop goes round again only when
+                // nothing was decoded), so an EVT2 summary covers every event checked.
+                let resolution = self.check.resolution();
+                let summary = match &mut self.decoder {
+                    Decoder::Evt2(d) => {
+                        Some(d.decode(bytes, &mut self.events, &mut self.triggers, resolution))
+                    }
+                    Decoder::Evt3(d) => {
+                        d.decode(bytes, &mut self.events, &mut self.triggers);
+                        None
+                    }
+                };
                 self.start += whole;
                 self.offset += whole as u64;
                 let offset = self.offset;
-                self.check
-                    .check(&self.events)
-                    .map_err(|error| EvtError::Event { error, offset })?;
+                match summary {
+                    Some(summary) => self.check.check_summarized(&self.events, summary),
+                    None => self.check.check(&self.events),
+                }
+                .map_err(|error| EvtError::Event { error, offset })?;
                 if !self.events.is_empty() || !self.triggers.is_empty() {
                     return Ok(Some(EvtChunk {
                         events: &self.events,

@@ -146,6 +146,11 @@ enum Coordinate {
     U16,
 }
 
+/// The largest record accepted, padding included: numpy pads the 13-byte event record to 16
+/// when aligned; anything near this size is not an event record, and a padding field declaring
+/// gigabytes must not decide how much the reader allocates.
+const MAX_RECORD: usize = 1 << 12;
+
 /// Where the four event fields sit in one record.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Layout {
@@ -242,7 +247,8 @@ pub(super) fn parse(text: &str) -> Result<(Layout, u64), NpyError> {
     };
     let descr_text = text
         .find("'descr'")
-        .map(|i| &text[i + 8..])
+        .and_then(|i| text.get(i + "'descr'".len()..))
+        .map(|rest| rest.trim_start().strip_prefix(':').unwrap_or(rest))
         .and_then(|rest| rest.split("'fortran_order'").next())
         .unwrap_or("")
         .trim()
@@ -273,7 +279,13 @@ pub(super) fn parse(text: &str) -> Result<(Layout, u64), NpyError> {
         let size = match (name, kind) {
             ("", k) if k.starts_with("|V") || k.starts_with("V") => k.trim_start_matches('|')[1..]
                 .parse::<usize>()
-                .map_err(|_| unsupported(format!("bad padding type `{k}`")))?,
+                .ok()
+                .filter(|&n| n <= MAX_RECORD)
+                .ok_or_else(|| {
+                    unsupported(format!(
+                        "padding field of type `{k}` is not a size of at most {MAX_RECORD} bytes"
+                    ))
+                })?,
             ("t", "<i8") => set(&mut t, offset, name, &unsupported)? + 8,
             ("x" | "y", "<i2" | "<u2") => {
                 let c = if kind == "<i2" {
@@ -297,6 +309,13 @@ pub(super) fn parse(text: &str) -> Result<(Layout, u64), NpyError> {
             (n, _) => return Err(unsupported(format!("unexpected field `{n}`"))),
         };
         offset += size;
+        // Each field adds at most MAX_RECORD bytes, so the sum cannot overflow before this.
+        if offset > MAX_RECORD {
+            return Err(unsupported(format!(
+                "the fields make records of more than {MAX_RECORD} bytes (the event record \
+                 takes 13)"
+            )));
+        }
     }
     let missing = |name: &str| unsupported(format!("field `{name}` is missing"));
     let layout = Layout {

@@ -1,6 +1,9 @@
 //! Integration tests of the event file readers and writers: one test binary, one module per
-//! format (the AEDAT4 codec's tests live in their own `aedat*.rs` files).
+//! format, and the bad-input matrix over every reader (`bad_input.rs`; the AEDAT4 codec's own
+//! tests live in `tests/aedat.rs`).
 
+mod alloc;
+mod bad_input;
 mod common;
 mod csv;
 mod evt;

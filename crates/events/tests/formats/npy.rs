@@ -134,3 +134,67 @@ proptest! {
         let _ = read_all(flipped.as_slice());
     }
 }
+
+/// The header of `write(&[Event::default(); 2])` with its dictionary replaced by `dict`.
+fn with_dict(dict: &str) -> Vec<u8> {
+    let mut bytes = write(&[Event::default(); 2]);
+    let len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+    let mut text = dict.as_bytes().to_vec();
+    text.resize(len - 1, b' ');
+    text.push(b'\n');
+    bytes[10..10 + len].copy_from_slice(&text);
+    bytes
+}
+
+/// Found by review and the `npy` fuzz target's seeds: two padding fields of `usize::MAX` bytes
+/// overflowed the record size (`attempt to add with overflow` in the header parser).
+#[test]
+fn padding_fields_summing_past_usize_are_an_error_not_an_overflow_panic() {
+    let bytes = with_dict(
+        "{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1'), \
+         ('', '|V18446744073709551615'), ('', '|V18446744073709551615')], \
+         'fortran_order': False, 'shape': (2,), }",
+    );
+    let err = read_all(bytes.as_slice()).unwrap_err();
+    assert!(err.to_string().contains("padding field"), "{err}");
+}
+
+/// A padding field of a gigabyte made the reader allocate a chunk buffer of 16384 such
+/// records (16 TB: an allocation failure abort) before reading a single one.
+#[test]
+fn a_padding_field_of_a_gigabyte_is_refused_before_allocating() {
+    let bytes = with_dict(
+        "{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1'), \
+         ('', '|V1000000000')], 'fortran_order': False, 'shape': (2,), }",
+    );
+    let (result, largest) = crate::alloc::largest_allocation_during(|| read_all(bytes.as_slice()));
+    let err = result.unwrap_err();
+    assert!(err.to_string().contains("padding field"), "{err}");
+    assert!(largest < 1 << 20, "allocated {largest} bytes");
+}
+
+/// The chunk buffer was sized by the declared record count (up to 16384 records) and the
+/// header buffer by the declared header length, before the bytes were known to exist.
+#[test]
+fn declared_sizes_allocate_only_what_the_file_holds() {
+    let bytes = with_dict(
+        "{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1'), ('', '|V4000')], \
+         'fortran_order': False, 'shape': (4294967296,), }",
+    );
+    let (result, largest) = crate::alloc::largest_allocation_during(|| read_all(bytes.as_slice()));
+    assert!(
+        matches!(result, Err(NpyError::Truncated { declared, .. }) if declared == 1 << 32),
+        "{result:?}"
+    );
+    // 16384 records of 4013 bytes would be 66 MB.
+    assert!(largest < 1 << 20, "allocated {largest} bytes");
+    let mut claim = b"\x93NUMPY\x02\x00".to_vec();
+    claim.extend_from_slice(&(1u32 << 20).to_le_bytes());
+    claim.extend_from_slice(b"{'descr'");
+    let (result, largest) = crate::alloc::largest_allocation_during(|| read_all(claim.as_slice()));
+    assert!(
+        matches!(result, Err(NpyError::TruncatedHeader { .. })),
+        "{result:?}"
+    );
+    assert!(largest < 1 << 16, "allocated {largest} bytes");
+}

@@ -1,0 +1,111 @@
+"""Writes the seed files the fuzz corpora grew from (see docs/reliability.md): NPY files written
+by numpy, AEDAT4 files written by dv-processing, small CSVs, and cuts of the real recordings.
+
+    .venv/bin/python fuzz/make_seeds.py OUT_DIR [FIXTURES_DIR]
+
+OUT_DIR gets one folder per fuzz target; FIXTURES_DIR defaults to ../shared/fixtures/real. Then
+`cargo +nightly fuzz run npy corpus/npy OUT_DIR/npy -- ...` adds them to a run.
+"""
+
+import os
+import sys
+
+import dv_processing as dv
+import numpy as np
+
+S = sys.argv[1]
+R = sys.argv[2] if len(sys.argv) > 2 else os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "fixtures", "real"
+)
+for target in ("aedat", "evt2", "evt3", "csv", "npy"):
+    os.makedirs(os.path.join(S, target), exist_ok=True)
+rng = np.random.default_rng(7)
+# NPY: the event record in several forms numpy writes
+base = [("t", "<i8"), ("x", "<i2"), ("y", "<i2"), ("p", "u1")]
+forms = {
+    "plain": np.dtype(base),
+    "aligned": np.dtype(base, align=True),
+    "reordered": np.dtype([("p", "?"), ("x", "<u2"), ("y", "<u2"), ("t", "<i8")]),
+    "bigx": np.dtype([("t", "<i8"), ("x", "<u2"), ("y", "<u2"), ("p", "i1")]),
+    "be": np.dtype([("t", ">i8"), ("x", ">i2"), ("y", ">i2"), ("p", "u1")]),
+    "f8t": np.dtype([("t", "<f8"), ("x", "<i2"), ("y", "<i2"), ("p", "u1")]),
+    "missing": np.dtype([("t", "<i8"), ("x", "<i2"), ("y", "<i2")]),
+}
+for name, dt in forms.items():
+    for n in (0, 1, 5, 40):
+        a = np.zeros(n, dtype=dt)
+        if n:
+            a["t"] = np.cumsum(rng.integers(0, 4, n)) + 1000
+            a["x"] = rng.integers(0, 320, n); a["y"] = rng.integers(0, 240, n)
+            if "p" in dt.names: a["p"] = rng.integers(0, 2, n)
+        np.save(f"{S}/npy/{name}_{n}.npy", a)
+for n, dt in [(4, "<f8"), (3, "<i8")]:
+    np.save(f"{S}/npy/scalar_{dt[1:]}.npy", np.arange(n, dtype=dt))
+np.save(f"{S}/npy/2d.npy", np.zeros((3, 2), dtype=np.dtype(base)))
+np.save(f"{S}/npy/fortran.npy", np.asfortranarray(np.zeros((2, 2), dtype="<i8")))
+# format version 2.0 and 3.0 headers
+from numpy.lib import format as fmt
+for v in ((2, 0), (3, 0)):
+    a = np.zeros(3, dtype=np.dtype(base))
+    with open(f"{S}/npy/v{v[0]}.npy", "wb") as f:
+        fmt.write_array(f, a, version=v)
+# the expected events of the EVT3 fixture, cut small
+e = np.load(f"{R}/prophesee_gen4_1280x720.evt3.expected.npy")
+np.save(f"{S}/npy/real_cut.npy", e[:64])
+# CSV
+for n in (0, 1, 10, 50):
+    with open(f"{S}/csv/ev_{n}.csv", "w") as f:
+        f.write("t,x,y,p\n")
+        t = 100
+        for i in range(n):
+            t += int(rng.integers(0, 3))
+            f.write(f"{t},{rng.integers(0,700)},{rng.integers(0,500)},{rng.integers(0,2)}\n")
+open(f"{S}/csv/crlf.csv", "w").write("t,x,y,p\r\n1,2,3,1\r\n2,3,4,0\r\n")
+open(f"{S}/csv/back.csv", "w").write("t,x,y,p\n5,1,1,1\n3,1,1,0\n")
+open(f"{S}/csv/neg.csv", "w").write("t,x,y,p\n-5,1,1,1\n3,-1,1,0\n4,1,1,2\n")
+# AEDAT4 written by dv-processing: every compression, small packets
+for comp in ("NONE", "LZ4", "LZ4_HIGH", "ZSTD", "ZSTD_HIGH"):
+    cfg = dv.io.MonoCameraWriter.Config("DVXplorer_PY")
+    cfg.compression = getattr(dv.CompressionType, comp)
+    cfg.addEventStream((320, 240))
+    cfg.addImuStream()
+    cfg.addTriggerStream()
+    path = f"{S}/aedat/dv_{comp}.aedat4"
+    w = dv.io.MonoCameraWriter(path, cfg)
+    w.setPackagingCount(4)
+    t = 1_600_000_000_000_000
+    for k in range(3):
+        s = dv.EventStore()
+        for i in range(6):
+            t += int(rng.integers(0, 3))
+            s.push_back(t, int(rng.integers(0, 320)), int(rng.integers(0, 240)), bool(rng.integers(0, 2)))
+        w.writeEvents(s)
+        w.writeImu(dv.IMU(t, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.0, 0.0, 0.0))
+        w.writeTrigger(dv.Trigger(t, dv.TriggerType.EXTERNAL_SIGNAL_RISING_EDGE))
+    del w
+
+
+# EVT: the real recordings cut to their header plus 0 B..16 KiB, 4 KiB slices from inside the
+# data, and the last 2 KiB; AEDAT4: the first 4, 16 and 64 KiB of the real recording.
+def header_length(b):
+    i = 0
+    while b[i : i + 1] == b"%":
+        i = b.index(b"\n", i) + 1
+    return i
+
+
+for kind, name in (
+    ("evt2", "prophesee_gen3_640x480.evt2.raw"),
+    ("evt3", "prophesee_gen4_1280x720.evt3.raw"),
+):
+    b = open(f"{R}/{name}", "rb").read()
+    h = header_length(b)
+    for n in (0, 64, 1024, 4096, 16384):
+        open(f"{S}/{kind}/head_{n}.raw", "wb").write(b[: h + n])
+    for k, off in enumerate((len(b) // 4, len(b) // 2, 3 * len(b) // 4, len(b) - 4096)):
+        off = h + ((off - h) // 4) * 4
+        open(f"{S}/{kind}/mid_{k}.raw", "wb").write(b[off : off + 4096])
+    open(f"{S}/{kind}/tail.raw", "wb").write(b[-2048:])
+b = open(f"{R}/dvxplorer_320x240_imu.aedat4", "rb").read()
+for n in (4096, 16384, 65536):
+    open(f"{S}/aedat/real_{n}.aedat4", "wb").write(b[:n])
