@@ -29,6 +29,8 @@ pub enum Format {
     Aedat4,
     /// Prophesee EVT 2.0 raw (`.raw`), read only.
     Evt2,
+    /// Prophesee EVT 2.1 raw (`.raw`), read only.
+    Evt21,
     /// Prophesee EVT 3.0 raw (`.raw`), read only.
     Evt3,
     /// `t,x,y,p` CSV (`.csv`).
@@ -38,11 +40,12 @@ pub enum Format {
 }
 
 impl Format {
-    /// The short name shown to users (`AEDAT4`, `EVT2`, `EVT3`, `CSV`, `NPY`).
+    /// The short name shown to users (`AEDAT4`, `EVT2`, `EVT21`, `EVT3`, `CSV`, `NPY`).
     pub const fn name(self) -> &'static str {
         match self {
             Self::Aedat4 => "AEDAT4",
             Self::Evt2 => "EVT2",
+            Self::Evt21 => "EVT21",
             Self::Evt3 => "EVT3",
             Self::Csv => "CSV",
             Self::Npy => "NPY",
@@ -95,6 +98,7 @@ impl Format {
             return match EvtReader::new(File::open(path).map_err(io)?) {
                 Ok(r) => Ok(match r.header().version {
                     EvtVersion::Evt2 => Self::Evt2,
+                    EvtVersion::Evt21 => Self::Evt21,
                     EvtVersion::Evt3 => Self::Evt3,
                 }),
                 Err(error) => Err(Error::Evt {
@@ -220,7 +224,7 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
             let name = r.source().map(str::to_string);
             (Inner::Aedat(Box::new(r)), name)
         }
-        Format::Evt2 | Format::Evt3 => {
+        Format::Evt2 | Format::Evt21 | Format::Evt3 => {
             let r = EvtReader::from_path(path).map_err(|error| Error::Evt {
                 path: path.to_path_buf(),
                 error,
@@ -607,7 +611,7 @@ impl EventWriter {
                 path: path.clone(),
                 error,
             })?),
-            Format::Evt2 | Format::Evt3 => {
+            Format::Evt2 | Format::Evt21 | Format::Evt3 => {
                 return Err(Error::NotWritable { path, format });
             }
         };

@@ -22,16 +22,51 @@ pub(crate) const TRIGGER_RISING: i8 = 1;
 /// See [`TRIGGER_RISING`].
 pub(crate) const TRIGGER_FALLING: i8 = 2;
 
+/// An external trigger at `t`: a rising edge when `value` is 1, else a falling one.
+#[inline]
+pub(crate) fn trigger(t: i64, value: u64) -> Trigger {
+    Trigger {
+        t,
+        kind: if value & 1 == 1 {
+            TRIGGER_RISING
+        } else {
+            TRIGGER_FALLING
+        },
+    }
+}
+
+/// The EVT 2.x clock: the time high of the last TIME_HIGH word, with the wraps of the 34-bit
+/// counter added (shared by EVT 2.0 and EVT 2.1, which encode time alike).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TimeHigh {
+    /// Whether a TIME_HIGH has been seen; words before the first one are skipped, as Prophesee
+    /// does, because their time is unknown.
+    pub(crate) set: bool,
+    /// Current time high in us, wraps included.
+    pub(crate) base: i64,
+    /// Accumulated wraps of the counter, in us.
+    loop_shift: i64,
+}
+
+impl TimeHigh {
+    /// Takes the 28-bit payload of a TIME_HIGH word.
+    #[inline]
+    pub(crate) fn advance(&mut self, payload: u32) {
+        let mut high = (i64::from(payload & 0x0FFF_FFFF) << LSB_BITS) + self.loop_shift;
+        if !self.set {
+            self.set = true;
+        } else if high < self.base && self.base - high >= MAX_TIMESTAMP - LOOP_THRESHOLD {
+            self.loop_shift += TIME_LOOP;
+            high += TIME_LOOP;
+        }
+        self.base = high;
+    }
+}
+
 /// Decoder state carried from word to word (and across reads).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Evt2Decoder {
-    /// Whether a TIME_HIGH has been seen; words before the first one are skipped, as Prophesee
-    /// does, because their time is unknown.
-    base_time_set: bool,
-    /// Current time high in us, wraps included.
-    base_time: i64,
-    /// Accumulated wraps of the counter, in us.
-    loop_shift: i64,
+    clock: TimeHigh,
 }
 
 impl Evt2Decoder {
@@ -43,12 +78,11 @@ impl Evt2Decoder {
         triggers: &mut Vec<Trigger>,
     ) {
         let mut words = bytes.chunks_exact(4);
-        if !self.base_time_set {
+        if !self.clock.set {
             for w in words.by_ref() {
                 let word = u32::from_le_bytes([w[0], w[1], w[2], w[3]]);
                 if word >> 28 == 0x8 {
-                    self.base_time = i64::from(word & 0x0FFF_FFFF) << LSB_BITS;
-                    self.base_time_set = true;
+                    self.clock.advance(word);
                     break;
                 }
             }
@@ -59,29 +93,13 @@ impl Evt2Decoder {
             let ts = i64::from((word >> 22) & 0x3F);
             match word >> 28 {
                 kind @ (0x0 | 0x1) => events.push(Event {
-                    t: self.base_time + ts,
+                    t: self.clock.base + ts,
                     x: ((word >> 11) & 0x7FF) as u16,
                     y: (word & 0x7FF) as u16,
                     polarity: kind == 1,
                 }),
-                0x8 => {
-                    let mut high = (i64::from(word & 0x0FFF_FFFF) << LSB_BITS) + self.loop_shift;
-                    if high < self.base_time
-                        && self.base_time - high >= MAX_TIMESTAMP - LOOP_THRESHOLD
-                    {
-                        self.loop_shift += TIME_LOOP;
-                        high += TIME_LOOP;
-                    }
-                    self.base_time = high;
-                }
-                0xA => triggers.push(Trigger {
-                    t: self.base_time + ts,
-                    kind: if word & 1 == 1 {
-                        TRIGGER_RISING
-                    } else {
-                        TRIGGER_FALLING
-                    },
-                }),
+                0x8 => self.clock.advance(word),
+                0xA => triggers.push(trigger(self.clock.base + ts, u64::from(word))),
                 _ => {}
             }
         }

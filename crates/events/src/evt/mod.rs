@@ -1,4 +1,4 @@
-//! Prophesee EVT 2.0 and EVT 3.0 raw files (with their `%` text header).
+//! Prophesee EVT 2.0, EVT 2.1 and EVT 3.0 raw files (with their `%` text header).
 //!
 //! [`EvtReader`] streams any [`Read`]: it parses the header, then decodes fixed-size reads into
 //! reused event and trigger buffers, carrying a word that straddles two reads over to the next.
@@ -20,6 +20,7 @@
 //! ```
 
 mod evt2;
+mod evt21;
 mod evt3;
 mod header;
 
@@ -101,10 +102,11 @@ pub struct EvtChunk<'a> {
 #[derive(Debug, Clone)]
 enum Decoder {
     Evt2(evt2::Evt2Decoder),
+    Evt21(evt21::Evt21Decoder),
     Evt3(evt3::Evt3Decoder),
 }
 
-/// A streaming EVT 2.0 / 3.0 reader over any [`Read`].
+/// A streaming EVT 2.0 / 2.1 / 3.0 reader over any [`Read`].
 #[derive(Debug)]
 pub struct EvtReader<R> {
     source: R,
@@ -200,6 +202,7 @@ impl<R: Read> EvtReader<R> {
         let header = header::parse_fields(fields, pos as u64).map_err(EvtError::Header)?;
         let decoder = match header.version {
             EvtVersion::Evt2 => Decoder::Evt2(evt2::Evt2Decoder::default()),
+            EvtVersion::Evt21 => Decoder::Evt21(evt21::Evt21Decoder::default()),
             EvtVersion::Evt3 => Decoder::Evt3(evt3::Evt3Decoder::default()),
         };
         let check = EventCheck::new(header.resolution);
@@ -252,6 +255,7 @@ impl<R: Read> EvtReader<R> {
                 let bytes = &self.buf[self.start..self.start + whole];
                 match &mut self.decoder {
                     Decoder::Evt2(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
+                    Decoder::Evt21(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
                     Decoder::Evt3(d) => d.decode(bytes, &mut self.events, &mut self.triggers),
                 }
                 self.start += whole;

@@ -4,5 +4,6 @@
 mod common;
 mod csv;
 mod evt;
+mod evt21;
 mod npy;
 mod recording;
