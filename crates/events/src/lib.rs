@@ -28,6 +28,7 @@
 //! ```
 
 pub mod aedat;
+pub mod aedat_legacy;
 pub mod check;
 pub mod csv;
 mod error;
@@ -37,6 +38,7 @@ pub mod manifest;
 pub mod npy;
 mod range;
 mod recording;
+mod text_header;
 mod types;
 
 pub use error::Error;
