@@ -241,6 +241,54 @@ fn aedat31_written_by_python_matches_its_figures() {
     }
 }
 
+/// Writes an AEDAT 2.0 and an AEDAT 3.1 file of plain polarity events (no other records, every
+/// event valid, one camera, no timestamp wrap: what iniVation's own legacy reader handles) and
+/// reads them back with that reader, `dv.LegacyAedatFile` (the `dv` package). It reports jAER's
+/// raw AEDAT 2.0 addresses, which evtac mirrors (`x = 239 - x`, `y = 179 - y`); the script applies
+/// that and prints the figures of what `dv` read from each file.
+const PY_DV_READS: &str = r##"
+import random, struct, sys, os
+from dv import LegacyAedatFile
+d = sys.argv[1]
+rng = random.Random(7)
+ev, t = [], 5000
+for _ in range(4000):
+    t += rng.randrange(0, 6)
+    ev.append((t, rng.randrange(240), rng.randrange(180), rng.randint(0, 1)))
+a2 = bytearray(b"#!AER-DAT2.0\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS240C\r\n")
+for t, x, y, p in ev:
+    a2 += struct.pack(">II", (179 - y) << 22 | (239 - x) << 12 | p << 11, t)
+open(os.path.join(d, "dv2.aedat"), "wb").write(a2)
+a3 = bytearray(b"#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS240C\r\n#!END-HEADER\r\n")
+for i in range(0, len(ev), 700):
+    batch = ev[i:i + 700]
+    a3 += struct.pack("<hhiiiiii", 1, 1, 8, 4, 0, len(batch), len(batch), len(batch))
+    for t, x, y, p in batch:
+        a3 += struct.pack("<Ii", x << 17 | y << 2 | p << 1 | 1, t)
+open(os.path.join(d, "dv31.aedat"), "wb").write(a3)
+for name, flip in [("dv2.aedat", True), ("dv31.aedat", False)]:
+    with LegacyAedatFile(os.path.join(d, name)) as f:
+        got = [(e.timestamp, 239 - e.x if flip else e.x, 179 - e.y if flip else e.y, int(e.polarity))
+               for e in f]
+    print(len(got), got[0][0], got[-1][0], sum(e[3] for e in got), digest(got))
+"##;
+
+#[test]
+fn inivations_legacy_reader_agrees() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = format!("{PY_DIGEST}\n{PY_DV_READS}");
+    let Some(out) = run_python(&script, &[dir.path().to_str().unwrap()]) else {
+        return;
+    };
+    let lines: Vec<&str> = out.lines().collect();
+    for (name, line) in ["dv2.aedat", "dv31.aedat"].iter().zip(lines) {
+        let rec = evtac_events::read_recording(dir.path().join(name)).unwrap();
+        let figures = Figures::parse(line);
+        assert_eq!(figures.count, 4000, "{name}");
+        assert_eq!(Figures::of(&rec.events), figures, "{name}");
+    }
+}
+
 #[test]
 fn other_versions_and_broken_headers_are_named() {
     let dir = tempfile::tempdir().unwrap();
