@@ -233,7 +233,11 @@ impl Decoder {
         if data & 1 == 0 {
             return;
         }
-        let t = self.shift + overflow + i64::from(i32_at(e, 4));
+        // Saturating: repeated resets after huge overflows must not overflow i64 (time then
+        // stops, and the time-order check names the event).
+        let t = self
+            .shift
+            .saturating_add(overflow + i64::from(i32_at(e, 4)));
         match kind {
             Kind::Polarity => out.events.push(Event {
                 t,
@@ -357,6 +361,16 @@ mod tests {
             out.triggers,
             vec![Trigger { t: 9, kind: 1 }, Trigger { t: first, kind: 0 }]
         );
+    }
+
+    #[test]
+    fn resets_after_the_largest_overflow_do_not_overflow() {
+        let reset = || packet(0, 8, 0, &[word_ts(1 << 1 | 1, 0)]);
+        let late = || packet(1, 8, i32::MAX, &[word_ts(1, i32::MAX)]);
+        let bytes = [late(), reset(), late(), reset(), late(), reset(), late()].concat();
+        let mut out = Out::default();
+        Decoder::default().decode(&bytes, 0, &mut out).unwrap();
+        assert_eq!(out.events.last().map(|e| e.t), Some(i64::MAX));
     }
 
     #[test]
