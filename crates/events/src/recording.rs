@@ -141,7 +141,7 @@ impl Format {
             }),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
-                reason: "no AEDAT, NPY or EVT signature, and the extension is not .csv".into(),
+                reason: "no AEDAT4, NPY or EVT signature, and the extension is not .csv".into(),
             }),
         }
     }

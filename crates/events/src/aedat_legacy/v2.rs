@@ -21,6 +21,10 @@
 //! after half of that): a timestamp more than 2^31 us below the previous one counts as a wrap,
 //! and 2^32 us is added from then on. Any other step back (a jAER timestamp reset) is an error,
 //! like every reader's time going backwards.
+//!
+//! The header ends at the first line that does not start with `#`, as jAER reads it: a first
+//! record whose first byte happens to be `#` (0x23) cannot be told from a header line, here as in
+//! jAER (SensorsINI's v2e drops such a first event when it writes).
 
 use super::{LegacyError, Out};
 use crate::{Event, Resolution};
