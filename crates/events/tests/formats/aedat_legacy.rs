@@ -330,8 +330,65 @@ fn headers() -> [&'static [u8]; 2] {
     ]
 }
 
+/// A small AEDAT 3.1 file built here (polarity, IMU6 and special packets) and the offsets where
+/// its packets end.
+fn small_aedat31() -> (Vec<u8>, Vec<usize>) {
+    let mut bytes = headers()[1].to_vec();
+    let mut ends = vec![bytes.len()];
+    let mut t = 10i32;
+    for (kind, size) in [(1i16, 8i32), (3, 36), (1, 8), (0, 8), (1, 8)] {
+        let n = 3;
+        bytes.extend(kind.to_le_bytes());
+        bytes.extend(1i16.to_le_bytes());
+        for v in [size, 4, 0, n, n, n] {
+            bytes.extend(v.to_le_bytes());
+        }
+        for i in 0..n {
+            t += 5;
+            let data: u32 = if kind == 0 {
+                2 << 1 | 1
+            } else {
+                (i as u32) << 17 | 1
+            };
+            bytes.extend(data.to_le_bytes());
+            bytes.extend(t.to_le_bytes());
+            bytes.extend(vec![0u8; size as usize - 8]);
+        }
+        ends.push(bytes.len());
+    }
+    (bytes, ends)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// A file cut anywhere but at a record (AEDAT 2.0) or packet (AEDAT 3.1) boundary is a
+    /// truncation error naming where the cut record or packet starts; a cut at a boundary reads
+    /// the whole packets before it.
+    #[test]
+    fn cuts_inside_records_and_packets_are_errors(cut in 0usize..400) {
+        let (bytes, ends) = small_aedat31();
+        let cut = ends[0] + cut % (bytes.len() - ends[0] + 1);
+        match decode_all(&bytes[..cut]) {
+            Ok(_) => prop_assert!(ends.contains(&cut), "cut at {cut} read without error"),
+            Err(LegacyError::Truncated { offset, len, .. }) => {
+                prop_assert!(!ends.contains(&cut));
+                prop_assert_eq!(len, cut as u64);
+                let start = ends.iter().copied().filter(|&e| e < cut).max().unwrap();
+                prop_assert_eq!(offset, start as u64);
+            }
+            Err(other) => prop_assert!(false, "cut at {cut}: {other}"),
+        }
+        let mut v2 = headers()[0].to_vec();
+        let header = v2.len();
+        for i in 0..40u32 {
+            v2.extend((i << 12).to_be_bytes());
+            v2.extend((100 + i).to_be_bytes());
+        }
+        let cut = header + cut % (v2.len() - header + 1);
+        let result = decode_all(&v2[..cut]);
+        prop_assert_eq!(result.is_ok(), (cut - header).is_multiple_of(8));
+    }
 
     /// Arbitrary bytes after a valid header: an error or events, never a panic.
     #[test]
