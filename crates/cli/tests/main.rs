@@ -5,6 +5,7 @@ mod convert;
 mod evaluate;
 mod info;
 mod labels;
+mod legacy_formats;
 mod online;
 mod predict;
 mod represent;

@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 
 use crate::aedat::AedatError;
+use crate::aedat_legacy::LegacyError;
 use crate::check::CheckError;
 use crate::csv::CsvError;
 use crate::evt::EvtError;
@@ -75,6 +76,14 @@ pub enum Error {
         path: PathBuf,
         /// What is wrong.
         error: AedatError,
+    },
+    /// An AEDAT 2.0 or 3.1 file is broken.
+    #[error("{}: {error}", path.display())]
+    AedatLegacy {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        error: LegacyError,
     },
     /// An EVT file is broken.
     #[error("{}: {error}", path.display())]

@@ -1,5 +1,6 @@
 //! Event and IMU types for evtac, and readers and writers for the files event-camera users have:
-//! AEDAT 4.0 ([`aedat`]), Prophesee EVT 2.0 / 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]).
+//! AEDAT 4.0 ([`aedat`]), the older AEDAT 3.1 and 2.0 ([`aedat_legacy`]), Prophesee EVT 2.0 / 2.1 /
+//! 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]).
 //!
 //! Time is `i64` microseconds everywhere; coordinates are on the full sensor with `x` to the right
 //! and `y` downwards; a [`Roi`] crops them (the paper uses the centered 240x240 region).
@@ -28,6 +29,7 @@
 //! ```
 
 pub mod aedat;
+pub mod aedat_legacy;
 pub mod check;
 pub mod csv;
 mod error;
@@ -37,6 +39,7 @@ pub mod manifest;
 pub mod npy;
 mod range;
 mod recording;
+mod text_header;
 mod types;
 
 pub use error::Error;

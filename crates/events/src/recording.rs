@@ -2,7 +2,8 @@
 //! ([`EventReader`]) or read it whole ([`read_recording`]), and write events to any writable
 //! format ([`EventWriter`]).
 //!
-//! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, EVT `%` header)
+//! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, `#!AER-DAT2.0` /
+//! `#!AER-DAT3.1` header, EVT `%` header)
 //! and otherwise by its extension (`.csv`). Every reader validates what it decodes: events
 //! inside the declared resolution and timestamps that never go backwards.
 //!
@@ -15,6 +16,7 @@ use std::io::{BufReader, BufWriter, Read};
 use std::path::{Path, PathBuf};
 
 use crate::aedat::{AedatReader, AedatWriter, WriterConfig};
+use crate::aedat_legacy::{self, LegacyReader};
 use crate::check::EventCheck;
 use crate::csv::{CsvReader, CsvWriter};
 use crate::evt::{EvtReader, EvtVersion};
@@ -27,8 +29,14 @@ use crate::{Error, Event, ImuSample, Resolution, Trigger};
 pub enum Format {
     /// iniVation AEDAT 4.0 (`.aedat4`): events, IMU and triggers.
     Aedat4,
+    /// jAER AEDAT 2.0 (`.aedat`) from a DAVIS240 or DAVIS346: polarity events, read only.
+    Aedat2,
+    /// cAER AEDAT 3.1 (`.aedat`): polarity events, IMU6 and triggers, read only.
+    Aedat31,
     /// Prophesee EVT 2.0 raw (`.raw`), read only.
     Evt2,
+    /// Prophesee EVT 2.1 raw (`.raw`), read only.
+    Evt21,
     /// Prophesee EVT 3.0 raw (`.raw`), read only.
     Evt3,
     /// `t,x,y,p` CSV (`.csv`).
@@ -38,11 +46,15 @@ pub enum Format {
 }
 
 impl Format {
-    /// The short name shown to users (`AEDAT4`, `EVT2`, `EVT3`, `CSV`, `NPY`).
+    /// The short name shown to users (`AEDAT4`, `AEDAT2`, `AEDAT3.1`, `EVT2`, `EVT21`, `EVT3`,
+    /// `CSV`, `NPY`).
     pub const fn name(self) -> &'static str {
         match self {
             Self::Aedat4 => "AEDAT4",
+            Self::Aedat2 => "AEDAT2",
+            Self::Aedat31 => "AEDAT3.1",
             Self::Evt2 => "EVT2",
+            Self::Evt21 => "EVT21",
             Self::Evt3 => "EVT3",
             Self::Csv => "CSV",
             Self::Npy => "NPY",
@@ -90,11 +102,22 @@ impl Format {
         if head.starts_with(crate::npy::MAGIC) {
             return Ok(Self::Npy);
         }
+        if let Some(version) = aedat_legacy::sniff(&head) {
+            return match version {
+                Ok(aedat_legacy::Version::Aedat2) => Ok(Self::Aedat2),
+                Ok(aedat_legacy::Version::Aedat31) => Ok(Self::Aedat31),
+                Err(version) => Err(Error::AedatLegacy {
+                    path: path.to_path_buf(),
+                    error: aedat_legacy::LegacyError::UnsupportedVersion { version },
+                }),
+            };
+        }
         if head.starts_with(b"%") {
             // The version needs the whole header, which the EVT reader parses.
             return match EvtReader::new(File::open(path).map_err(io)?) {
                 Ok(r) => Ok(match r.header().version {
                     EvtVersion::Evt2 => Self::Evt2,
+                    EvtVersion::Evt21 => Self::Evt21,
                     EvtVersion::Evt3 => Self::Evt3,
                 }),
                 Err(error) => Err(Error::Evt {
@@ -151,9 +174,9 @@ fn extension(path: &Path) -> String {
 pub struct Chunk<'a> {
     /// Events, in time order.
     pub events: &'a [Event],
-    /// IMU samples (AEDAT4 only).
+    /// IMU samples (AEDAT4, AEDAT 3.1).
     pub imu: &'a [ImuSample],
-    /// Triggers (AEDAT4, EVT).
+    /// Triggers (AEDAT4, AEDAT 3.1, EVT).
     pub triggers: &'a [Trigger],
 }
 
@@ -170,6 +193,7 @@ impl<'a> Chunk<'a> {
 
 enum Inner {
     Aedat(Box<AedatReader<BufReader<File>>>),
+    Legacy(Box<LegacyReader<File>>),
     Evt(Box<EvtReader<File>>),
     Csv(Box<CsvReader<BufReader<File>>>),
     Npy(Box<NpyReader<File>>),
@@ -229,7 +253,15 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
             let name = r.source().map(str::to_string);
             (Inner::Aedat(Box::new(r)), name)
         }
-        Format::Evt2 | Format::Evt3 => {
+        Format::Aedat2 | Format::Aedat31 => {
+            let r = LegacyReader::from_path(path).map_err(|error| Error::AedatLegacy {
+                path: path.to_path_buf(),
+                error,
+            })?;
+            let name = r.header().camera.clone();
+            (Inner::Legacy(Box::new(r)), name)
+        }
+        Format::Evt2 | Format::Evt21 | Format::Evt3 => {
             let r = EvtReader::from_path(path).map_err(|error| Error::Evt {
                 path: path.to_path_buf(),
                 error,
@@ -290,6 +322,7 @@ impl EventReader {
     pub fn resolution(&self) -> Option<Resolution> {
         match &self.inner {
             Inner::Aedat(_) => self.aedat_check.resolution(),
+            Inner::Legacy(r) => r.resolution(),
             Inner::Evt(r) => r.resolution(),
             Inner::Csv(r) => r.resolution(),
             Inner::Npy(r) => r.resolution(),
@@ -311,6 +344,7 @@ impl EventReader {
         }
         match &mut self.inner {
             Inner::Aedat(_) => self.aedat_check.set_resolution(Some(resolution)),
+            Inner::Legacy(r) => r.set_resolution(resolution),
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
@@ -327,6 +361,7 @@ impl EventReader {
     pub fn position(&self) -> u64 {
         match &self.inner {
             Inner::Aedat(r) => r.offset(),
+            Inner::Legacy(r) => r.position(),
             Inner::Evt(r) => r.position(),
             Inner::Csv(r) => r.position(),
             Inner::Npy(r) => r.position(),
@@ -438,6 +473,19 @@ fn next_unfiltered<'a>(
                 triggers: chunk.triggers,
             }))
         }
+        Inner::Legacy(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|c| Chunk {
+                    events: c.events,
+                    imu: c.imu,
+                    triggers: c.triggers,
+                })
+            })
+            .map_err(|error| Error::AedatLegacy {
+                path: path.to_path_buf(),
+                error,
+            }),
         Inner::Evt(r) => r
             .next_chunk()
             .map(|c| {
@@ -616,7 +664,7 @@ impl EventWriter {
                 path: path.clone(),
                 error,
             })?),
-            Format::Evt2 | Format::Evt3 => {
+            Format::Aedat2 | Format::Aedat31 | Format::Evt2 | Format::Evt21 | Format::Evt3 => {
                 return Err(Error::NotWritable { path, format });
             }
         };

@@ -15,7 +15,7 @@ use evtac_events::{EventWriter, Resolution, Roi};
 /// Arguments of `evtac convert`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording to read (AEDAT4, EVT 2.0/3.0 raw, CSV or NPY).
+    /// The recording to read (AEDAT 4.0, 3.1 or 2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY).
     pub input: PathBuf,
     /// The file to write; its extension picks the format: .aedat4 (LZ4), .csv or .npy.
     pub output: PathBuf,

@@ -8,7 +8,7 @@ use serde::Serialize;
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording to summarise (AEDAT4, EVT 2.0/3.0 raw, CSV or NPY).
+    /// The recording to summarise (AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY).
     pub file: PathBuf,
     /// Print the summary as one JSON object instead of text.
     #[arg(long)]
@@ -18,7 +18,7 @@ pub struct Args {
 /// What `evtac info` reports (also its JSON output).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
-    /// Format name (`AEDAT4`, `EVT2`, `EVT3`, `CSV`, `NPY`).
+    /// Format name (`AEDAT4`, `AEDAT3.1`, `AEDAT2`, `EVT2`, `EVT21`, `EVT3`, `CSV`, `NPY`).
     pub format: String,
     /// Camera the file names, if any.
     pub source: Option<String>,

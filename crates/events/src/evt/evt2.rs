@@ -23,6 +23,47 @@ pub(crate) const TRIGGER_RISING: i8 = 1;
 /// See [`TRIGGER_RISING`].
 pub(crate) const TRIGGER_FALLING: i8 = 2;
 
+/// An external trigger at `t`: a rising edge when `value` is 1, else a falling one.
+#[inline]
+pub(crate) fn trigger(t: i64, value: u64) -> Trigger {
+    Trigger {
+        t,
+        kind: if value & 1 == 1 {
+            TRIGGER_RISING
+        } else {
+            TRIGGER_FALLING
+        },
+    }
+}
+
+/// The EVT 2.x clock: the time high of the last TIME_HIGH word, with the wraps of the 34-bit
+/// counter added (shared by EVT 2.0 and EVT 2.1, which encode time alike).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TimeHigh {
+    /// Whether a TIME_HIGH has been seen; words before the first one are skipped, as Prophesee
+    /// does, because their time is unknown.
+    pub(crate) set: bool,
+    /// Current time high in us, wraps included.
+    pub(crate) base: i64,
+    /// Accumulated wraps of the counter, in us.
+    loop_shift: i64,
+}
+
+impl TimeHigh {
+    /// Takes the 28-bit payload of a TIME_HIGH word.
+    #[inline]
+    pub(crate) fn advance(&mut self, payload: u32) {
+        let mut high = (i64::from(payload & 0x0FFF_FFFF) << LSB_BITS) + self.loop_shift;
+        if !self.set {
+            self.set = true;
+        } else if high < self.base && self.base - high >= MAX_TIMESTAMP - LOOP_THRESHOLD {
+            self.loop_shift += TIME_LOOP;
+            high += TIME_LOOP;
+        }
+        self.base = high;
+    }
+}
+
 /// Decoder state carried from word to word (and across reads).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Evt2Decoder {
@@ -98,14 +139,7 @@ impl Evt2Decoder {
             } else if kind == 0x8 {
                 base = self.time_high(word, base);
             } else if kind == 0xA {
-                triggers.push(Trigger {
-                    t,
-                    kind: if word & 1 == 1 {
-                        TRIGGER_RISING
-                    } else {
-                        TRIGGER_FALLING
-                    },
-                });
+                triggers.push(trigger(t, u64::from(word)));
             }
         }
         self.base_time = base;

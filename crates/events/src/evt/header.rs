@@ -1,8 +1,9 @@
-//! The `%` text header that Prophesee tools write before EVT 2.0 / 3.0 data.
+//! The `%` text header that Prophesee tools write before EVT 2.0 / 2.1 / 3.0 data.
 //!
 //! Each line is `% key value`; the header ends at `% end` or at the first line that does not
 //! start with `%`. The version comes from `% evt 3.0` (older files) or
-//! `% format EVT3;height=720;width=1280` (newer ones); the resolution from the `format` options,
+//! `% format EVT3;height=720;width=1280` (newer ones; EVT 2.1 is `% format EVT21`, and its
+//! `endianness=legacy` variant, with the two 32-bit halves of each word swapped, is refused); the resolution from the `format` options,
 //! `% geometry 1280x720`, or, for older files that carry neither (such as our Gen3 and Gen4.1
 //! fixtures), from the sensor named by `% sensor_generation` or `% plugin_name`.
 
@@ -13,6 +14,8 @@ use crate::Resolution;
 pub enum EvtVersion {
     /// EVT 2.0: 32-bit words, one event per word.
     Evt2,
+    /// EVT 2.1: 64-bit words, each up to 32 events of one row (a validity mask).
+    Evt21,
     /// EVT 3.0: 16-bit words, stateful and vectorised.
     Evt3,
 }
@@ -22,6 +25,7 @@ impl EvtVersion {
     pub const fn word_size(self) -> usize {
         match self {
             Self::Evt2 => 4,
+            Self::Evt21 => 8,
             Self::Evt3 => 2,
         }
     }
@@ -31,6 +35,7 @@ impl std::fmt::Display for EvtVersion {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Self::Evt2 => "EVT 2.0",
+            Self::Evt21 => "EVT 2.1",
             Self::Evt3 => "EVT 3.0",
         })
     }
@@ -84,7 +89,10 @@ pub enum HeaderError {
     #[error("the header has no `% evt` or `% format` field, so the EVT version is unknown")]
     MissingVersion,
     /// The version field names an encoding evtac does not decode.
-    #[error("header field `{field}` names `{value}`; evtac reads EVT 2.0 and EVT 3.0 only")]
+    #[error(
+        "header field `{field}` names `{value}`; evtac reads EVT 2.0, EVT 2.1 (little-endian) \
+         and EVT 3.0 only"
+    )]
     UnsupportedVersion {
         /// The field (`evt` or `format`).
         field: &'static str,
@@ -111,6 +119,7 @@ pub(crate) fn parse_fields(fields: Vec<(String, String)>, len: u64) -> Result<He
         let name = parts.next().unwrap_or("").trim();
         version = Some(match name.to_ascii_uppercase().as_str() {
             "EVT2" | "EVT20" | "EVT2.0" => EvtVersion::Evt2,
+            "EVT21" | "EVT2.1" => EvtVersion::Evt21,
             "EVT3" | "EVT30" | "EVT3.0" => EvtVersion::Evt3,
             _ => {
                 return Err(HeaderError::UnsupportedVersion {
@@ -128,6 +137,13 @@ pub(crate) fn parse_fields(fields: Vec<(String, String)>, len: u64) -> Result<He
             match option.split_once('=').map(|(k, v)| (k.trim(), v.trim())) {
                 Some(("width", v)) => width = Some(v.parse::<u16>().map_err(|_| bad())?),
                 Some(("height", v)) => height = Some(v.parse::<u16>().map_err(|_| bad())?),
+                // Legacy EVT 2.1 swaps the two 32-bit halves of each word: not decoded.
+                Some(("endianness", v)) if !v.eq_ignore_ascii_case("little") => {
+                    return Err(HeaderError::UnsupportedVersion {
+                        field: "format",
+                        value: value.clone(),
+                    });
+                }
                 _ => {}
             }
         }
@@ -147,6 +163,7 @@ pub(crate) fn parse_fields(fields: Vec<(String, String)>, len: u64) -> Result<He
     {
         version = Some(match value.trim() {
             "2" | "2.0" => EvtVersion::Evt2,
+            "2.1" => EvtVersion::Evt21,
             "3" | "3.0" => EvtVersion::Evt3,
             _ => {
                 return Err(HeaderError::UnsupportedVersion {
@@ -263,11 +280,13 @@ mod tests {
             parse_fields(fields(&[" Date today"]), 0),
             Err(HeaderError::MissingVersion)
         );
-        let err = parse_fields(fields(&[" evt 2.1"]), 0).unwrap_err();
+        let err = parse_fields(fields(&[" evt 4.0"]), 0).unwrap_err();
         assert!(err.to_string().contains("`evt`"), "{err}");
         let err = parse_fields(fields(&[" evt 3.0", " geometry 12"]), 0).unwrap_err();
         assert!(err.to_string().contains("`geometry`"), "{err}");
         let err = parse_fields(fields(&[" format EVT3;width=12"]), 0).unwrap_err();
         assert!(err.to_string().contains("`format`"), "{err}");
+        let header = parse_fields(fields(&[" evt 2.1", " geometry 64x32"]), 0).unwrap();
+        assert_eq!(header.version, EvtVersion::Evt21);
     }
 }

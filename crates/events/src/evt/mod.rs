@@ -1,4 +1,4 @@
-//! Prophesee EVT 2.0 and EVT 3.0 raw files (with their `%` text header).
+//! Prophesee EVT 2.0, EVT 2.1 and EVT 3.0 raw files (with their `%` text header).
 //!
 //! [`EvtReader`] streams any [`Read`]: it parses the header, then decodes fixed-size reads into
 //! reused event and trigger buffers, carrying a word that straddles two reads over to the next.
@@ -20,22 +20,19 @@
 //! ```
 
 mod evt2;
+mod evt21;
 mod evt3;
 mod header;
 
 use std::fs::File;
-use std::io::{ErrorKind, Read};
+use std::io::Read;
 use std::path::Path;
 
 pub use header::{EvtVersion, Header, HeaderError};
 
 use crate::check::{CheckError, EventCheck};
+use crate::text_header::{self, HeaderReadError, TextHeader, read_some};
 use crate::{Event, Resolution, Trigger};
-
-/// Bytes asked of the source per read.
-const READ_SIZE: usize = 1 << 16;
-/// A header longer than this is not an EVT header.
-const MAX_HEADER: usize = 1 << 20;
 
 /// What can go wrong reading an EVT file.
 #[derive(Debug, thiserror::Error)]
@@ -101,10 +98,11 @@ pub struct EvtChunk<'a> {
 #[derive(Debug, Clone)]
 enum Decoder {
     Evt2(evt2::Evt2Decoder),
+    Evt21(evt21::Evt21Decoder),
     Evt3(evt3::Evt3Decoder),
 }
 
-/// A streaming EVT 2.0 / 3.0 reader over any [`Read`].
+/// A streaming EVT 2.0 / 2.1 / 3.0 reader over any [`Read`].
 #[derive(Debug)]
 pub struct EvtReader<R> {
     source: R,
@@ -135,71 +133,34 @@ impl<'a> EvtReader<&'a [u8]> {
     }
 }
 
-/// Reads into `buf`, retrying when interrupted; `Ok(0)` only at the end of the source.
-fn read_some(source: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
-    loop {
-        match source.read(buf) {
-            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-            other => return other,
-        }
-    }
-}
-
 impl<R: Read> EvtReader<R> {
     /// Reads and parses the header from `source`, leaving it at the first data byte.
     pub fn new(mut source: R) -> Result<Self, EvtError> {
-        let mut buf = vec![0u8; READ_SIZE];
-        let mut end = 0;
-        let mut pos = 0;
-        let mut fields = Vec::new();
-        loop {
-            // Make sure at least one byte past `pos` is buffered to see whether a line follows.
-            if pos == end {
-                if end == buf.len() {
-                    buf.resize(buf.len() * 2, 0);
-                }
-                let n = read_some(&mut source, &mut buf[end..])?;
-                if n == 0 {
-                    if end == 0 {
-                        return Err(EvtError::Empty);
-                    }
-                    break;
-                }
-                end += n;
-            }
-            if buf[pos] != b'%' {
-                break;
-            }
-            let Some(newline) = buf[pos..end].iter().position(|&b| b == b'\n') else {
-                // The line continues past what is buffered: read more (bounded).
-                if end >= MAX_HEADER {
-                    return Err(EvtError::TruncatedHeader { offset: end as u64 });
-                }
-                if end == buf.len() {
-                    buf.resize(buf.len() * 2, 0);
-                }
-                let n = read_some(&mut source, &mut buf[end..])?;
-                if n == 0 {
-                    return Err(EvtError::TruncatedHeader { offset: end as u64 });
-                }
-                end += n;
-                continue;
-            };
-            let line = &buf[pos + 1..pos + newline];
-            let line = line.strip_suffix(b"\r").unwrap_or(line);
-            let (key, value) = header::split_line(line);
-            pos += newline + 1;
-            if key == "end" {
-                break;
-            }
-            fields.push((key, value));
-        }
+        let TextHeader {
+            lines,
+            buf,
+            len: pos,
+            end,
+        } = text_header::read(&mut source, b'%', |line| {
+            header::split_line(line).0 == "end"
+        })
+        .map_err(|error| match error {
+            HeaderReadError::Io(error) => EvtError::Io(error),
+            HeaderReadError::Empty => EvtError::Empty,
+            HeaderReadError::Truncated(offset) => EvtError::TruncatedHeader { offset },
+        })?;
+        let fields = lines
+            .iter()
+            .map(|line| header::split_line(line))
+            .take_while(|(key, _)| key != "end")
+            .collect();
         if pos == 0 {
             return Err(EvtError::NoHeader);
         }
         let header = header::parse_fields(fields, pos as u64).map_err(EvtError::Header)?;
         let decoder = match header.version {
             EvtVersion::Evt2 => Decoder::Evt2(evt2::Evt2Decoder::default()),
+            EvtVersion::Evt21 => Decoder::Evt21(evt21::Evt21Decoder::default()),
             EvtVersion::Evt3 => Decoder::Evt3(evt3::Evt3Decoder::default()),
         };
         let check = EventCheck::new(header.resolution);
@@ -256,6 +217,10 @@ impl<R: Read> EvtReader<R> {
                 let summary = match &mut self.decoder {
                     Decoder::Evt2(d) => {
                         Some(d.decode(bytes, &mut self.events, &mut self.triggers, resolution))
+                    }
+                    Decoder::Evt21(d) => {
+                        d.decode(bytes, &mut self.events, &mut self.triggers);
+                        None
                     }
                     Decoder::Evt3(d) => {
                         d.decode(bytes, &mut self.events, &mut self.triggers);

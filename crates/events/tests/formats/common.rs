@@ -55,3 +55,65 @@ pub fn read_npy_events(path: &std::path::Path) -> Vec<Event> {
     }
     out
 }
+
+/// FNV-1a (64-bit) over the lines `t,x,y,p\n` of `events` (`p` 1 for ON, 0 for OFF): the digest
+/// that the Python writers in the tests compute over the events they encode.
+pub fn events_digest(events: &[Event]) -> u64 {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for e in events {
+        let line = format!("{},{},{},{}\n", e.t, e.x, e.y, u8::from(e.polarity));
+        for b in line.bytes() {
+            hash ^= u64::from(b);
+            hash = hash.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    hash
+}
+
+/// The same digest in Python, for the test scripts: `digest(events)` over `(t, x, y, p)` tuples.
+pub const PY_DIGEST: &str = r#"
+def digest(events):
+    h = 0xcbf29ce484222325
+    for t, x, y, p in events:
+        for b in f"{t},{x},{y},{p}\n".encode():
+            h ^= b
+            h = (h * 0x100000001b3) % (1 << 64)
+    return h
+"#;
+
+/// The figures a test's independent writer states about the events it wrote, and that the
+/// reader must reproduce: `count first_t last_t on digest` on one line.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Figures {
+    pub count: usize,
+    pub first_t: i64,
+    pub last_t: i64,
+    pub on: usize,
+    pub digest: u64,
+}
+
+impl Figures {
+    /// The figures of decoded events.
+    pub fn of(events: &[Event]) -> Self {
+        Self {
+            count: events.len(),
+            first_t: events.first().map_or(-1, |e| e.t),
+            last_t: events.last().map_or(-1, |e| e.t),
+            on: events.iter().filter(|e| e.polarity).count(),
+            digest: events_digest(events),
+        }
+    }
+
+    /// Parses the line `count first_t last_t on digest` a script printed.
+    pub fn parse(line: &str) -> Self {
+        let v: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(v.len(), 5, "figures line `{line}`");
+        Self {
+            count: v[0].parse().unwrap(),
+            first_t: v[1].parse().unwrap(),
+            last_t: v[2].parse().unwrap(),
+            on: v[3].parse().unwrap(),
+            digest: v[4].parse().unwrap(),
+        }
+    }
+}

@@ -2,10 +2,12 @@
 //! format, and the bad-input matrix over every reader (`bad_input.rs`; the AEDAT4 codec's own
 //! tests live in `tests/aedat.rs`).
 
+mod aedat_legacy;
 mod alloc;
 mod bad_input;
 mod common;
 mod csv;
 mod evt;
+mod evt21;
 mod npy;
 mod recording;

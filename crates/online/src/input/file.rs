@@ -5,8 +5,8 @@ use crate::Notice;
 use evtac_events::{Event, EventReader, Resolution};
 use std::path::Path;
 
-/// Streams the events of an AEDAT4, EVT 2.0/3.0, CSV or NPY file (IMU samples and triggers are
-/// skipped).
+/// Streams the events of an AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0, CSV or NPY file (IMU samples and
+/// triggers are skipped).
 #[derive(Debug)]
 pub struct FileSource {
     reader: EventReader,

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 /// An input named on the command line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum SourceSpec {
-    /// A recording on disk (AEDAT4, EVT 2.0/3.0, CSV or NPY; format by extension or magic).
+    /// A recording on disk (AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0, CSV or NPY; format by extension or magic).
     File(PathBuf),
     /// A live AEDAT4 network stream (DV software's network output, dv-processing's
     /// `NetworkWriter`), reached over TCP.
