@@ -13,6 +13,7 @@
 
 use pyo3::prelude::*;
 
+pub mod dataset;
 pub mod error;
 pub mod io;
 pub mod model;
@@ -25,6 +26,10 @@ fn _evtac(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(io::read, m)?)?;
     m.add_function(wrap_pyfunction!(io::write, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::labels, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::label_trial, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::dataset_features, m)?)?;
     m.add_class::<io::Recording>()?;
     m.add_class::<io::Reader>()?;
     m.add_class::<representation::Representation>()?;

@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Iterator, Mapping, Optional, Tuple, Union
+from dataclasses import dataclass
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -49,6 +50,12 @@ __all__ = [
     "Representation",
     "Model",
     "Estimator",
+    "LABEL_DTYPE",
+    "simulate",
+    "labels",
+    "label_trial",
+    "DatasetFeatures",
+    "dataset_features",
 ]
 
 #: Events: evtac's NPY event dtype (packed, 13 bytes).
@@ -62,6 +69,11 @@ TRIGGER_DTYPE = np.dtype([("t", "<i8"), ("kind", "i1")])
 #: Online estimates: grid time (us), pitch and roll (deg), processing latency (us).
 ESTIMATE_DTYPE = np.dtype(
     [("t_us", "<i8"), ("pitch_deg", "<f4"), ("roll_deg", "<f4"), ("latency_us", "<f8")]
+)
+
+#: Labels: time (us), tilt magnitude, contact pitch and roll (deg), as `labels/<trial>.csv`.
+LABEL_DTYPE = np.dtype(
+    [("t_us", "<i8"), ("theta_deg", "<f8"), ("pitch_deg", "<f8"), ("roll_deg", "<f8")]
 )
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -369,3 +381,80 @@ class Estimator:
         """Events received, inside the crop, and skipped as out of order."""
         events, in_roi, out_of_order = self._inner.counters
         return {"events": events, "events_in_roi": in_roi, "events_out_of_order": out_of_order}
+
+
+def simulate(
+    protocol: str,
+    out: PathLike,
+    scale: str = "small",
+    seed: int = 0,
+    limit: Optional[int] = None,
+    params: Optional[Mapping[str, Any]] = None,
+) -> int:
+    """Simulates a protocol into the dataset folder ``out``, as ``evtac simulate``.
+
+    ``protocol``: ``exp1``, ``exp2``, ``exp3-speed``, ``exp3-depth`` or ``no-contact``;
+    ``scale``: ``tiny``, ``small`` or ``paper``; the same seed gives the same bytes. ``limit``
+    keeps the first trials only; ``params`` overrides simulator parameters (the ``params`` of a
+    ``simulator.json``). Returns the number of trials written.
+    """
+    return _evtac.simulate(
+        protocol, os.fspath(out), scale, int(seed), limit,
+        None if params is None else json.dumps(params),
+    )
+
+
+def labels(dataset_dir: PathLike, **settings: Any) -> Mapping[str, Any]:
+    """Labels every trial of a dataset, as ``evtac labels``: writes ``labels/<trial>.csv``.
+
+    ``settings`` are ``evtac_labels::LabelConfig`` fields (e.g. ``cutoff_hz``, ``scale``).
+    Returns the per-trial reports and summaries that ``evtac labels --json`` prints.
+    """
+    return json.loads(_evtac.labels(os.fspath(dataset_dir), json.dumps(settings)))
+
+
+def label_trial(dataset_dir: PathLike, trial: str, **settings: Any) -> np.ndarray:
+    """The labels of one trial of a dataset, in memory (:data:`LABEL_DTYPE`)."""
+    t, theta, pitch, roll = _evtac.label_trial(os.fspath(dataset_dir), trial, json.dumps(settings))
+    out = np.empty(len(t), LABEL_DTYPE)
+    out["t_us"], out["theta_deg"], out["pitch_deg"], out["roll_deg"] = t, theta, pitch, roll
+    return out
+
+
+@dataclass(frozen=True)
+class DatasetFeatures:
+    """A dataset's samples as training sees them (see :func:`dataset_features`)."""
+
+    #: float32 ``(N, 900)``.
+    features: np.ndarray
+    #: float32 ``(N, 2)``: pitch and roll in degrees.
+    labels: np.ndarray
+    #: int64 ``(N,)``: index of each sample's trial in :attr:`trials`.
+    trial: np.ndarray
+    #: int64 ``(N,)``: sample time in microseconds.
+    t_us: np.ndarray
+    #: bool ``(N,)``: whether the sample is from the stop phase.
+    stop: np.ndarray
+    #: The trial names.
+    trials: Tuple[str, ...]
+
+
+def dataset_features(
+    dataset_dir: PathLike,
+    representation: Optional[Representation] = None,
+    trials: Optional[Sequence[str]] = None,
+    motion_points: int = 50,
+    stop_points: int = 10,
+) -> DatasetFeatures:
+    """The features and labels of a dataset's trials, through its feature cache, as training
+    reads them: ``motion_points`` per trial's motion phase and ``stop_points`` per stop phase,
+    computed and cached under ``cache/`` when missing. ``representation`` (default combined) gives
+    the config; the mask comes from the dataset's ``no_contact.aedat4``. ``trials``: names
+    (default: all, in manifest order).
+    """
+    representation = representation or Representation()
+    features, labels, trial, t_us, stop, names = _evtac.dataset_features(
+        os.fspath(dataset_dir), representation._inner,
+        None if trials is None else list(trials), motion_points, stop_points,
+    )
+    return DatasetFeatures(features, labels, trial, t_us, stop, tuple(names))

@@ -97,3 +97,32 @@ class Estimator:
     def __init__(self, model: Model, sensor: _Size, interval_us: int) -> None: ...
     def push(self, events: _Bytes, horizon_us: Optional[int] = None) -> np.ndarray: ...
     def finish(self) -> np.ndarray: ...
+
+def simulate(
+    protocol: str,
+    out: _Path,
+    scale: str = "small",
+    seed: int = 0,
+    limit: Optional[int] = None,
+    params_json: Optional[str] = None,
+) -> int: ...
+def labels(dataset_dir: _Path, config_json: str = "{}") -> str: ...
+def label_trial(
+    dataset_dir: _Path, trial: str, config_json: str = "{}"
+) -> Tuple[
+    npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]
+]: ...
+def dataset_features(
+    dataset_dir: _Path,
+    representation: Representation,
+    trials: Optional[list[str]] = None,
+    motion_points: int = 50,
+    stop_points: int = 10,
+) -> Tuple[
+    npt.NDArray[np.float32],
+    npt.NDArray[np.float32],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.bool_],
+    list[str],
+]: ...
