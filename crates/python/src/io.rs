@@ -162,7 +162,7 @@ pub fn read(
 
 /// A large event file read chunk by chunk (iterate it: each item is a `Recording` of one
 /// chunk of at least `chunk_events` events, the last one shorter).
-#[pyclass(module = "evtac._evtac")]
+#[pyclass(frozen, module = "evtac._evtac")]
 pub struct Reader {
     inner: Mutex<ReaderState>,
     /// The file's format.

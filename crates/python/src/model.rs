@@ -110,7 +110,7 @@ impl Model {
 }
 
 /// The online estimator: events in, estimates out as they become final.
-#[pyclass(module = "evtac._evtac")]
+#[pyclass(frozen, module = "evtac._evtac")]
 pub struct Estimator {
     inner: Mutex<evtac_online::Estimator>,
 }

@@ -92,7 +92,7 @@ pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
 }
 
 /// A representation on a crop of a sensor, with its incremental state.
-#[pyclass(module = "evtac._evtac")]
+#[pyclass(frozen, module = "evtac._evtac")]
 pub struct Representation {
     config: ReprConfig,
     /// The sensor events come from; `None`: events are already in crop coordinates.
