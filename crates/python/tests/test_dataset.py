@@ -16,7 +16,7 @@ def datasets(cli, tmp_path_factory):
     by_cli, by_python = root / "cli", root / "python"
     cli("simulate", "--protocol", "exp2", "--scale", "tiny", "--seed", "11", "--out", by_cli,
         "--limit", "2")
-    assert evtac.simulate("exp2", by_python, scale="tiny", seed=11, limit=2) == 2
+    assert evtac.simulate("exp2", "tiny", 11, by_python, limit=2) == 2
     return by_cli, by_python
 
 
@@ -56,9 +56,9 @@ def test_label_trial_is_the_written_csv(cli, datasets):
 
 def test_errors(tmp_path, datasets):
     with pytest.raises(ValueError, match="exp9"):
-        evtac.simulate("exp9", tmp_path / "x", scale="tiny")
+        evtac.simulate("exp9", "tiny", 0, tmp_path / "x")
     with pytest.raises(ValueError, match="huge"):
-        evtac.simulate("exp1", tmp_path / "x", scale="huge")
+        evtac.simulate("exp1", "huge", 0, tmp_path / "x")
     with pytest.raises(OSError, match="trials.csv"):
         evtac.labels(tmp_path / "empty")
     with pytest.raises(ValueError, match="no trial `nope`"):

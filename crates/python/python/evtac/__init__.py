@@ -385,9 +385,9 @@ class Estimator:
 
 def simulate(
     protocol: str,
+    scale: str,
+    seed: int,
     out: PathLike,
-    scale: str = "small",
-    seed: int = 0,
     limit: Optional[int] = None,
     params: Optional[Mapping[str, Any]] = None,
 ) -> int:
