@@ -55,6 +55,8 @@ def test_features_and_frames_are_the_clis(cli, tmp_path, aedat, recording, times
     assert features.dtype == np.float32 and features.shape == (len(times), 900)
     assert features.tobytes() == expected.tobytes()
     assert features.any(), "a test on all-zero features could not tell much"
+    # Handed over from Rust without a copy: numpy does not own the buffer.
+    assert not features.flags["OWNDATA"] and features.flags["C_CONTIGUOUS"]
     frames = rep.frames(recording.events, times)
     expected = _cli_output(cli, tmp_path, aedat, times, kind, options, "frames")
     assert frames.dtype == np.uint8 and frames.shape == (len(times), 240, 240)
