@@ -4,11 +4,20 @@
 //! an array, an unordered event) is a `ValueError`.
 
 use pyo3::PyErr;
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 
 /// An `OSError` carrying `err`'s message.
 pub fn file(err: impl std::fmt::Display) -> PyErr {
     PyOSError::new_err(err.to_string())
+}
+
+/// An `OSError` carrying `err`'s message, as the subclass `FileNotFoundError` when `io` says
+/// the file is missing (what Python's own `open` raises).
+pub fn io(err: impl std::fmt::Display, io: &std::io::Error) -> PyErr {
+    match io.kind() {
+        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(err.to_string()),
+        _ => file(err),
+    }
 }
 
 /// A `ValueError` carrying `err`'s message.

@@ -19,6 +19,7 @@ pub fn events_error(err: evtac_events::Error) -> PyErr {
         evtac_events::Error::NotWritable { .. }
         | evtac_events::Error::MissingResolution { .. }
         | evtac_events::Error::ResolutionMismatch { .. } => error::value(err),
+        evtac_events::Error::Io { ref error, .. } => error::io(&err, error),
         _ => error::file(err),
     }
 }

@@ -107,7 +107,7 @@ def test_written_npy_is_numpy_readable_and_other_dtypes_convert(tmp_path):
 
 
 def test_missing_and_corrupt_files_are_os_errors(tmp_path, aedat):
-    with pytest.raises(OSError, match="nothing-here.aedat4"):
+    with pytest.raises(FileNotFoundError, match="nothing-here.aedat4"):
         evtac.read(tmp_path / "nothing-here.aedat4")
     broken = tmp_path / "broken.aedat4"
     broken.write_bytes(aedat.read_bytes()[:5000])
