@@ -57,8 +57,8 @@ pub enum LegacyError {
     NotAedat,
     /// The version line names a version evtac does not read here.
     #[error(
-        "the header says AEDAT `{version}`; this reader reads AEDAT 2.0 and 3.1 (AEDAT 4.0 has \
-         its own)"
+        "line 1: the version field after `#!AER-DAT` says `{version}`; evtac reads AEDAT 2.0, \
+         3.1 and 4.0 (`#!AER-DAT4.0` and a line break)"
     )]
     UnsupportedVersion {
         /// The version as written after `#!AER-DAT`.
