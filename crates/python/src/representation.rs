@@ -187,6 +187,28 @@ impl Representation {
         fx.run(&cropped, times, visit).map_err(error::value)
     }
 
+    /// What `read` gives at each of `times` (`per_sample` values each), concatenated, with the
+    /// interpreter released while the representation runs: the shared body of `features`,
+    /// `frames` and `potentials`. Returns the number of samples with the values.
+    fn sampled<T: Copy + Send + Sync>(
+        &self,
+        py: Python<'_>,
+        events: &PyReadonlyArray1<'_, u8>,
+        times: &PyReadonlyArray1<'_, i64>,
+        per_sample: usize,
+        read: impl Fn(&FeatureExtractor) -> &[T] + Sync,
+    ) -> PyResult<(usize, Vec<T>)> {
+        let (events, times) = (
+            events.as_slice().map_err(error::value)?,
+            times.as_slice().map_err(error::value)?,
+        );
+        py.detach(|| {
+            let mut out = Vec::with_capacity(times.len() * per_sample);
+            self.run(events, times, |_, fx| out.extend_from_slice(read(fx)))?;
+            Ok((times.len(), out))
+        })
+    }
+
     fn frame_dims(&self) -> (usize, usize) {
         (
             usize::from(self.roi.size.height),
@@ -250,16 +272,9 @@ impl Representation {
         events: PyReadonlyArray1<'py, u8>,
         times: PyReadonlyArray1<'py, i64>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let (events, times) = (
-            events.as_slice().map_err(error::value)?,
-            times.as_slice().map_err(error::value)?,
-        );
         let len = self.state()?.feature_len();
-        let out = py.detach(|| -> PyResult<_> {
-            let mut out = Vec::with_capacity(times.len() * len);
-            self.run(events, times, |_, fx| out.extend_from_slice(fx.features(0)))?;
-            Array2::from_shape_vec((times.len(), len), out).map_err(error::value)
-        })?;
+        let (n, out) = self.sampled(py, &events, &times, len, |fx| fx.features(0))?;
+        let out = Array2::from_shape_vec((n, len), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))
     }
 
@@ -270,16 +285,9 @@ impl Representation {
         events: PyReadonlyArray1<'py, u8>,
         times: PyReadonlyArray1<'py, i64>,
     ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        let (events, times) = (
-            events.as_slice().map_err(error::value)?,
-            times.as_slice().map_err(error::value)?,
-        );
         let (h, w) = self.frame_dims();
-        let out = py.detach(|| -> PyResult<_> {
-            let mut out = Vec::with_capacity(times.len() * h * w);
-            self.run(events, times, |_, fx| out.extend_from_slice(fx.frame(0)))?;
-            Array3::from_shape_vec((times.len(), h, w), out).map_err(error::value)
-        })?;
+        let (n, out) = self.sampled(py, &events, &times, h * w, |fx| fx.frame(0))?;
+        let out = Array3::from_shape_vec((n, h, w), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))
     }
 
@@ -295,18 +303,11 @@ impl Representation {
                 "a dynamic representation has no potentials (static and combined have)",
             ));
         }
-        let (events, times) = (
-            events.as_slice().map_err(error::value)?,
-            times.as_slice().map_err(error::value)?,
-        );
         let (h, w) = self.frame_dims();
-        let out = py.detach(|| -> PyResult<_> {
-            let mut out = Vec::with_capacity(times.len() * h * w);
-            self.run(events, times, |_, fx| {
-                out.extend_from_slice(fx.potentials(0).unwrap_or_default());
-            })?;
-            Array3::from_shape_vec((times.len(), h, w), out).map_err(error::value)
+        let (n, out) = self.sampled(py, &events, &times, h * w, |fx| {
+            fx.potentials(0).unwrap_or_default()
         })?;
+        let out = Array3::from_shape_vec((n, h, w), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))
     }
 
