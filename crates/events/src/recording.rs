@@ -411,9 +411,13 @@ impl EventReader {
         let (Some((from, to)), Some(chunk)) = (range, chunk) else {
             return Ok(chunk);
         };
-        // Time never goes backwards in these formats: once an event reaches `to`, the range is
-        // over.
-        self.past_range = chunk.events.last().is_some_and(|e| e.t >= to);
+        // Time never goes backwards within a stream: once an event reaches `to` (plus the lag
+        // by which the format's other streams may trail the events), the range is over.
+        let lag = stream_lag_us(self.format);
+        self.past_range = chunk
+            .events
+            .last()
+            .is_some_and(|e| e.t >= to.saturating_add(lag));
         Ok(Some(chunk.within(from, to)))
     }
 
@@ -444,6 +448,23 @@ impl EventReader {
             imu,
             triggers,
         })
+    }
+}
+
+/// How far (us) IMU samples and triggers may come after events of a later time, in the file
+/// order of `format`: a range read keeps reading that far past its end.
+///
+/// EVT, CSV and NPY hold one time-ordered stream, and AEDAT 2.0 only events. AEDAT 3.1 stores
+/// one packet per event type: cAER writes the polarity, IMU and special packets of a *packet
+/// container* one after another, each spanning the container's interval (libcaer's
+/// `PacketContainerInterval`, 10 ms by default, at most a few hundred ms in any setup seen),
+/// so an IMU packet may follow a polarity packet that already ends past the range. One second
+/// covers that with a wide margin and costs one second of decoding per range read. (AEDAT4 is
+/// read through its own range logic, stream by stream.)
+fn stream_lag_us(format: Format) -> i64 {
+    match format {
+        Format::Aedat31 => 1_000_000,
+        _ => 0,
     }
 }
 

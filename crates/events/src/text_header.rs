@@ -1,6 +1,7 @@
 //! The text headers that EVT (`%` lines) and AEDAT 2.0 / 3.1 (`#` lines) files start with: lines
 //! that begin with a marker byte, read from any [`Read`] up to the first line that does not (or
-//! up to a closing line), with the bytes read past the header kept for the data reader.
+//! up to a closing line), with the bytes read past the header kept for the data reader; and the
+//! [`DataBuffer`] both kinds of readers then decode from.
 
 use std::io::{ErrorKind, Read};
 
@@ -114,4 +115,64 @@ fn read_more(
         buf.resize(buf.len() * 2, 0);
     }
     Ok(read_some(source, &mut buf[end..])?)
+}
+
+/// The data after a text header, read in blocks of [`READ_SIZE`] into one reused buffer: the EVT
+/// and AEDAT 2.0 / 3.1 readers decode the whole units (words, records, packets) at its front and
+/// [`refill`](Self::refill) carries a unit that straddles two reads over to the next.
+#[derive(Debug)]
+pub(crate) struct DataBuffer<R> {
+    source: R,
+    buf: Vec<u8>,
+    /// Unconsumed bytes are `buf[start..end]`.
+    start: usize,
+    end: usize,
+    /// File offset of `buf[start]`.
+    offset: u64,
+}
+
+impl<R: Read> DataBuffer<R> {
+    /// The data of `source` after `header` (whose buffer already holds its first bytes).
+    pub(crate) fn after(source: R, header: &mut TextHeader) -> Self {
+        Self {
+            source,
+            buf: std::mem::take(&mut header.buf),
+            start: header.len,
+            end: header.end,
+            offset: header.len as u64,
+        }
+    }
+
+    /// The bytes read and not yet consumed.
+    pub(crate) fn bytes(&self) -> &[u8] {
+        &self.buf[self.start..self.end]
+    }
+
+    /// File offset of the first unconsumed byte.
+    pub(crate) fn offset(&self) -> u64 {
+        self.offset
+    }
+
+    /// Bytes of the source read so far (header included).
+    pub(crate) fn position(&self) -> u64 {
+        self.offset + (self.end - self.start) as u64
+    }
+
+    /// Marks the first `n` unconsumed bytes as decoded.
+    pub(crate) fn consume(&mut self, n: usize) {
+        debug_assert!(n <= self.end - self.start);
+        self.start += n;
+        self.offset += n as u64;
+    }
+
+    /// Moves the unconsumed bytes (a partial unit) to the front and reads more behind them;
+    /// returns the bytes read, 0 at the end of the source.
+    pub(crate) fn refill(&mut self) -> std::io::Result<usize> {
+        self.buf.copy_within(self.start..self.end, 0);
+        self.end -= self.start;
+        self.start = 0;
+        let n = read_some(&mut self.source, &mut self.buf[self.end..])?;
+        self.end += n;
+        Ok(n)
+    }
 }

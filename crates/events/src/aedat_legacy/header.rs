@@ -18,6 +18,16 @@ pub enum Version {
     Aedat31,
 }
 
+impl Version {
+    /// The version as the first line writes it after `#!AER-DAT`.
+    pub fn number(self) -> &'static str {
+        match self {
+            Self::Aedat2 => "2.0",
+            Self::Aedat31 => "3.1",
+        }
+    }
+}
+
 impl std::fmt::Display for Version {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
@@ -80,10 +90,19 @@ pub(crate) fn parse(lines: Vec<String>, len: u64) -> Result<Header, LegacyError>
         Some(Err(version)) => return Err(LegacyError::UnsupportedVersion { version }),
         Some(Ok(v)) => v,
     };
+    // `sniff` reads up to the first line break; the version line must hold nothing more (a
+    // damaged line break would otherwise swallow the next header line unnoticed).
+    let written = first["#!AER-DAT".len()..].trim();
+    if written != version.number() {
+        return Err(LegacyError::UnsupportedVersion {
+            version: written.escape_debug().to_string(),
+        });
+    }
+    // The first line with `key:`, as (1-based line number, trimmed value).
     let value = |key: &str| {
-        lines.iter().find_map(|l| {
+        lines.iter().enumerate().find_map(|(i, l)| {
             let (k, v) = l.split_once(':')?;
-            (k.trim() == key).then(|| v.trim().to_string())
+            (k.trim() == key).then(|| (i + 1, v.trim().to_string()))
         })
     };
     let (camera, resolution) = match version {
@@ -91,21 +110,26 @@ pub(crate) fn parse(lines: Vec<String>, len: u64) -> Result<Header, LegacyError>
             let camera = value("AEChip");
             let resolution = match &camera {
                 None => Resolution::new(240, 180),
-                Some(chip) => match known_camera(chip) {
+                Some((line, chip)) => match known_camera(chip) {
                     Some(r) if !chip.to_ascii_lowercase().contains("dvs128") => r,
-                    _ => return Err(LegacyError::UnsupportedChip { chip: chip.clone() }),
+                    _ => {
+                        return Err(LegacyError::UnsupportedChip {
+                            line: *line,
+                            chip: chip.clone(),
+                        });
+                    }
                 },
             };
-            (camera, Some(resolution))
+            (camera.map(|(_, chip)| chip), Some(resolution))
         }
         Version::Aedat31 => {
             if lines.last().is_none_or(|l| l != "!END-HEADER") {
                 return Err(LegacyError::TruncatedHeader { offset: len });
             }
             match value("Format") {
-                Some(f) if f.eq_ignore_ascii_case("RAW") => {}
+                Some((_, f)) if f.eq_ignore_ascii_case("RAW") => {}
                 None => {}
-                Some(value) => return Err(LegacyError::UnsupportedFormat { value }),
+                Some((line, value)) => return Err(LegacyError::UnsupportedFormat { line, value }),
             }
             let camera = lines.iter().find_map(|l| {
                 let (k, v) = l.split_once(':')?;
@@ -176,5 +200,8 @@ mod tests {
             err(&["!AER-DAT3.1", "Format: SerializedTS", "!END-HEADER"]).contains("SerializedTS")
         );
         assert!(err(&["!AER-DAT3.1", "Source 1: DAVIS240C"]).contains("cut off at byte 5"));
+        // A line break damaged into another byte joins two lines: the version line says more.
+        assert!(err(&["!AER-DAT3.1\r\u{f5}Format: RAW", "!END-HEADER"]).contains("line 1"));
+        assert!(err(&["!AER-DAT3.1", "Format: LZ4", "!END-HEADER"]).contains("line 2"));
     }
 }

@@ -39,7 +39,7 @@ use std::path::Path;
 pub use header::{Header, Version, sniff};
 
 use crate::check::{CheckError, EventCheck};
-use crate::text_header::{self, HeaderReadError, TextHeader, read_some};
+use crate::text_header::{self, DataBuffer, HeaderReadError};
 use crate::{Event, ImuSample, Resolution, Trigger};
 
 /// What can go wrong reading an AEDAT 2.0 or 3.1 file.
@@ -72,18 +72,23 @@ pub enum LegacyError {
     },
     /// An AEDAT 2.0 header names a camera whose address layout evtac does not decode.
     #[error(
-        "the header names the camera `{chip}`; evtac decodes AEDAT 2.0 from DAVIS240 and DAVIS346 \
-         cameras only"
+        "line {line}: the `# AEChip:` field names the camera `{chip}`; evtac decodes AEDAT 2.0 \
+         from DAVIS240 and DAVIS346 cameras only"
     )]
     UnsupportedChip {
+        /// The header line (1-based).
+        line: usize,
         /// The camera class named by the `# AEChip:` line.
         chip: String,
     },
     /// An AEDAT 3.1 header declares a data encoding other than `RAW`.
     #[error(
-        "the header declares `#Format: {value}`; evtac reads the RAW (uncompressed) format only"
+        "line {line}: the `#Format:` field says `{value}`; evtac reads the RAW (uncompressed) \
+         format only"
     )]
     UnsupportedFormat {
+        /// The header line (1-based).
+        line: usize,
         /// The declared format.
         value: String,
     },
@@ -191,15 +196,9 @@ enum Decoder {
 /// A streaming AEDAT 2.0 / 3.1 reader over any [`Read`].
 #[derive(Debug)]
 pub struct LegacyReader<R> {
-    source: R,
+    data: DataBuffer<R>,
     header: Header,
     decoder: Decoder,
-    buf: Vec<u8>,
-    /// Unconsumed bytes are `buf[start..end]`.
-    start: usize,
-    end: usize,
-    /// File offset of `buf[start]`.
-    offset: u64,
     out: Out,
     check: EventCheck,
 }
@@ -221,35 +220,26 @@ impl<'a> LegacyReader<&'a [u8]> {
 impl<R: Read> LegacyReader<R> {
     /// Reads and parses the header from `source`, leaving it at the first data byte.
     pub fn new(mut source: R) -> Result<Self, LegacyError> {
-        let TextHeader {
-            lines,
-            buf,
-            len: pos,
-            end,
-        } = text_header::read(&mut source, b'#', |line| line == b"!END-HEADER").map_err(
-            |error| match error {
+        let mut text = text_header::read(&mut source, b'#', |line| line == b"!END-HEADER")
+            .map_err(|error| match error {
                 HeaderReadError::Io(error) => LegacyError::Io(error),
                 HeaderReadError::Empty => LegacyError::Empty,
                 HeaderReadError::Truncated(offset) => LegacyError::TruncatedHeader { offset },
-            },
-        )?;
-        let lines = lines
+            })?;
+        let lines = text
+            .lines
             .iter()
             .map(|line| String::from_utf8_lossy(line).into_owned())
             .collect();
-        let header = header::parse(lines, pos as u64)?;
+        let header = header::parse(lines, text.len as u64)?;
         let decoder = match header.version {
             Version::Aedat2 => Decoder::V2(v2::Decoder::new(header.resolution)),
             Version::Aedat31 => Decoder::V3(v3::Decoder::default()),
         };
         let check = EventCheck::new(header.resolution);
         Ok(Self {
-            source,
+            data: DataBuffer::after(source, &mut text),
             decoder,
-            buf,
-            start: pos,
-            end,
-            offset: header.len,
             out: Out::default(),
             check,
             header,
@@ -275,7 +265,7 @@ impl<R: Read> LegacyReader<R> {
 
     /// Bytes of the source consumed so far (header included).
     pub fn position(&self) -> u64 {
-        self.offset + (self.end - self.start) as u64
+        self.data.position()
     }
 
     /// Decodes the next chunk; `Ok(None)` at the end of the data. Chunks hold at least one
@@ -283,15 +273,14 @@ impl<R: Read> LegacyReader<R> {
     pub fn next_chunk(&mut self) -> Result<Option<LegacyChunk<'_>>, LegacyError> {
         self.out.clear();
         loop {
-            let bytes = &self.buf[self.start..self.end];
+            let (bytes, at) = (self.data.bytes(), self.data.offset());
             let used = match &mut self.decoder {
-                Decoder::V2(d) => d.decode(bytes, self.offset, &mut self.out)?,
-                Decoder::V3(d) => d.decode(bytes, self.offset, &mut self.out)?,
+                Decoder::V2(d) => d.decode(bytes, at, &mut self.out)?,
+                Decoder::V3(d) => d.decode(bytes, at, &mut self.out)?,
             };
-            self.start += used;
-            self.offset += used as u64;
+            self.data.consume(used);
             if used > 0 {
-                let offset = self.offset;
+                let offset = self.data.offset();
                 self.check
                     .check(&self.out.events)
                     .map_err(|error| LegacyError::Event { error, offset })?;
@@ -305,20 +294,15 @@ impl<R: Read> LegacyReader<R> {
                 continue;
             }
             // Carry the partial record to the front and read more behind it.
-            let available = self.end - self.start;
-            self.buf.copy_within(self.start..self.end, 0);
-            self.start = 0;
-            self.end = available;
-            let n = read_some(&mut self.source, &mut self.buf[self.end..])?;
-            if n == 0 {
-                let len = self.offset + available as u64;
+            if self.data.refill()? == 0 {
+                let (available, at) = (self.data.bytes().len(), self.data.offset());
+                let len = at + available as u64;
                 return match &self.decoder {
-                    Decoder::V2(d) => d.finish(available, self.offset, len),
-                    Decoder::V3(d) => d.finish(available, self.offset, len),
+                    Decoder::V2(d) => d.finish(available, at, len),
+                    Decoder::V3(d) => d.finish(available, at, len),
                 }
                 .map(|()| None);
             }
-            self.end += n;
         }
     }
 }

@@ -31,7 +31,7 @@ use std::path::Path;
 pub use header::{EvtVersion, Header, HeaderError};
 
 use crate::check::{CheckError, EventCheck};
-use crate::text_header::{self, HeaderReadError, TextHeader, read_some};
+use crate::text_header::{self, DataBuffer, HeaderReadError};
 use crate::{Event, Resolution, Trigger};
 
 /// What can go wrong reading an EVT file.
@@ -105,15 +105,9 @@ enum Decoder {
 /// A streaming EVT 2.0 / 2.1 / 3.0 reader over any [`Read`].
 #[derive(Debug)]
 pub struct EvtReader<R> {
-    source: R,
+    data: DataBuffer<R>,
     header: Header,
     decoder: Decoder,
-    buf: Vec<u8>,
-    /// Unconsumed bytes are `buf[start..end]`.
-    start: usize,
-    end: usize,
-    /// File offset of `buf[start]`.
-    offset: u64,
     events: Vec<Event>,
     triggers: Vec<Trigger>,
     check: EventCheck,
@@ -136,12 +130,7 @@ impl<'a> EvtReader<&'a [u8]> {
 impl<R: Read> EvtReader<R> {
     /// Reads and parses the header from `source`, leaving it at the first data byte.
     pub fn new(mut source: R) -> Result<Self, EvtError> {
-        let TextHeader {
-            lines,
-            buf,
-            len: pos,
-            end,
-        } = text_header::read(&mut source, b'%', |line| {
+        let mut text = text_header::read(&mut source, b'%', |line| {
             header::split_line(line).0 == "end"
         })
         .map_err(|error| match error {
@@ -149,15 +138,16 @@ impl<R: Read> EvtReader<R> {
             HeaderReadError::Empty => EvtError::Empty,
             HeaderReadError::Truncated(offset) => EvtError::TruncatedHeader { offset },
         })?;
-        let fields = lines
+        let fields = text
+            .lines
             .iter()
             .map(|line| header::split_line(line))
             .take_while(|(key, _)| key != "end")
             .collect();
-        if pos == 0 {
+        if text.len == 0 {
             return Err(EvtError::NoHeader);
         }
-        let header = header::parse_fields(fields, pos as u64).map_err(EvtError::Header)?;
+        let header = header::parse_fields(fields, text.len as u64).map_err(EvtError::Header)?;
         let decoder = match header.version {
             EvtVersion::Evt2 => Decoder::Evt2(evt2::Evt2Decoder::default()),
             EvtVersion::Evt21 => Decoder::Evt21(evt21::Evt21Decoder::default()),
@@ -165,12 +155,8 @@ impl<R: Read> EvtReader<R> {
         };
         let check = EventCheck::new(header.resolution);
         Ok(Self {
-            source,
+            data: DataBuffer::after(source, &mut text),
             decoder,
-            buf,
-            start: pos,
-            end,
-            offset: header.len,
             events: Vec::new(),
             triggers: Vec::new(),
             check,
@@ -197,7 +183,7 @@ impl<R: Read> EvtReader<R> {
 
     /// Bytes of the source consumed so far (header included).
     pub fn position(&self) -> u64 {
-        self.offset + (self.end - self.start) as u64
+        self.data.position()
     }
 
     /// Decodes the next chunk; `Ok(None)` at the end of the data. Chunks hold at least one event
@@ -207,10 +193,10 @@ impl<R: Read> EvtReader<R> {
         self.events.clear();
         self.triggers.clear();
         loop {
-            let available = self.end - self.start;
+            let available = self.data.bytes().len();
             let whole = available - available % word;
             if whole > 0 {
-                let bytes = &self.buf[self.start..self.start + whole];
+                let bytes = &self.data.bytes()[..whole];
                 // `events` is empty before each decode (the loop goes round again only when
                 // nothing was decoded), so an EVT2 summary covers every event checked.
                 let resolution = self.check.resolution();
@@ -227,9 +213,8 @@ impl<R: Read> EvtReader<R> {
                         None
                     }
                 };
-                self.start += whole;
-                self.offset += whole as u64;
-                let offset = self.offset;
+                self.data.consume(whole);
+                let offset = self.data.offset();
                 match summary {
                     Some(summary) => self.check.check_summarized(&self.events, summary),
                     None => self.check.check(&self.events),
@@ -244,21 +229,16 @@ impl<R: Read> EvtReader<R> {
                 continue;
             }
             // Carry the partial word (if any) to the front and read more behind it.
-            self.buf.copy_within(self.start..self.end, 0);
-            self.end = available;
-            self.start = 0;
-            let n = read_some(&mut self.source, &mut self.buf[self.end..])?;
-            if n == 0 {
+            if self.data.refill()? == 0 {
                 if available > 0 {
                     return Err(EvtError::Truncated {
-                        offset: self.offset,
+                        offset: self.data.offset(),
                         got: available,
                         word,
                     });
                 }
                 return Ok(None);
             }
-            self.end += n;
         }
     }
 }

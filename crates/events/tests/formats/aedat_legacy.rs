@@ -322,6 +322,64 @@ fn other_versions_and_broken_headers_are_named() {
     assert_eq!(reader.header().version, Version::Aedat2);
 }
 
+/// cAER writes a packet container's polarity packet before its IMU and special packets, so the
+/// IMU samples and triggers of a range may come after events past the range's end (here after
+/// more than one read's worth of them): a range read still finds them.
+#[test]
+fn aedat31_range_reads_find_imu_and_triggers_that_trail_the_events() {
+    let mut bytes = headers()[1].to_vec();
+    let mut packet = |kind: i16, size: i32, events: Vec<(u32, i32)>| {
+        let n = events.len() as i32;
+        bytes.extend(kind.to_le_bytes());
+        bytes.extend(1i16.to_le_bytes());
+        for v in [size, 4, 0, n, n, n] {
+            bytes.extend(v.to_le_bytes());
+        }
+        for (data, t) in events {
+            bytes.extend(data.to_le_bytes());
+            bytes.extend(t.to_le_bytes());
+            bytes.extend(vec![0u8; size as usize - 8]);
+        }
+    };
+    // 20,000 events (160 KB) at t = 100 .. 20,099, then IMU samples and rising edges that span
+    // the same time.
+    packet(1, 8, (0..20_000).map(|i| (3 << 17 | 1, 100 + i)).collect());
+    packet(3, 36, (0..20).map(|i| (1, 100 + 1_000 * i)).collect());
+    packet(
+        0,
+        8,
+        (0..20).map(|i| (2 << 1 | 1, 150 + 1_000 * i)).collect(),
+    );
+    packet(1, 8, vec![(5 << 17 | 1, 30_000)]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("containers.aedat");
+    std::fs::write(&path, &bytes).unwrap();
+    let whole = evtac_events::read_recording(&path).unwrap();
+    let (from, to) = (2_000, 5_000);
+    let (part, _) = evtac_events::read_recording_range(&path, from, to).unwrap();
+    let within = |t: i64| from <= t && t < to;
+    assert_eq!(part.events.len(), 3_000);
+    assert_eq!(
+        part.imu,
+        whole
+            .imu
+            .iter()
+            .copied()
+            .filter(|s| within(s.t))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(
+        part.triggers,
+        whole
+            .triggers
+            .iter()
+            .copied()
+            .filter(|t| within(t.t))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!((part.imu.len(), part.triggers.len()), (3, 3));
+}
+
 /// A valid header of each version, for the never-panic properties.
 fn headers() -> [&'static [u8]; 2] {
     [

@@ -8,7 +8,8 @@
 //! and locates the problem (a byte offset, line, field or key). Nothing may panic, and no single
 //! allocation may exceed [`ALLOCATION_LIMIT`], whatever sizes the file claims.
 //!
-//! All failures are collected and reported together, one line per case.
+//! All failures are collected and reported together, one line per case. The AEDAT 2.0 and 3.1
+//! rows are in `bad_input_legacy.rs`.
 
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -22,7 +23,7 @@ use evtac_events::{Event, Resolution};
 use crate::alloc::largest_allocation_during;
 
 /// The sensor every sample declares.
-const SENSOR: Resolution = Resolution::new(64, 32);
+pub(crate) const SENSOR: Resolution = Resolution::new(64, 32);
 /// The largest single allocation a read may make. The readers' fixed buffers (event chunks,
 /// read buffers) take a few hundred KiB; the files are a few KiB; the claims go up to 4 GiB.
 const ALLOCATION_LIMIT: usize = 16 << 20;
@@ -44,28 +45,28 @@ const LOCATORS: [&str; 10] = [
 /// A header field: a name for the report, its bytes, and whether inverting any of its bytes
 /// must make the file unreadable (a magic, a version or a size must; a free-text value may be
 /// anything).
-struct Field {
-    name: String,
-    range: Range<usize>,
-    must_fail: bool,
+pub(crate) struct Field {
+    pub(crate) name: String,
+    pub(crate) range: Range<usize>,
+    pub(crate) must_fail: bool,
 }
 
 /// A small valid file of one format, and what the matrix needs to know about its layout.
-struct Sample {
-    label: &'static str,
+pub(crate) struct Sample {
+    pub(crate) label: &'static str,
     /// File name; the extension is how CSV files are recognised.
-    file: &'static str,
-    bytes: Vec<u8>,
+    pub(crate) file: &'static str,
+    pub(crate) bytes: Vec<u8>,
     /// Sensor size to declare (CSV and NPY files do not store one).
-    declare: Option<Resolution>,
+    pub(crate) declare: Option<Resolution>,
     /// The cuts that leave a valid shorter file, with the number of events it still holds. Every
     /// other cut (from 0 to the length) must be an error.
-    valid_cuts: Vec<(usize, usize)>,
-    header: Vec<Field>,
+    pub(crate) valid_cuts: Vec<(usize, usize)>,
+    pub(crate) header: Vec<Field>,
 }
 
 /// The events every sample holds: 40 ms, so the AEDAT4 writer makes several packets.
-fn events() -> Vec<Event> {
+pub(crate) fn events() -> Vec<Event> {
     (0..10u16)
         .map(|i| Event {
             t: 1_000_000 + 4_000 * i64::from(i) + i64::from(i % 3),
@@ -115,14 +116,14 @@ fn read(dir: &Path, file: &str, bytes: &[u8], declare: Option<Resolution>) -> (O
 }
 
 /// Runs the cases of one sample and collects what went wrong.
-struct Matrix<'a> {
+pub(crate) struct Matrix<'a> {
     dir: &'a Path,
     failures: Vec<String>,
     cases: usize,
 }
 
 /// What a case must give.
-enum Expect<'a> {
+pub(crate) enum Expect<'a> {
     /// An error naming the file and the place.
     Error,
     /// Exactly these events.
@@ -132,7 +133,7 @@ enum Expect<'a> {
 }
 
 impl Matrix<'_> {
-    fn case(&mut self, sample: &Sample, case: &str, bytes: &[u8], expect: Expect<'_>) {
+    pub(crate) fn case(&mut self, sample: &Sample, case: &str, bytes: &[u8], expect: Expect<'_>) {
         self.cases += 1;
         let name = format!("{} / {case}", sample.label);
         let (outcome, largest) = read(self.dir, sample.file, bytes, sample.declare);
@@ -182,7 +183,7 @@ impl Matrix<'_> {
 
     /// The cases every sample gets: empty, every cut, every header byte inverted and with its
     /// lowest bit flipped.
-    fn generic(&mut self, sample: &Sample, events: &[Event]) {
+    pub(crate) fn generic(&mut self, sample: &Sample, events: &[Event]) {
         self.case(sample, "intact", &sample.bytes, Expect::Events(events));
         self.case(sample, "empty", &[], Expect::Error);
         for cut in 0..sample.bytes.len() {
@@ -215,6 +216,8 @@ impl Matrix<'_> {
     }
 
     fn finish(self) {
+        // Shown with `--nocapture`: the case counts `docs/reliability.md` reports.
+        eprintln!("{} cases", self.cases);
         assert!(
             self.failures.is_empty(),
             "{} of {} cases failed:\n{}",
@@ -225,7 +228,7 @@ impl Matrix<'_> {
     }
 }
 
-fn with_matrix(f: impl FnOnce(&mut Matrix<'_>)) {
+pub(crate) fn with_matrix(f: impl FnOnce(&mut Matrix<'_>)) {
     let dir = tempfile::tempdir().unwrap();
     let mut matrix = Matrix {
         dir: dir.path(),
@@ -237,7 +240,7 @@ fn with_matrix(f: impl FnOnce(&mut Matrix<'_>)) {
 }
 
 /// The offset of the only occurrence of `needle` in `haystack`.
-fn find_once(haystack: &[u8], needle: &[u8]) -> usize {
+pub(crate) fn find_once(haystack: &[u8], needle: &[u8]) -> usize {
     let hits: Vec<usize> = haystack
         .windows(needle.len())
         .enumerate()
@@ -252,25 +255,16 @@ fn find_once(haystack: &[u8], needle: &[u8]) -> usize {
 // EVT 2.0 and 3.0
 // ---------------------------------------------------------------------------------------------
 
-/// An EVT file: header lines, then the words of each event (several words per event for EVT3).
-/// Returns the sample; cuts are valid at every line end of the header and every word end.
-fn evt_sample(
-    label: &'static str,
-    version: &str,
-    geometry: &str,
-    word_size: usize,
-    encode: impl Fn(&Event) -> Vec<u32>,
-    events: &[Event],
-) -> Sample {
-    let lines = [
-        format!("% evt {version}\n"),
-        format!("% geometry {geometry}\n"),
-        "% end\n".to_string(),
-    ];
+/// Text header lines (`%` for EVT, `#` for AEDAT 2.0 / 3.1), each with whether every change of
+/// one must make the file unreadable: their bytes, one field per line, and a valid cut (with no
+/// events) after each line, since a file cut there is a header without data.
+pub(crate) fn evt_header_fields(
+    lines: &[(&str, bool)],
+) -> (Vec<u8>, Vec<Field>, Vec<(usize, usize)>) {
     let mut bytes = Vec::new();
     let mut valid_cuts = Vec::new();
     let mut header = Vec::new();
-    for (line, must_fail) in lines.iter().zip([true, false, false]) {
+    for &(line, must_fail) in lines {
         let start = bytes.len();
         bytes.extend_from_slice(line.as_bytes());
         header.push(Field {
@@ -278,9 +272,27 @@ fn evt_sample(
             range: start..bytes.len(),
             must_fail,
         });
-        // A file cut after a header line is a header without data.
         valid_cuts.push((bytes.len(), 0));
     }
+    (bytes, header, valid_cuts)
+}
+
+/// An EVT file: header lines, then the words of each event (several words per event for EVT3).
+/// Returns the sample; cuts are valid at every line end of the header and every word end.
+pub(crate) fn evt_sample(
+    label: &'static str,
+    version: &str,
+    geometry: &str,
+    word_size: usize,
+    encode: impl Fn(&Event) -> Vec<u64>,
+    events: &[Event],
+) -> Sample {
+    let (version, geometry) = (
+        format!("% evt {version}\n"),
+        format!("% geometry {geometry}\n"),
+    );
+    let (mut bytes, header, mut valid_cuts) =
+        evt_header_fields(&[(&version, true), (&geometry, false), ("% end\n", false)]);
     for (n, e) in events.iter().enumerate() {
         for word in encode(e) {
             bytes.extend_from_slice(&word.to_le_bytes()[..word_size]);
@@ -299,33 +311,37 @@ fn evt_sample(
     }
 }
 
-fn evt2_words(e: &Event) -> Vec<u32> {
-    let t = e.t as u32;
+fn evt2_words(e: &Event) -> Vec<u64> {
+    let t = e.t as u64;
     vec![
         0x8000_0000 | t >> 6,
-        u32::from(e.polarity) << 28 | (t & 0x3F) << 22 | u32::from(e.x) << 11 | u32::from(e.y),
+        u64::from(e.polarity) << 28 | (t & 0x3F) << 22 | u64::from(e.x) << 11 | u64::from(e.y),
     ]
 }
 
-fn evt3_words(e: &Event) -> Vec<u32> {
-    let t = e.t as u32;
+fn evt3_words(e: &Event) -> Vec<u64> {
+    let t = e.t as u64;
     vec![
         0x8000 | (t >> 12 & 0xFFF),
         0x6000 | (t & 0xFFF),
-        u32::from(e.y),
-        0x2000 | u32::from(e.polarity) << 11 | u32::from(e.x),
+        u64::from(e.y),
+        0x2000 | u64::from(e.polarity) << 11 | u64::from(e.x),
     ]
 }
 
-fn evt_cases(version: &str, word_size: usize, encode: fn(&Event) -> Vec<u32>) {
-    let label = if word_size == 4 { "EVT2" } else { "EVT3" };
+fn evt_cases(version: &str, word_size: usize, encode: fn(&Event) -> Vec<u64>) {
+    let label = match word_size {
+        2 => "EVT3",
+        4 => "EVT2",
+        _ => "EVT2.1",
+    };
     let good = events();
     with_matrix(|m| {
         let sample = evt_sample(label, version, "64x32", word_size, encode, &good);
         m.generic(&sample, &good);
 
         // EVT 2.1 is read too (a different word size), so the wrong EVT2 version is 2.5.
-        let wrong_version = if word_size == 4 { "2.5" } else { "4.0" };
+        let wrong_version = if word_size == 2 { "4.0" } else { "2.5" };
         let bad = evt_sample(label, wrong_version, "64x32", word_size, encode, &good);
         m.case(&sample, "wrong version", &bad.bytes, Expect::Error);
 
@@ -358,6 +374,26 @@ fn evt2_bad_input_matrix() {
 #[test]
 fn evt3_bad_input_matrix() {
     evt_cases("3.0", 2, evt3_words);
+}
+
+/// EVT 2.1: a TIME_HIGH word, then a vectorised CD word whose mask marks the one event's column
+/// within its 32-column group.
+fn evt21_words(e: &Event) -> Vec<u64> {
+    let t = e.t as u64;
+    let x = u64::from(e.x);
+    vec![
+        0x8 << 60 | (t >> 6) << 32,
+        u64::from(e.polarity) << 60
+            | (t & 0x3F) << 54
+            | (x & !31) << 43
+            | u64::from(e.y) << 32
+            | 1 << (x & 31),
+    ]
+}
+
+#[test]
+fn evt21_bad_input_matrix() {
+    evt_cases("2.1", 8, evt21_words);
 }
 
 // ---------------------------------------------------------------------------------------------
