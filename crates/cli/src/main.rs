@@ -49,6 +49,8 @@ enum Command {
     Tune(commands::tune::Args),
     /// Reproduce the paper end to end: simulate, label, tune, Experiments 1-3, latency, report.
     Reproduce(commands::reproduce::Args),
+    /// Run one job of a jobs file (a Slurm array task's work).
+    Jobs(commands::jobs::Args),
     /// Estimate contact angles online from a live or replayed event stream.
     Online(commands::online::Args),
 }
@@ -66,6 +68,7 @@ fn main() {
         Command::Predict(args) => commands::predict::run(args),
         Command::Tune(args) => commands::tune::run(args),
         Command::Reproduce(args) => commands::reproduce::run(args),
+        Command::Jobs(args) => commands::jobs::run(args),
         Command::Online(args) => commands::online::run(args),
     };
     if let Err(err) = result {

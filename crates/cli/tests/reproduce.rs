@@ -15,15 +15,8 @@ pub fn tiny_run() -> &'static Path {
     let (_, out) = RUN.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
         let out = dir.path().join("out");
-        let args = [
-            "reproduce",
-            "--scale",
-            "tiny",
-            "--seed",
-            "1",
-            "--out",
-            out.to_str().expect("utf-8 path"),
-        ];
+        let args = tiny_args(&out);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
         run_ok(&args);
         let exp1 = |out: &Path| results(out)["exp1"].clone();
         let first = exp1(&out);
@@ -32,6 +25,14 @@ pub fn tiny_run() -> &'static Path {
         (dir, out)
     });
     out
+}
+
+/// The arguments of the tiny reproduction (scale tiny, seed 1) into `out`.
+pub fn tiny_args(out: &Path) -> Vec<String> {
+    let out = out.to_str().expect("utf-8 path");
+    ["reproduce", "--scale", "tiny", "--seed", "1", "--out", out]
+        .map(String::from)
+        .to_vec()
 }
 
 /// `results.json` of a finished run.

@@ -12,8 +12,9 @@
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
-//!   experiments; [`pipeline`] runs them all; [`results`], [`report`] and [`plots`] write
-//!   `report.md`, `results.json` and the PNG figures.
+//!   experiments; [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm
+//!   cluster); [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the
+//!   PNG figures.
 //!
 //! ```no_run
 //! use evtac_experiments::jobs::Quiet;
@@ -45,6 +46,7 @@ pub mod plots;
 pub mod report;
 pub mod results;
 pub mod sampling;
+pub mod slurm;
 pub mod splits;
 pub mod stage;
 pub mod training;

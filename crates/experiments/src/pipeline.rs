@@ -315,6 +315,16 @@ pub fn train_command(
     jobs::command_line(&args)
 }
 
+/// Whether every tuning run of both representations is finished in `out`.
+pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
+    let models = out.join("models");
+    [Kind::Static, Kind::Dynamic].into_iter().all(|kind| {
+        tuning::grid(plan, kind)
+            .iter()
+            .all(|p| exp1::finished(&tuning::run_dir(&models, kind, &p.config)))
+    })
+}
+
 /// The training jobs that can run now and are not finished, as `evtac train` command lines:
 /// the tuning runs, and once both tunings are finished, Experiments 1 and 2. Run them (in any
 /// order, in parallel), then run `evtac reproduce` again: it resumes from the finished jobs.

@@ -49,6 +49,8 @@ pub enum Stage {
     Exp2Training,
     /// The latency study (units: representation x interval).
     Latency,
+    /// Tasks of a Slurm job array, run by the cluster (units: tasks).
+    SlurmTasks,
 }
 
 impl std::fmt::Display for Stage {
@@ -64,6 +66,7 @@ impl std::fmt::Display for Stage {
             Stage::Exp1Training => f.write_str("experiment 1 training"),
             Stage::Exp2Training => f.write_str("experiment 2 training"),
             Stage::Latency => f.write_str("latency"),
+            Stage::SlurmTasks => f.write_str("Slurm tasks"),
         }
     }
 }
@@ -165,6 +168,8 @@ impl CostModel {
                 let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
                 units * trials as f64 * cost::LATENCY_TRIAL
             }
+            // The cluster's pace is its own: the local ETA does not cover it.
+            Stage::SlurmTasks => 0.0,
         }
     }
 

@@ -84,3 +84,13 @@ pub fn run_python(script: &str, args: &[&str]) -> Option<String> {
     }
     Some(String::from_utf8_lossy(&out.stdout).into_owned())
 }
+
+/// Whether a Slurm cluster answers on this machine (`scontrol ping`; `bash .ci/slurm-up` starts
+/// one). `false` (test skipped) outside CI when none does.
+pub fn slurm_cluster() -> bool {
+    let up = Command::new("scontrol")
+        .arg("ping")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("is UP"));
+    up || missing("a running Slurm cluster (`bash .ci/slurm-up` starts one)").is_some()
+}

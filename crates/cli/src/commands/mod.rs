@@ -3,6 +3,7 @@
 pub mod convert;
 pub mod evaluate;
 pub mod info;
+pub mod jobs;
 pub mod labels;
 pub mod online;
 pub mod predict;

@@ -1,13 +1,15 @@
 //! `evtac reproduce`: the paper end to end. Simulates the datasets when none are given (every
 //! protocol), then labels, splits, tuning, Experiments 1-3, the latency study and the report
 //! (`OUT/report.md`, `OUT/results.json`, `OUT/figures/`). Interrupted runs resume from finished
-//! jobs; `--export-jobs` writes the ready training jobs as `evtac train` lines instead.
+//! jobs; `--export-jobs` writes the ready training jobs as `evtac train` lines instead, and
+//! `--executor slurm` submits every stage to a Slurm cluster (`evtac_experiments::slurm`).
 
 use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::jobs::Progress;
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
+use evtac_experiments::slurm::{Reproduction, Slurm};
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_sim::Scale;
 use std::path::PathBuf;
@@ -38,6 +40,23 @@ pub struct Args {
     /// reproduce` again with the same arguments: it resumes from the finished jobs.
     #[arg(long)]
     pub export_jobs: Option<PathBuf>,
+    /// Where the jobs run: `local` (this machine's threads) or `slurm` (each stage's jobs as a
+    /// Slurm job array, followed with squeue; OUT must be on storage every node sees). An
+    /// interrupted or partly failed run resumes when run again.
+    #[arg(long, value_enum, default_value_t = Executor::Local)]
+    pub executor: Executor,
+    /// Extra `sbatch` arguments for every Slurm job, e.g. "--partition=cpu --time=4:00:00".
+    #[arg(long, allow_hyphen_values = true)]
+    pub slurm_args: Option<String>,
+}
+
+/// Where the jobs of a reproduction run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Executor {
+    /// This machine, `--jobs` threads.
+    Local,
+    /// A Slurm cluster: `sbatch` job arrays, one task per job.
+    Slurm,
 }
 
 /// The stage bars plus an overall bar over the estimated cost of every stage: its ETA is the
@@ -93,10 +112,56 @@ impl Progress for Overall<'_> {
     }
 }
 
+/// Runs `evtac reproduce` on Slurm: submits, follows, and returns when the report is written.
+fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let exe = std::env::current_exe().context("finding the evtac binary the tasks run")?;
+    let absolute = |p: &PathBuf| std::path::absolute(p).with_context(|| p.display().to_string());
+    let run = Reproduction {
+        exe: exe.display().to_string(),
+        scale: args.scale,
+        seed: args.seed,
+        out: absolute(&args.out)?,
+        data: args.data.as_ref().map(absolute).transpose()?,
+    };
+    let slurm = Slurm {
+        sbatch_args: args
+            .slurm_args
+            .as_deref()
+            .unwrap_or_default()
+            .split_whitespace()
+            .map(str::to_string)
+            .collect(),
+        ..Slurm::default()
+    };
+    let bars = Bars::default();
+    run.run(&slurm, plan, &bars)?;
+    bars.finish();
+    println!("{}", run.out.join("report.md").display());
+    eprintln!(
+        "reproduced at scale {} on Slurm in {:.1} s (task logs in {})",
+        args.scale,
+        started.elapsed().as_secs_f64(),
+        run.out.join("slurm").display()
+    );
+    Ok(())
+}
+
 /// Runs `evtac reproduce`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let plan = Plan::for_scale(args.scale);
+    anyhow::ensure!(
+        args.slurm_args.is_none() || args.executor == Executor::Slurm,
+        "--slurm-args is for --executor slurm"
+    );
+    if args.executor == Executor::Slurm {
+        anyhow::ensure!(
+            args.export_jobs.is_none(),
+            "--export-jobs lists the jobs for a scheduler of your own; --executor slurm submits them itself: use one or the other"
+        );
+        return run_on_slurm(&args, &plan);
+    }
     let pool = args.workers.pool()?;
     let bars = Bars::default();
     let sim_dir = args.out.join("data");

@@ -63,6 +63,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .install(|| simulate_dataset(&config, &args.out, |_| bar.inc(1)))
         .with_context(|| format!("simulating {} into {}", args.protocol, args.out.display()))?;
     bar.finish_and_clear();
+    // The dataset `evtac reproduce` would simulate here (default parameters, every trial) is
+    // marked done as `reproduce` marks its own, so a reproduction (local or on Slurm, whose
+    // simulation tasks run this command) resumes from it.
+    if args.params.is_none() && args.limit.is_none() {
+        evtac_experiments::jobs::mark_done(&args.out)?;
+    }
     eprintln!(
         "simulated {} {} trials ({} scale, seed {}) into {} in {:.1} s",
         manifest.trials.len(),

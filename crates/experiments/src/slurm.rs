@@ -1,0 +1,420 @@
+//! Running a reproduction on a Slurm cluster: every stage's jobs become one Slurm job array
+//! (`sbatch --array`), followed with `squeue` until it ends; the report is written by a last job
+//! that depends on the final array (`--dependency=afterok`).
+//!
+//! Every job is idempotent and marks its folder done (see [`crate::jobs`]), so the jobs files
+//! are written from what is *not* finished, and a task that was cancelled or failed is found by
+//! its missing `done` marker, not by trusting the scheduler's accounting (which many clusters
+//! keep only for minutes, or not at all). Running the same command again resumes: only the
+//! unfinished jobs are submitted. Tasks run the same `evtac` commands as a local run with the
+//! same seed, so the results are the same bytes.
+//!
+//! The stages, in order (each submitted only when the one before it has finished, because its
+//! job list depends on the one before: Experiments 1 and 2 train the configs the tuning chose):
+//!
+//! 1. `simulate`: one task per dataset not yet simulated (`evtac simulate`);
+//! 2. `train`: the training jobs [`pipeline::export_jobs`] lists (first the tuning grid, then,
+//!    once both tunings are done, Experiments 1 and 2);
+//! 3. `report`: one task running `evtac reproduce` itself, which finds every training done and
+//!    evaluates, runs Experiment 3 and the latency study, and writes the report.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use crate::io::IoError;
+use crate::jobs::{self, Progress};
+use crate::pipeline::{self, Datasets};
+use crate::plan::Plan;
+use crate::stage::{PROTOCOLS, Stage};
+
+/// What can go wrong running on Slurm.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A Slurm command could not be started (Slurm not installed, or not on the PATH).
+    #[error("could not run `{command}` (is Slurm installed and on the PATH?): {source}")]
+    Spawn {
+        /// The command.
+        command: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A Slurm command failed.
+    #[error("`{command}` failed: {stderr}")]
+    Command {
+        /// The command line.
+        command: String,
+        /// What it printed on stderr.
+        stderr: String,
+    },
+    /// Tasks of an array ended without finishing their job.
+    #[error(
+        "{failed} of {tasks} tasks of the `{stage}` array (Slurm job {job}) did not finish: {details}. \
+         Finished work is kept: run the same command again to resume"
+    )]
+    TasksFailed {
+        /// The stage.
+        stage: String,
+        /// The array's Slurm job id.
+        job: String,
+        /// Tasks in the array.
+        tasks: usize,
+        /// Tasks that did not finish.
+        failed: usize,
+        /// Each failed task: its index, the state Slurm reports, its log file.
+        details: String,
+    },
+    /// A jobs file could not be written.
+    #[error(transparent)]
+    Io(#[from] IoError),
+    /// Listing the jobs failed.
+    #[error(transparent)]
+    Pipeline(#[from] pipeline::Error),
+}
+
+/// How to submit: extra `sbatch` arguments (partition, account, time limit, ...) and how often
+/// to poll.
+#[derive(Debug, Clone)]
+pub struct Slurm {
+    /// Added to every `sbatch` call, split on whitespace (e.g. `--partition=cpu --time=2:00:00`).
+    pub sbatch_args: Vec<String>,
+    /// Time between two `squeue` polls.
+    pub poll: Duration,
+}
+
+impl Default for Slurm {
+    fn default() -> Self {
+        Self {
+            sbatch_args: Vec::new(),
+            poll: Duration::from_secs(2),
+        }
+    }
+}
+
+/// A submitted job array.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ArrayJob {
+    /// Slurm's job id of the array.
+    pub id: String,
+    /// Tasks in the array.
+    pub tasks: usize,
+}
+
+/// Runs `program args` and returns its stdout.
+fn run(program: &str, args: &[String]) -> Result<String, Error> {
+    let command = jobs::command_line(&[&[program.to_string()], args].concat());
+    let out = Command::new(program)
+        .args(args)
+        .output()
+        .map_err(|source| Error::Spawn {
+            command: command.clone(),
+            source,
+        })?;
+    if !out.status.success() {
+        return Err(Error::Command {
+            command,
+            stderr: String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        });
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+impl Slurm {
+    /// Submits the `lines` (shell command lines) as one array named `evtac-<stage>`: task `k`
+    /// runs line `k` through `evtac jobs run` (`exe` is the `evtac` binary), one CPU each,
+    /// logging to `logs/<stage>-<job>_<task>.out`, after `after` (if any) has finished well.
+    pub fn submit(
+        &self,
+        stage: &str,
+        lines: &[String],
+        exe: &str,
+        logs: &Path,
+        after: Option<&ArrayJob>,
+    ) -> Result<ArrayJob, Error> {
+        std::fs::create_dir_all(logs).map_err(IoError::at(logs))?;
+        let file = logs.join(format!("{stage}.jobs"));
+        let mut text = lines.join("\n");
+        text.push('\n');
+        jobs::write_atomic(&file, text.as_bytes()).map_err(IoError::at(&file))?;
+        let wrap = format!(
+            "{} jobs run {} --index \"$SLURM_ARRAY_TASK_ID\"",
+            jobs::shell_quote(exe),
+            jobs::shell_quote(&file.display().to_string())
+        );
+        let mut args = vec![
+            "--parsable".to_string(),
+            format!("--array=0-{}", lines.len().saturating_sub(1)),
+            format!("--job-name=evtac-{stage}"),
+            format!("--output={}/{stage}-%A_%a.out", logs.display()),
+            "--cpus-per-task=1".to_string(),
+        ];
+        if let Some(after) = after {
+            args.push(format!("--dependency=afterok:{}", after.id));
+        }
+        args.extend(self.sbatch_args.iter().cloned());
+        args.push(format!("--wrap={wrap}"));
+        let out = run("sbatch", &args)?;
+        // `--parsable` prints `id` or `id;cluster`.
+        let id = out.trim().split(';').next().unwrap_or_default().to_string();
+        Ok(ArrayJob {
+            id,
+            tasks: lines.len(),
+        })
+    }
+
+    /// Waits until no task of `job` is pending or running, reporting each task that leaves the
+    /// queue to `progress`.
+    pub fn wait(&self, job: &ArrayJob, progress: &dyn Progress) -> Result<(), Error> {
+        let mut left = job.tasks;
+        loop {
+            let out = run(
+                "squeue",
+                &[
+                    "--noheader".into(),
+                    "--array".into(),
+                    format!("--jobs={}", job.id),
+                    "--format=%i".into(),
+                ],
+            )?;
+            let queued = out.lines().filter(|l| !l.trim().is_empty()).count();
+            if queued < left {
+                progress.advance((left - queued) as u64);
+                left = queued;
+            }
+            if queued == 0 {
+                return Ok(());
+            }
+            std::thread::sleep(self.poll);
+        }
+    }
+
+    /// Cancels every task of `job` (`scancel`).
+    pub fn cancel(&self, job: &ArrayJob) -> Result<(), Error> {
+        run("scancel", std::slice::from_ref(&job.id)).map(|_| ())
+    }
+
+    /// The state Slurm reports for each task of `job` (`scontrol show job`, which keeps
+    /// finished jobs for `MinJobAge`), by task index; empty when Slurm no longer knows them.
+    pub fn task_states(&self, job: &ArrayJob) -> Vec<(usize, String)> {
+        let Ok(out) = run(
+            "scontrol",
+            &[
+                "--oneliner".into(),
+                "show".into(),
+                "job".into(),
+                job.id.clone(),
+            ],
+        ) else {
+            return Vec::new();
+        };
+        out.lines()
+            .filter_map(|line| {
+                let field = |key: &str| {
+                    line.split_whitespace()
+                        .find_map(|f| f.strip_prefix(key))
+                        .map(str::to_string)
+                };
+                let task = field("ArrayTaskId=")?.parse().ok()?;
+                Some((task, field("JobState=")?))
+            })
+            .collect()
+    }
+}
+
+/// A reproduction to run on Slurm: the arguments of the `evtac reproduce` it stands for.
+#[derive(Debug, Clone)]
+pub struct Reproduction {
+    /// The `evtac` binary the tasks run (an absolute path every node can reach).
+    pub exe: String,
+    /// Scale name (`tiny`, `small`, `paper`).
+    pub scale: evtac_sim::Scale,
+    /// Master seed.
+    pub seed: u64,
+    /// Output folder (on storage every node shares).
+    pub out: PathBuf,
+    /// Existing datasets, or `None` to simulate them into `out/data`.
+    pub data: Option<PathBuf>,
+}
+
+impl Reproduction {
+    /// The `evtac reproduce` command line of this reproduction, run locally (by the last task).
+    fn local_command(&self) -> String {
+        let mut args = vec![
+            self.exe.clone(),
+            "reproduce".into(),
+            "--scale".into(),
+            self.scale.name().into(),
+            "--seed".into(),
+            self.seed.to_string(),
+            "--out".into(),
+            self.out.display().to_string(),
+            "--jobs".into(),
+            "1".into(),
+        ];
+        if let Some(data) = &self.data {
+            args.extend(["--data".into(), data.display().to_string()]);
+        }
+        jobs::command_line(&args)
+    }
+
+    /// The folder of the simulated datasets.
+    fn sim_dir(&self) -> PathBuf {
+        self.out.join("data")
+    }
+
+    /// `evtac simulate` lines for the datasets not yet simulated (none when data is given).
+    fn simulation_jobs(&self) -> Vec<(PathBuf, String)> {
+        if self.data.is_some() {
+            return Vec::new();
+        }
+        PROTOCOLS
+            .iter()
+            .map(|p| (*p, self.sim_dir().join(p.name())))
+            .filter(|(_, dir)| !jobs::is_done(dir))
+            .map(|(p, dir)| {
+                let line = jobs::command_line(&[
+                    self.exe.clone(),
+                    "simulate".into(),
+                    "--protocol".into(),
+                    p.name().into(),
+                    "--scale".into(),
+                    self.scale.name().into(),
+                    "--seed".into(),
+                    self.seed.to_string(),
+                    "--out".into(),
+                    dir.display().to_string(),
+                    "--jobs".into(),
+                    "1".into(),
+                ]);
+                (dir, line)
+            })
+            .collect()
+    }
+
+    /// Runs the whole reproduction on `slurm`: the simulation, the training jobs (two rounds:
+    /// tuning, then Experiments 1 and 2), and the report task; returns when the report is
+    /// written.
+    pub fn run(&self, slurm: &Slurm, plan: &Plan, progress: &dyn Progress) -> Result<(), Error> {
+        let logs = self.out.join("slurm");
+        let sims = self.simulation_jobs();
+        if !sims.is_empty() {
+            let lines: Vec<String> = sims.iter().map(|(_, l)| l.clone()).collect();
+            let job = submit(slurm, "simulate", &lines, &self.exe, &logs, None, progress)?;
+            slurm.wait(&job, progress)?;
+            let unfinished: Vec<usize> = (0..sims.len())
+                .filter(|&k| !jobs::is_done(&sims[k].0))
+                .collect();
+            check(slurm, "simulate", &job, &unfinished, &logs)?;
+        }
+        let data = Datasets::in_dir(self.data.as_deref().unwrap_or(&self.sim_dir()));
+        let report = [self.local_command()];
+        let submitted = std::time::SystemTime::now();
+        let mut round = 0;
+        let report_job = loop {
+            let lines = pipeline::export_jobs(&data, plan, self.seed, &self.out, &self.exe)?;
+            if lines.is_empty() {
+                break submit(slurm, "report", &report, &self.exe, &logs, None, progress)?;
+            }
+            // Once both tunings are done, this round (Experiments 1 and 2) is the last: the
+            // report task is queued behind it at once.
+            let last = pipeline::tunings_finished(plan, &self.out);
+            round += 1;
+            let stage = format!("train-{round}");
+            let job = submit(slurm, &stage, &lines, &self.exe, &logs, None, progress)?;
+            let report_job = if last {
+                let after = Some(&job);
+                Some(submit(
+                    slurm, "report", &report, &self.exe, &logs, after, progress,
+                )?)
+            } else {
+                None
+            };
+            slurm.wait(&job, progress)?;
+            let left = pipeline::export_jobs(&data, plan, self.seed, &self.out, &self.exe)?;
+            let unfinished: Vec<usize> = (0..lines.len())
+                .filter(|&k| left.contains(&lines[k]))
+                .collect();
+            if let Err(e) = check(slurm, &stage, &job, &unfinished, &logs) {
+                // A report behind a failed array would wait forever (DependencyNeverSatisfied).
+                if let Some(report_job) = report_job {
+                    slurm.cancel(&report_job)?;
+                }
+                return Err(e);
+            }
+            if let Some(report_job) = report_job {
+                break report_job;
+            }
+        };
+        slurm.wait(&report_job, progress)?;
+        let written = std::fs::metadata(self.out.join("report.md"))
+            .and_then(|m| m.modified())
+            .is_ok_and(|t| t >= submitted);
+        check(
+            slurm,
+            "report",
+            &report_job,
+            if written { &[] } else { &[0] },
+            &logs,
+        )
+    }
+}
+
+/// Submits one stage's array (after `after`, if given) and says so.
+fn submit(
+    slurm: &Slurm,
+    stage: &str,
+    lines: &[String],
+    exe: &str,
+    logs: &Path,
+    after: Option<&ArrayJob>,
+    progress: &dyn Progress,
+) -> Result<ArrayJob, Error> {
+    let job = slurm.submit(stage, lines, exe, logs, after)?;
+    progress.stage(Stage::SlurmTasks, lines.len() as u64);
+    let behind = after.map_or(String::new(), |a| format!(" after job {}", a.id));
+    progress.message(&format!(
+        "`{stage}`: {} task(s) submitted as Slurm job {}{behind}",
+        lines.len(),
+        job.id
+    ));
+    Ok(job)
+}
+
+/// An error naming the tasks of `job` in `unfinished`, with Slurm's state and log of each.
+fn check(
+    slurm: &Slurm,
+    stage: &str,
+    job: &ArrayJob,
+    unfinished: &[usize],
+    logs: &Path,
+) -> Result<(), Error> {
+    if unfinished.is_empty() {
+        return Ok(());
+    }
+    let states = slurm.task_states(job);
+    let details = unfinished
+        .iter()
+        .map(|&k| {
+            let state = states
+                .iter()
+                .find(|(t, _)| *t == k)
+                // Slurm forgets a task cancelled before it started (and any task once its
+                // record expires), so "not listed" is all that can honestly be said of it.
+                .map_or(
+                    "not listed by Slurm (cancelled before it started, or its record expired)",
+                    |(_, s)| s.as_str(),
+                );
+            let log = logs.join(format!("{stage}-{}_{k}.out", job.id));
+            format!("task {k} {state} (log {})", log.display())
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    Err(Error::TasksFailed {
+        stage: stage.to_string(),
+        job: job.id.clone(),
+        tasks: job.tasks,
+        failed: unfinished.len(),
+        details,
+    })
+}
