@@ -20,6 +20,8 @@ def main():
     parser.add_argument("--epochs", type=int, default=2)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--samples", type=int, default=35_000)
+    parser.add_argument("--density", type=float, default=0.138,
+                        help="fraction of non-zero features (its speed does not depend on it)")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     torch.set_flush_denormal(True)
@@ -27,7 +29,7 @@ def main():
     rng = np.random.default_rng(1)
     n = args.samples
     x = rng.random((n, 900), dtype=np.float32)
-    x[rng.random((n, 900)) >= 0.25] = 0.0
+    x[rng.random((n, 900)) >= args.density] = 0.0
     y = rng.uniform(-20, 20, (n, 2)).astype(np.float32)
     x, y = torch.from_numpy(x), torch.from_numpy(y)
 

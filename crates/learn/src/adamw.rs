@@ -110,6 +110,23 @@ impl AdamW {
         }
     }
 
+    /// The moments of parameter tensor `index` (any fixed numbering) of `len` values, created
+    /// zeroed on first use.
+    pub(crate) fn moments(&mut self, index: usize, len: usize) -> (&mut [f32], &mut [f32]) {
+        while self.moments.len() <= index {
+            self.moments.push(Moments {
+                m: Vec::new(),
+                v: Vec::new(),
+            });
+        }
+        let moments = &mut self.moments[index];
+        if moments.m.len() != len {
+            moments.m = vec![0.0; len];
+            moments.v = vec![0.0; len];
+        }
+        (&mut moments.m, &mut moments.v)
+    }
+
     /// Updates parameter tensor `index` (any fixed numbering) in place from its gradient.
     ///
     /// `param` and `grad` have the same length, the same for every step of one tensor.
@@ -121,31 +138,39 @@ impl AdamW {
         grad: &[f32],
     ) {
         debug_assert_eq!(param.len(), grad.len());
-        while self.moments.len() <= index {
-            self.moments.push(Moments {
-                m: Vec::new(),
-                v: Vec::new(),
-            });
-        }
-        let moments = &mut self.moments[index];
-        if moments.m.len() != param.len() {
-            moments.m = vec![0.0; param.len()];
-            moments.v = vec![0.0; param.len()];
-        }
-        // The same operations in the same order as PyTorch's single-tensor path, one element
-        // at a time: weight decay, lerp of the first moment, addcmul of the second, then the
-        // corrected step.
-        for (((p, &g), m), v) in param
-            .iter_mut()
-            .zip(grad)
-            .zip(moments.m.iter_mut())
-            .zip(moments.v.iter_mut())
-        {
-            let decayed = *p * s.decay;
-            *m += (g - *m) * s.one_minus_beta1;
-            *v = *v * s.beta2 + g * s.one_minus_beta2 * g;
-            let denom = v.sqrt() / s.bias_correction2_sqrt + s.epsilon;
-            *p = decayed - *m / denom * s.step_size;
-        }
+        let (m, v) = self.moments(index, param.len());
+        update(s, param, grad, m, v);
+    }
+}
+
+/// One element's update: the same operations in the same order as PyTorch's single-tensor path
+/// (weight decay, lerp of the first moment, addcmul of the second, then the corrected step).
+#[inline(always)]
+pub(crate) fn update_one(s: &StepScalars, p: &mut f32, g: f32, m: &mut f32, v: &mut f32) {
+    let decayed = *p * s.decay;
+    *m += (g - *m) * s.one_minus_beta1;
+    *v = *v * s.beta2 + g * s.one_minus_beta2 * g;
+    let denom = v.sqrt() / s.bias_correction2_sqrt + s.epsilon;
+    *p = decayed - *m / denom * s.step_size;
+}
+
+/// Updates `param` from `grad` with the moments `m`, `v` (all the same length). Compiled for
+/// AVX-512 and AVX2 besides the baseline: the operations are IEEE-exact (no FMA, `sqrt` and
+/// division correctly rounded), so every target gives the same bits.
+#[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
+pub(crate) fn update(
+    s: &StepScalars,
+    param: &mut [f32],
+    grad: &[f32],
+    m: &mut [f32],
+    v: &mut [f32],
+) {
+    for (((p, &g), m), v) in param
+        .iter_mut()
+        .zip(grad)
+        .zip(m.iter_mut())
+        .zip(v.iter_mut())
+    {
+        update_one(s, p, g, m, v);
     }
 }

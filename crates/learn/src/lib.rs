@@ -18,10 +18,10 @@
 //! - [`metrics`]: MAE overall / pitch / roll.
 //! - [`ftz`]: [`flush_denormals`], to call on every thread that trains or infers.
 //!
-//! Training runs on burn's flex CPU backend with its SIMD kernels, one thread per training run
-//! (parallelism comes from running several runs side by side). A binary that trains should use
-//! mimalloc, as `evtac` does: with glibc's malloc each step's megabyte tensors are returned to
-//! the kernel and faulted back in, which made steps 2.5x slower here.
+//! Training runs a hand-written forward and backward pass (`backprop.rs`, on the panel layout of
+//! `panels.rs` that inference shares) that skips zero inputs, one thread per training run
+//! (parallelism comes from running several runs side by side). burn defines the model
+//! ([`Mlp`]) and is the independent reference its gradients are tested against.
 //!
 //! ```no_run
 //! use evtac_learn::{FeatureSet, Model, ModelBundle, Representation, TrainConfig, train};
@@ -41,12 +41,14 @@
 //! ```
 
 pub mod adamw;
+mod backprop;
 pub mod bundle;
 pub mod cell_layer;
 pub mod data;
 pub mod ftz;
 pub mod metrics;
 pub mod model;
+mod panels;
 pub mod predictor;
 pub mod streaming;
 mod trained_model;

@@ -13,15 +13,13 @@
 //!   update it from the cells that changed and still give the same bits;
 //! - on any other input, in float32 like the other layers.
 //!
-//! The float32 layers are sequences of `y += x[i] * W[i, :]` row updates over the transposed
-//! weight (`[in, out]`), 64 outputs at a time held in registers, which vectorises without
-//! horizontal sums and skips zero inputs outright. The weights of each 64-output block are
-//! stored together (`[block][in][64]`), so a block streams through one contiguous panel. They
-//! are compiled for AVX-512 and AVX2 besides the baseline and dispatched at run time, with
-//! identical results on all three. Training stays on burn.
+//! The float32 layers use the panel layout and kernels that training uses too
+//! (`panels.rs`): zero inputs skipped, compiled for AVX-512 and AVX2 besides the baseline,
+//! with identical results on all three.
 
 use crate::cell_layer::{self, CellLayer, CellSums};
 use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
+use crate::panels::Dense;
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
@@ -42,82 +40,6 @@ pub enum Error {
 const H1: usize = LAYER_SIZES[1];
 const H2: usize = LAYER_SIZES[2];
 const H3: usize = LAYER_SIZES[3];
-
-/// One layer: its weight transposed to `[in, out]` row-major, then, when `out` is a multiple of
-/// [`BLOCK`], regrouped into panels `[out / BLOCK][in][BLOCK]`.
-#[derive(Debug, Clone)]
-struct Dense {
-    weights: Vec<f32>,
-    bias: Vec<f32>,
-}
-
-/// `[in, out]` to `[out / BLOCK][in][BLOCK]` when `out` is a multiple of [`BLOCK`] (else as is).
-fn into_panels(weight_t: Vec<f32>, fan_out: usize) -> Vec<f32> {
-    if !fan_out.is_multiple_of(BLOCK) {
-        return weight_t;
-    }
-    let mut panels = Vec::with_capacity(weight_t.len());
-    for b in 0..fan_out / BLOCK {
-        for row in weight_t.chunks_exact(fan_out) {
-            panels.extend_from_slice(&row[b * BLOCK..(b + 1) * BLOCK]);
-        }
-    }
-    panels
-}
-
-impl Dense {
-    #[inline]
-    fn forward(&self, x: &[f32], out: &mut [f32], relu: bool) {
-        dense_forward(&self.weights, &self.bias, x, out, relu);
-    }
-}
-
-/// Outputs accumulated together: 64 floats stay in registers (4 AVX-512 or 8 AVX2 registers)
-/// while every input row streams past, instead of loading and storing the whole output row for
-/// each input.
-const BLOCK: usize = 64;
-
-/// `out = relu?(bias + x W)` with `W` laid out as in [`Dense`], compiled for AVX-512 and AVX2 as
-/// well as the baseline and picked at run time.
-///
-/// Every output is still `bias` plus the products added in input order, with separate
-/// multiplies and adds (no FMA), so all versions give bit-identical results: estimates do not
-/// depend on the CPU they ran on.
-#[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
-fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut [f32], relu: bool) {
-    let width = out.len();
-    out.copy_from_slice(bias);
-    if width.is_multiple_of(BLOCK) {
-        let panels = weights.chunks_exact(x.len() * BLOCK);
-        for (out, panel) in out.chunks_exact_mut(BLOCK).zip(panels) {
-            let mut acc = [0.0_f32; BLOCK];
-            acc.copy_from_slice(out);
-            for (&xi, row) in x.iter().zip(panel.chunks_exact(BLOCK)) {
-                // Zero inputs contribute exactly zero (weights are finite, checked on load),
-                // and the masked, binarised representations are mostly zeros.
-                if xi != 0.0 {
-                    for (a, &w) in acc.iter_mut().zip(row) {
-                        *a += xi * w;
-                    }
-                }
-            }
-            out.copy_from_slice(&acc);
-        }
-    } else {
-        for (&xi, row) in x.iter().zip(weights.chunks_exact(width)) {
-            if xi != 0.0 {
-                for (o, &w) in out.iter_mut().zip(row) {
-                    *o += xi * w;
-                }
-            }
-        }
-    }
-    if relu {
-        for o in out.iter_mut() {
-            *o = o.max(0.0);
-        }
-    }
-}
 
 /// A trained model ready for inference. Cheap to clone; `Send + Sync`, so one predictor can be
 /// shared by reference across threads.
@@ -142,14 +64,8 @@ impl Predictor {
         params.validate()?;
         crate::ftz::flush_denormals();
         let dense = |i: usize| {
-            let (fan_in, fan_out) = (LAYER_SIZES[i], LAYER_SIZES[i + 1]);
-            Dense {
-                weights: into_panels(
-                    model::transpose(&params.layers[i].weight, fan_out, fan_in),
-                    fan_out,
-                ),
-                bias: params.layers[i].bias.clone(),
-            }
+            let p = &params.layers[i];
+            Dense::from_pytorch(&p.weight, &p.bias, LAYER_SIZES[i], LAYER_SIZES[i + 1])
         };
         let first = &params.layers[0];
         Ok(Self {

@@ -6,18 +6,13 @@
 
 use std::time::Instant;
 
-use burn::module::{Module, Param};
-use burn::nn::loss::{HuberLoss, HuberLossConfig, Reduction};
-use burn::tensor::{Device, Tensor, TensorData};
 use serde::{Deserialize, Serialize};
 
-use crate::adamw::{AdamW, AdamWConfig, StepScalars};
+use crate::adamw::{AdamW, AdamWConfig};
+use crate::backprop::{self, MAX_BATCH, Network, Scratch};
 use crate::data::{FeatureSet, Shuffler};
 use crate::metrics::{self, Mae};
-use crate::model::{self, INPUTS, LAYER_SIZES, Mlp, OUTPUTS, Parameters, transpose};
-
-/// Samples per forward pass when predicting for validation (bounds the activation memory).
-const EVAL_CHUNK: usize = 4096;
+use crate::model::{self, INPUTS, OUTPUTS, Parameters};
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
@@ -47,8 +42,10 @@ pub enum Error {
         /// The limit it breaks.
         why: &'static str,
     },
-    /// A batch passed to [`Trainer::step`] is malformed.
-    #[error("batch of {features} feature values and {labels} labels is not n x 900 and n x 2")]
+    /// A batch passed to [`Trainer::step`] is malformed (or over 65,535 samples).
+    #[error(
+        "batch of {features} feature values and {labels} labels is not n x 900 and n x 2 with 1 <= n <= 65535"
+    )]
     Batch {
         /// Number of feature values.
         features: usize,
@@ -110,8 +107,8 @@ impl TrainConfig {
             (
                 "batch_size",
                 self.batch_size as f64,
-                self.batch_size >= 1,
-                "at least 1",
+                (1..=MAX_BATCH).contains(&self.batch_size),
+                "from 1 to 65535",
             ),
             (
                 "huber_beta",
@@ -194,7 +191,7 @@ pub struct Trained {
 /// best-validation weights with the history. `on_epoch` sees each epoch's record as it ends
 /// (for progress bars). Deterministic: the same inputs and config give the same bytes.
 ///
-/// Calls [`crate::flush_denormals`] on this thread and on rayon's global pool.
+/// Calls [`crate::flush_denormals`] on this thread (training runs on it alone).
 pub fn train(
     train: &FeatureSet,
     val: &FeatureSet,
@@ -264,65 +261,28 @@ pub fn train(
     })
 }
 
-/// A model being trained: burn parameters on the flex CPU backend plus the AdamW state.
-///
-/// The weights live twice: as burn parameters for the forward and backward passes, and as host
-/// vectors that AdamW updates in place and uploads after each step.
+/// A model being trained: its weights in the training layout, the AdamW state and the step's
+/// buffers (see `backprop.rs`).
 #[derive(Debug)]
 pub struct Trainer {
-    mlp: Mlp,
+    net: Network,
     optimizer: AdamW,
-    loss: HuberLoss,
-    device: Device,
-    /// Per layer: weight (burn's `[in, out]` layout) and bias, as updated by AdamW.
-    values: Vec<[Vec<f32>; 2]>,
-}
-
-/// Applies AdamW to the host copy `host` of parameter tensor `index` from its gradient, and
-/// returns the updated values as a tensor of `shape` for the next forward pass.
-fn host_update<const D: usize>(
-    optimizer: &mut AdamW,
-    s: &StepScalars,
-    index: usize,
-    host: &mut [f32],
-    grad: TensorData,
-    shape: [usize; D],
-    device: &Device,
-) -> Result<Tensor<D>, Error> {
-    let grad = grad
-        .as_slice::<f32>()
-        .map_err(|e| model::Error::Readback(format!("{e:?}")))?;
-    optimizer.update(s, index, host, grad);
-    Ok(Tensor::from_data(
-        TensorData::new(host.to_vec(), shape),
-        device,
-    ))
+    beta: f32,
+    scratch: Scratch,
 }
 
 impl Trainer {
     /// A trainer starting from `params` with `cfg`'s loss and optimiser settings (its `epochs`,
-    /// `batch_size` and `seed` are not used here). Flushes subnormals on this thread and on
-    /// rayon's global pool.
+    /// `batch_size` and `seed` are not used here). Flushes subnormals on this thread.
     pub fn new(params: &Parameters, cfg: &TrainConfig) -> Result<Self, Error> {
         cfg.validate()?;
+        params.validate()?;
         crate::ftz::flush_denormals();
-        crate::ftz::flush_denormals_in_rayon_pool();
-        let device = Device::flex().autodiff();
-        let mlp = Mlp::from_parameters(params, &device)?;
-        let values = params
-            .layers
-            .iter()
-            .zip(LAYER_SIZES.windows(2))
-            .map(|(p, w)| [transpose(&p.weight, w[1], w[0]), p.bias.clone()])
-            .collect();
         Ok(Self {
-            mlp,
-            values,
+            net: Network::new(params),
             optimizer: AdamW::new(cfg.optimizer),
-            // SmoothL1 with threshold beta equals Huber with delta beta divided by beta; for the
-            // paper's beta = 1 they coincide. Other betas are rescaled in `step`.
-            loss: HuberLossConfig::new(cfg.huber_beta as f32).init(),
-            device,
+            beta: cfg.huber_beta as f32,
+            scratch: Scratch::default(),
         })
     }
 
@@ -335,71 +295,36 @@ impl Trainer {
     /// mean SmoothL1 loss before the update.
     pub fn step(&mut self, features: &[f32], labels: &[f32]) -> Result<f32, Error> {
         let n = labels.len() / OUTPUTS;
-        if n == 0 || features.len() != n * INPUTS || labels.len() != n * OUTPUTS {
+        if n == 0 || n > MAX_BATCH || features.len() != n * INPUTS || labels.len() != n * OUTPUTS {
             return Err(Error::Batch {
                 features: features.len(),
                 labels: labels.len(),
             });
         }
-        let x = Tensor::<2>::from_data(
-            TensorData::new(features.to_vec(), [n, INPUTS]),
-            &self.device,
-        );
-        let y =
-            Tensor::<2>::from_data(TensorData::new(labels.to_vec(), [n, OUTPUTS]), &self.device);
-        let pred = self.mlp.forward(x);
-        let mut loss = self.loss.forward(pred, y, Reduction::Mean);
-        let beta = self.loss.delta;
-        if beta != 1.0 {
-            loss = loss.div_scalar(beta);
-        }
-        let grads = loss.backward();
-        let value = loss
-            .into_data()
-            .try_into_vec::<f32>()
-            .map_err(|e| model::Error::Readback(format!("{e:?}")))?
-            .first()
-            .copied()
-            .unwrap_or(f32::NAN);
-        let s = self.optimizer.begin_step();
-        for (i, (linear, [weight, bias])) in
-            self.mlp.layers.iter_mut().zip(&mut self.values).enumerate()
-        {
-            let shape = [LAYER_SIZES[i], LAYER_SIZES[i + 1]];
-            if let Some(g) = linear.weight.val().grad(&grads) {
-                let (optimizer, device) = (&mut self.optimizer, &self.device);
-                let new = host_update(optimizer, &s, 2 * i, weight, g.into_data(), shape, device)?;
-                linear.weight = Param::from_tensor(new);
-            }
-            if let Some(param) = linear.bias.as_mut()
-                && let Some(g) = param.val().grad(&grads)
-            {
-                let (optimizer, device) = (&mut self.optimizer, &self.device);
-                let shape = [shape[1]];
-                let new =
-                    host_update(optimizer, &s, 2 * i + 1, bias, g.into_data(), shape, device)?;
-                *param = Param::from_tensor(new);
-            }
-        }
-        Ok(value)
+        let (net, optimizer, scratch) = (&mut self.net, &mut self.optimizer, &mut self.scratch);
+        Ok(backprop::step(
+            net, optimizer, scratch, features, labels, self.beta,
+        ))
     }
 
-    /// Predictions for `features` (n x 900, flat) with the current weights, without autodiff.
+    /// Predictions for `features` (n x 900, flat) with the current weights.
     pub fn predict(&self, features: &[f32]) -> Result<Vec<[f32; 2]>, Error> {
-        let model = self.mlp.valid();
-        let device = self.device.clone().inner();
-        let mut out = Vec::with_capacity(features.len() / INPUTS);
-        for chunk in features.chunks(EVAL_CHUNK * INPUTS) {
-            let n = chunk.len() / INPUTS;
-            let x = Tensor::<2>::from_data(TensorData::new(chunk.to_vec(), [n, INPUTS]), &device);
-            let y = model::to_vec(&model.forward(x))?;
-            out.extend(y.chunks_exact(OUTPUTS).map(|p| [p[0], p[1]]));
+        if !features.len().is_multiple_of(INPUTS) {
+            return Err(Error::Batch {
+                features: features.len(),
+                labels: 0,
+            });
         }
-        Ok(out)
+        Ok(features
+            .chunks_exact(INPUTS)
+            .map(|x| self.net.predict_one(x))
+            .collect())
     }
 
     /// The current weights in PyTorch layout.
     pub fn parameters(&self) -> Result<Parameters, Error> {
-        Ok(self.mlp.valid().parameters()?)
+        let params = self.net.parameters();
+        params.validate()?;
+        Ok(params)
     }
 }
