@@ -5,6 +5,7 @@
 //! `evtac-experiments`, `evtac-online`). Run `evtac --help` for the subcommands.
 
 mod commands;
+mod inputs;
 mod progress;
 mod workers;
 

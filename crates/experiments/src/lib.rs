@@ -2,7 +2,8 @@
 //! Experiments 1-3, the latency study, and the report with its figures.
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
-//!   `no_contact.aedat4`, `labels/`), labels computed when missing.
+//!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
+//!   calibration and mask come from its files or were opted out of.
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -36,6 +37,7 @@ pub mod examples;
 pub mod exp1;
 pub mod exp2;
 pub mod exp3;
+pub mod inputs;
 pub mod io;
 pub mod jobs;
 pub mod latency;

@@ -1,6 +1,7 @@
 //! Integration tests of evtac-experiments on small simulated datasets.
 
 mod cache;
+mod inputs;
 mod resume;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
