@@ -36,6 +36,9 @@ enum Command {
     Convert(commands::convert::Args),
     /// Simulate NeuroTac trials of one of the paper's protocols into a dataset folder.
     Simulate(commands::simulate::Args),
+    /// Validate a dataset before training: manifest, files, time spans, IMU rate, calibration,
+    /// no-contact recording, Experiment 3 groups (exit status 1 when anything is wrong).
+    Check(commands::check::Args),
     /// Derive contact-angle labels from each trial's IMU stream.
     Labels(commands::labels::Args),
     /// Build static, dynamic or combined frames, potentials or pooled features at sample times.
@@ -60,6 +63,7 @@ fn main() {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
+        Command::Check(args) => commands::check::run(args),
         Command::Labels(args) => commands::labels::run(args),
         Command::Represent(args) => commands::represent::run(args),
         Command::Train(args) => commands::train::run(args),

@@ -4,6 +4,7 @@
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
+//! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -31,6 +32,7 @@
 //! ```
 
 pub mod cache;
+pub mod check;
 pub mod context;
 pub mod dataset;
 pub mod examples;

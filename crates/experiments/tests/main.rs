@@ -1,6 +1,7 @@
 //! Integration tests of evtac-experiments on small simulated datasets.
 
 mod cache;
+mod check;
 mod inputs;
 mod resume;
 

@@ -1,5 +1,6 @@
 //! One module per subcommand: its clap arguments (`Args`) and its `run`.
 
+pub mod check;
 pub mod convert;
 pub mod evaluate;
 pub mod info;
