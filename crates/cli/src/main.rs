@@ -36,6 +36,8 @@ enum Command {
     Convert(commands::convert::Args),
     /// Simulate NeuroTac trials of one of the paper's protocols into a dataset folder.
     Simulate(commands::simulate::Args),
+    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log).
+    Import(commands::import::Args),
     /// Validate a dataset before training: manifest, files, time spans, IMU rate, calibration,
     /// no-contact recording, Experiment 3 groups (exit status 1 when anything is wrong).
     Check(commands::check::Args),
@@ -63,6 +65,7 @@ fn main() {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
+        Command::Import(args) => commands::import::run(args),
         Command::Check(args) => commands::check::run(args),
         Command::Labels(args) => commands::labels::run(args),
         Command::Represent(args) => commands::represent::run(args),

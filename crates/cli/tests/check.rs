@@ -1,26 +1,14 @@
 //! Tests of `evtac check`: exit status 0 and a summary for a simulated dataset, 1 and a table
 //! of problems for a damaged one.
 
-use crate::common::{evtac, run_ok};
+use crate::common::{evtac, run_ok, simulate_tiny};
 
 #[test]
 fn passes_a_simulated_dataset_and_tables_the_problems_of_a_damaged_one() {
     let dir = tempfile::tempdir().unwrap();
     let ds = dir.path().join("ds");
     let ds_s = ds.to_str().unwrap();
-    run_ok(&[
-        "simulate",
-        "--protocol",
-        "exp1",
-        "--scale",
-        "tiny",
-        "--seed",
-        "5",
-        "--out",
-        ds_s,
-        "--limit",
-        "2",
-    ]);
+    simulate_tiny("exp1", 5, &ds, 2);
     let out = run_ok(&["check", ds_s]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(

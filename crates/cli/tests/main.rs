@@ -4,6 +4,7 @@ mod check;
 mod common;
 mod convert;
 mod evaluate;
+mod import;
 mod info;
 mod labels;
 mod legacy_formats;

@@ -259,7 +259,7 @@ fn manifest_problem(path: &Path, e: &ManifestError) -> Problem {
 }
 
 /// The range checks of one manifest row.
-fn range_problems(path: &Path, line: usize, t: &TrialMeta) -> Vec<Problem> {
+pub(crate) fn range_problems(path: &Path, line: usize, t: &TrialMeta) -> Vec<Problem> {
     let mut out = Vec::new();
     let mut bad = |field: &str, problem: String, fix: &str| {
         out.push(Problem::new(path, Some(line), Some(field), problem, fix));

@@ -5,6 +5,7 @@
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
+//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -39,6 +40,7 @@ pub mod examples;
 pub mod exp1;
 pub mod exp2;
 pub mod exp3;
+pub mod import;
 pub mod inputs;
 pub mod io;
 pub mod jobs;
@@ -48,6 +50,7 @@ pub mod plan;
 pub mod plots;
 pub mod report;
 pub mod results;
+pub mod robot_log;
 pub mod sampling;
 pub mod splits;
 pub mod stage;

@@ -2,6 +2,7 @@
 
 mod cache;
 mod check;
+mod import;
 mod inputs;
 mod resume;
 
