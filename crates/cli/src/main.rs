@@ -5,6 +5,7 @@
 //! `evtac-experiments`, `evtac-online`). Run `evtac --help` for the subcommands.
 
 mod commands;
+mod inputs;
 mod progress;
 mod workers;
 
@@ -35,6 +36,11 @@ enum Command {
     Convert(commands::convert::Args),
     /// Simulate NeuroTac trials of one of the paper's protocols into a dataset folder.
     Simulate(commands::simulate::Args),
+    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log).
+    Import(commands::import::Args),
+    /// Validate a dataset before training: manifest, files, time spans, IMU rate, calibration,
+    /// no-contact recording, Experiment 3 groups (exit status 1 when anything is wrong).
+    Check(commands::check::Args),
     /// Derive contact-angle labels from each trial's IMU stream.
     Labels(commands::labels::Args),
     /// Build static, dynamic or combined frames, potentials or pooled features at sample times.
@@ -61,6 +67,8 @@ fn main() {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
+        Command::Import(args) => commands::import::run(args),
+        Command::Check(args) => commands::check::run(args),
         Command::Labels(args) => commands::labels::run(args),
         Command::Represent(args) => commands::represent::run(args),
         Command::Train(args) => commands::train::run(args),

@@ -20,3 +20,22 @@ pub fn run_ok(args: &[&str]) -> Output {
     );
     out
 }
+
+/// Simulates the first `limit` trials of `protocol` at the tiny scale with `seed` into `out`.
+pub fn simulate_tiny(protocol: &str, seed: u64, out: &std::path::Path, limit: usize) {
+    let (seed, limit) = (seed.to_string(), limit.to_string());
+    let out = out.to_str().expect("utf-8 path");
+    run_ok(&[
+        "simulate",
+        "--protocol",
+        protocol,
+        "--scale",
+        "tiny",
+        "--seed",
+        &seed,
+        "--out",
+        out,
+        "--limit",
+        &limit,
+    ]);
+}

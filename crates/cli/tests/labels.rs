@@ -88,3 +88,32 @@ fn errors_name_the_trial_and_what_is_missing() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("trials.csv"), "{err}");
 }
+
+#[test]
+fn a_missing_calibration_is_refused_unless_the_identity_is_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("ds");
+    simulate(&ds);
+    std::fs::remove_file(ds.join("calibration.json")).unwrap();
+    let ds_s = ds.to_str().unwrap();
+    let out = evtac().args(["labels", ds_s]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("calibration.json is missing"), "{err}");
+    assert!(err.contains("--identity-calibration"), "{err}");
+
+    // Without the gyroscope scale check, which the wrong rotation would fail.
+    let out = run_ok(&[
+        "labels",
+        ds_s,
+        "--identity-calibration",
+        "--scale",
+        "none",
+        "--json",
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The simulator turns its IMU against the sensor, so the identity gives wrong labels: the
+    // flag really replaced the calibration.
+    let rms = json["truth_rms_deg"]["mean"].as_f64().unwrap();
+    assert!(rms > 1.0, "identity-calibrated labels RMS {rms} deg");
+}

@@ -1,8 +1,10 @@
 //! Integration tests of the `evtac` binary: one test binary, one module per subcommand.
 
+mod check;
 mod common;
 mod convert;
 mod evaluate;
+mod import;
 mod info;
 mod jobs;
 mod labels;

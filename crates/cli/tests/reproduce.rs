@@ -115,3 +115,78 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
     assert!(lines.iter().any(|l| l.contains("--repr static")));
     assert!(lines.iter().any(|l| l.contains("--repr dynamic")));
 }
+
+/// Runs `evtac` with `args`, expecting it to fail; returns its stderr.
+fn run_err(args: &[&str]) -> String {
+    let out = crate::common::evtac().args(args).output().unwrap();
+    assert!(!out.status.success(), "evtac {args:?} succeeded");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn datasets_without_calibration_or_no_contact_are_refused_unless_opted_out() {
+    let report = std::fs::read_to_string(tiny_run().join("report.md")).unwrap();
+    assert!(
+        report.contains("Calibration: calibration.json. No-contact mask: no_contact.aedat4."),
+        "the report does not state its inputs"
+    );
+    // A dataset of only a manifest: opening it is refused before any recording is read.
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    let exp1 = data.join("exp1");
+    std::fs::create_dir_all(&exp1).unwrap();
+    std::fs::copy(
+        tiny_run().join("data").join("exp1").join("trials.csv"),
+        exp1.join("trials.csv"),
+    )
+    .unwrap();
+    let (data_s, exp1_s) = (data.to_str().unwrap(), exp1.to_str().unwrap());
+    let out_s = dir.path().join("out").display().to_string();
+    let list = dir.path().join("jobs.txt");
+    let list_s = list.to_str().unwrap();
+    let reproduce = |extra: &[&str]| {
+        let mut a = vec!["reproduce", "--scale", "tiny", "--data", data_s, "--out"];
+        a.extend([out_s.as_str(), "--export-jobs", list_s]);
+        a.extend(extra);
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let run = |extra: &[&str], ok: bool| {
+        let a = reproduce(extra);
+        let args: Vec<&str> = a.iter().map(String::as_str).collect();
+        if ok {
+            run_ok(&args);
+            String::new()
+        } else {
+            run_err(&args)
+        }
+    };
+    let err = run(&[], false);
+    assert!(
+        err.contains("calibration.json is missing") && err.contains("--identity-calibration"),
+        "{err}"
+    );
+    let err = run(&["--identity-calibration"], false);
+    assert!(
+        err.contains("no_contact.aedat4 is missing") && err.contains("--no-mask"),
+        "{err}"
+    );
+    run(&["--identity-calibration", "--no-mask"], true);
+    let jobs = std::fs::read_to_string(&list).unwrap();
+    assert!(!jobs.is_empty());
+    assert!(
+        jobs.lines()
+            .all(|l| l.contains(" --identity-calibration") && l.contains(" --no-mask")),
+        "exported jobs must open the dataset as the reproduction does:\n{jobs}"
+    );
+    let model = dir.path().join("m").display().to_string();
+    for cmd in [
+        vec!["train", exp1_s, "--repr", "static", "--out", &model],
+        vec!["tune", exp1_s, "--repr", "static", "--scale", "tiny"],
+    ] {
+        let err = run_err(&cmd);
+        assert!(
+            err.contains("calibration.json is missing"),
+            "{cmd:?}: {err}"
+        );
+    }
+}

@@ -29,3 +29,8 @@ pub const TRUTH_DIR: &str = "truth";
 pub const SPLITS_FILE: &str = "splits.json";
 /// The feature cache folder.
 pub const CACHE_DIR: &str = "cache";
+
+/// The recording of the trial named `trial`, as the simulator and `evtac import` name it.
+pub fn trial_file(trial: &str) -> String {
+    format!("{trial}.aedat4")
+}

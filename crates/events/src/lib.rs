@@ -9,7 +9,8 @@
 //! [`read_recording`] reads it whole; [`read_recording_range`] (or
 //! [`EventReader::select_range`]) reads only a time range `[from, to)`, through an AEDAT4 file's
 //! data table when it has one ([`RangeIndex`] says how the range was found); [`EventWriter`]
-//! writes AEDAT4 (events, IMU samples and triggers), CSV or NPY. Readers never
+//! writes AEDAT4 (events, IMU samples and triggers), CSV or NPY; [`Summary`] is what a
+//! recording holds (counts, time spans, IMU rate), read in one streaming pass. Readers never
 //! panic on bad input: a truncated or corrupt file, a bad header, an event outside the declared
 //! resolution or a timestamp going backwards is an [`Error`] naming the file, the byte offset or
 //! event index, and the broken limit.
@@ -39,6 +40,7 @@ pub mod manifest;
 pub mod npy;
 mod range;
 mod recording;
+mod summary;
 mod text_header;
 mod types;
 
@@ -48,4 +50,5 @@ pub use recording::{
     Chunk, EventReader, EventWriter, Events, Format, Recording, open, read_recording,
     read_recording_range,
 };
+pub use summary::Summary;
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

@@ -194,19 +194,34 @@ impl Manifest {
         Self::parse(&text, &path)
     }
 
-    /// Parses manifest text; `path` only names the source in errors.
+    /// Parses manifest text; `path` only names the source in errors. Fails on the first bad
+    /// row ([`Manifest::parse_rows`] reports them all).
     pub fn parse(text: &str, path: &Path) -> Result<Self, ManifestError> {
+        let rows = Self::parse_rows(text, path);
+        match rows.errors.into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(Self {
+                trials: rows.trials.into_iter().map(|(_, t)| t).collect(),
+            }),
+        }
+    }
+
+    /// Parses manifest text row by row, keeping going past bad rows: every good row with its
+    /// line number, and an error for every bad one (a bad header is the only error, as the
+    /// rows cannot be read without it). What `evtac check` lists.
+    pub fn parse_rows(text: &str, path: &Path) -> ParsedRows {
+        let mut out = ParsedRows::default();
         let mut lines = text.lines().enumerate();
         let header = lines.next().map(|(_, l)| l.trim_end()).unwrap_or("");
         let expected = COLUMNS.join(",");
         if header != expected {
-            return Err(ManifestError::Header {
+            out.errors.push(ManifestError::Header {
                 path: path.to_path_buf(),
                 expected,
                 found: header.to_string(),
             });
+            return out;
         }
-        let mut trials = Vec::new();
         let mut seen = std::collections::HashMap::new();
         for (index, raw) in lines {
             let line = index + 1;
@@ -214,43 +229,24 @@ impl Manifest {
             if raw.is_empty() {
                 continue;
             }
-            let cells: Vec<&str> = raw.split(',').collect();
-            if cells.len() != COLUMNS.len() {
-                return Err(ManifestError::CellCount {
-                    path: path.to_path_buf(),
-                    line,
-                    expected: COLUMNS.len(),
-                    found: cells.len(),
-                });
+            match parse_row(path, line, raw) {
+                Ok(meta) => {
+                    if let Some(&first_line) = seen.get(&meta.trial) {
+                        out.errors.push(ManifestError::DuplicateTrial {
+                            path: path.to_path_buf(),
+                            line,
+                            first_line,
+                            trial: meta.trial,
+                        });
+                        continue;
+                    }
+                    seen.insert(meta.trial.clone(), line);
+                    out.trials.push((line, meta));
+                }
+                Err(e) => out.errors.push(e),
             }
-            let row = Row { path, line, cells };
-            let meta = TrialMeta {
-                trial: row.name(0)?,
-                file: PathBuf::from(row.name(1)?),
-                truth: row.optional(2, |r, i| r.name(i).map(PathBuf::from))?,
-                direction_deg: row.float(3)?,
-                speed_deg_s: row.float(4)?,
-                depth_mm: row.float(5)?,
-                total_deg: row.float(6)?,
-                motion_start_us: row.int(7)?,
-                motion_end_us: row.int(8)?,
-                stop_start_us: row.optional(9, Row::int)?,
-                stop_end_us: row.optional(10, Row::int)?,
-                stop_deg: row.optional(11, Row::float)?,
-                group: row.optional(12, Row::name)?,
-            };
-            if let Some(&first_line) = seen.get(&meta.trial) {
-                return Err(ManifestError::DuplicateTrial {
-                    path: path.to_path_buf(),
-                    line,
-                    first_line,
-                    trial: meta.trial,
-                });
-            }
-            seen.insert(meta.trial.clone(), line);
-            trials.push(meta);
         }
-        Ok(Self { trials })
+        out
     }
 
     /// The manifest as CSV text (header and one line per trial, `\n` line ends).
@@ -308,6 +304,44 @@ impl Manifest {
     pub fn get(&self, trial: &str) -> Option<&TrialMeta> {
         self.trials.iter().find(|t| t.trial == trial)
     }
+}
+
+/// What [`Manifest::parse_rows`] found: the rows that parse, and an error per row that does not.
+#[derive(Debug, Default)]
+pub struct ParsedRows {
+    /// The good rows, each with its 1-based line number, in file order.
+    pub trials: Vec<(usize, TrialMeta)>,
+    /// The bad header, or every bad row (wrong cell count, bad cell, repeated trial name).
+    pub errors: Vec<ManifestError>,
+}
+
+/// Parses the data row `raw` at 1-based `line`.
+fn parse_row(path: &Path, line: usize, raw: &str) -> Result<TrialMeta, ManifestError> {
+    let cells: Vec<&str> = raw.split(',').collect();
+    if cells.len() != COLUMNS.len() {
+        return Err(ManifestError::CellCount {
+            path: path.to_path_buf(),
+            line,
+            expected: COLUMNS.len(),
+            found: cells.len(),
+        });
+    }
+    let row = Row { path, line, cells };
+    Ok(TrialMeta {
+        trial: row.name(0)?,
+        file: PathBuf::from(row.name(1)?),
+        truth: row.optional(2, |r, i| r.name(i).map(PathBuf::from))?,
+        direction_deg: row.float(3)?,
+        speed_deg_s: row.float(4)?,
+        depth_mm: row.float(5)?,
+        total_deg: row.float(6)?,
+        motion_start_us: row.int(7)?,
+        motion_end_us: row.int(8)?,
+        stop_start_us: row.optional(9, Row::int)?,
+        stop_end_us: row.optional(10, Row::int)?,
+        stop_deg: row.optional(11, Row::float)?,
+        group: row.optional(12, Row::name)?,
+    })
 }
 
 /// One data row being parsed, carrying what error messages need.
@@ -584,6 +618,32 @@ mod tests {
             ),
             "{err}"
         );
+    }
+
+    #[test]
+    fn parse_rows_reports_every_bad_row_and_keeps_the_good_ones() {
+        let text = format!(
+            "{HEADER}\nb,b.aedat4,,0.5,2,1.25,20,1,2,,,,\nc,c.aedat4,,x,2,1,20,1,2,,,,\n\
+             d,d.aedat4\nb,b.aedat4,,0.5,2,1.25,20,1,2,,,,\ne,e.aedat4,,1,2,1,20,1,2,,,,\n"
+        );
+        let rows = Manifest::parse_rows(&text, Path::new("trials.csv"));
+        let good: Vec<(usize, &str)> = rows
+            .trials
+            .iter()
+            .map(|(l, t)| (*l, t.trial.as_str()))
+            .collect();
+        assert_eq!(good, [(2, "b"), (6, "e")]);
+        let lines: Vec<String> = rows.errors.iter().map(|e| e.to_string()).collect();
+        assert_eq!(rows.errors.len(), 3, "{lines:?}");
+        assert!(lines[0].contains(":3: column `direction_deg`"), "{lines:?}");
+        assert!(lines[1].contains(":4: expected 13"), "{lines:?}");
+        assert!(
+            lines[2].contains(":5: trial `b` already appears on line 2"),
+            "{lines:?}"
+        );
+        let rows = Manifest::parse_rows("trial,file\n", Path::new("trials.csv"));
+        assert!(rows.trials.is_empty());
+        assert!(matches!(rows.errors[..], [ManifestError::Header { .. }]));
     }
 
     #[test]

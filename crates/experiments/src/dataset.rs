@@ -1,11 +1,14 @@
 //! A dataset folder: `trials.csv` (the manifest), the trial recordings, `calibration.json`,
 //! `no_contact.aedat4` (for the static representation's mask), and what evtac adds to it:
 //! `labels/<trial>.csv` (computed from the IMU when missing), `splits.json` and `cache/`.
+//! Opening one takes the [`Inputs`] to use: a missing calibration or no-contact recording is an
+//! error unless they opt out of it.
 
+use crate::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use crate::io::IoError;
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
-use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR, NO_CONTACT_FILE};
+use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_labels::geometry::Calibration;
@@ -24,13 +27,17 @@ pub enum Error {
     /// A file could not be read or written.
     #[error(transparent)]
     Io(#[from] IoError),
-    /// `calibration.json` is not a calibration.
-    #[error("{path}: not a calibration: {source}")]
-    Calibration {
-        /// The file.
+    /// `calibration.json` is missing or not a calibration.
+    #[error(transparent)]
+    Calibration(evtac_labels::Error),
+    /// `no_contact.aedat4` is missing and the mask was not opted out of.
+    #[error(
+        "{path} is missing: add a recording without contact there (for the static \
+         representation's mask), or pass --{NO_MASK_FLAG} to run without a mask"
+    )]
+    MissingNoContact {
+        /// The file that is missing.
         path: PathBuf,
-        /// The cause.
-        source: serde_json::Error,
     },
     /// A recording could not be decoded.
     #[error("{path}: {source}")]
@@ -84,8 +91,10 @@ pub struct Dataset {
     pub dir: PathBuf,
     /// Its trials.
     pub manifest: Manifest,
-    /// Its sensor calibration (the default when `calibration.json` is absent).
+    /// Its sensor calibration (`calibration.json`, or the identity when opted out).
     pub calibration: Calibration,
+    /// Where the calibration and the mask come from.
+    pub inputs: Inputs,
 }
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
@@ -118,23 +127,21 @@ pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
 }
 
 impl Dataset {
-    /// Opens the dataset at `dir`: reads `trials.csv` and `calibration.json` (default when
-    /// absent).
-    pub fn open(dir: &Path) -> Result<Dataset, Error> {
+    /// Opens the dataset at `dir` with `inputs`: reads `trials.csv` and the calibration, and
+    /// checks that `no_contact.aedat4` exists when the mask is built from it.
+    pub fn open(dir: &Path, inputs: Inputs) -> Result<Dataset, Error> {
         let manifest = Manifest::read(dir)?;
-        let cal_path = dir.join(CALIBRATION_FILE);
-        let calibration = match std::fs::read_to_string(&cal_path) {
-            Ok(text) => serde_json::from_str(&text).map_err(|source| Error::Calibration {
-                path: cal_path.clone(),
-                source,
-            })?,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Calibration::default(),
-            Err(e) => return Err(io_err(&cal_path)(e)),
-        };
+        let calibration = evtac_labels::dataset_calibration(dir, inputs.calibration)
+            .map_err(Error::Calibration)?;
+        let no_contact = dir.join(NO_CONTACT_FILE);
+        if inputs.mask == MaskSource::NoContact && !no_contact.is_file() {
+            return Err(Error::MissingNoContact { path: no_contact });
+        }
         Ok(Dataset {
             dir: dir.to_path_buf(),
             manifest,
             calibration,
+            inputs,
         })
     }
 
@@ -226,19 +233,17 @@ impl Dataset {
         read_cropped(&self.dir.join(&meta.file))
     }
 
-    /// The no-contact recording's events cropped to [`CROP`], or `None` when the dataset has
-    /// no `no_contact.aedat4`.
+    /// The no-contact recording's events cropped to [`CROP`], or `None` when the dataset was
+    /// opened without a mask.
     pub fn no_contact_events(&self) -> Result<Option<Vec<Event>>, Error> {
-        let path = self.dir.join(NO_CONTACT_FILE);
-        if !path.is_file() {
-            return Ok(None);
+        match self.inputs.mask {
+            MaskSource::NoContact => read_cropped(&self.dir.join(NO_CONTACT_FILE)).map(Some),
+            MaskSource::Unmasked => Ok(None),
         }
-        read_cropped(&path).map(Some)
     }
 
     /// The no-contact mask for `config` (built with its static part's settings, as the paper's
-    /// rule implies), or `None` for a dynamic config or a dataset without a no-contact
-    /// recording.
+    /// rule implies), or `None` for a dynamic config or a dataset opened without a mask.
     pub fn mask_for(
         &self,
         config: &ReprConfig,

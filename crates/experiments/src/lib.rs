@@ -2,7 +2,10 @@
 //! Experiments 1-3, the latency study, and the report with its figures.
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
-//!   `no_contact.aedat4`, `labels/`), labels computed when missing.
+//!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
+//!   calibration and mask come from its files or were opted out of.
+//! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
+//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -31,12 +34,15 @@
 //! ```
 
 pub mod cache;
+pub mod check;
 pub mod context;
 pub mod dataset;
 pub mod examples;
 pub mod exp1;
 pub mod exp2;
 pub mod exp3;
+pub mod import;
+pub mod inputs;
 pub mod io;
 pub mod jobs;
 pub mod latency;
@@ -45,6 +51,7 @@ pub mod plan;
 pub mod plots;
 pub mod report;
 pub mod results;
+pub mod robot_log;
 pub mod sampling;
 pub mod slurm;
 pub mod splits;

@@ -6,6 +6,7 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::{self, Dataset};
 use crate::exp3::Axis;
+use crate::inputs::Inputs;
 use crate::jobs::{self, Progress};
 use crate::plan::Plan;
 use crate::results::{Results, RunInfo};
@@ -68,11 +69,14 @@ pub struct Datasets {
     pub exp3_speed: Option<PathBuf>,
     /// Depth-wise (Experiment 3).
     pub exp3_depth: Option<PathBuf>,
+    /// The calibration and mask every dataset is opened with.
+    pub inputs: Inputs,
 }
 
 impl Datasets {
     /// The datasets under `dir` as `evtac simulate` lays them out (`exp1/`, `exp2/`,
-    /// `exp3-speed/`, `exp3-depth/`); absent optional ones are `None`.
+    /// `exp3-speed/`, `exp3-depth/`); absent optional ones are `None`. Each dataset's
+    /// calibration and mask come from its files ([`Inputs::FROM_FILES`]).
     pub fn in_dir(dir: &Path) -> Datasets {
         let opt = |name: &str| {
             let p = dir.join(name);
@@ -85,6 +89,7 @@ impl Datasets {
             exp2: opt("exp2"),
             exp3_speed: opt("exp3-speed"),
             exp3_depth: opt("exp3-depth"),
+            inputs: Inputs::FROM_FILES,
         }
     }
 }
@@ -152,7 +157,7 @@ pub fn reproduce(
         progress,
     };
     let models = out.join("models");
-    let ds1 = Dataset::open(&data.exp1)?;
+    let ds1 = Dataset::open(&data.exp1, data.inputs)?;
     let splits1 = ds1.splits(seed)?;
     let cache1 = FeatureCache::new(&ds1)?;
     let mut datasets = vec![("exp1".to_string(), ds1.manifest.trials.len())];
@@ -175,7 +180,7 @@ pub fn reproduce(
     let mut e2 = Vec::new();
     let mut example = None;
     if let Some(dir) = &data.exp2 {
-        let ds2 = Dataset::open(dir)?;
+        let ds2 = Dataset::open(dir, data.inputs)?;
         datasets.push(("exp2".into(), ds2.manifest.trials.len()));
         let splits2 = ds2.splits(seed)?;
         let cache2 = FeatureCache::new(&ds2)?;
@@ -209,7 +214,7 @@ pub fn reproduce(
         (&data.exp3_depth, Axis::Depth, &depths),
     ] {
         let Some(dir) = dir else { continue };
-        let ds = Dataset::open(dir)?;
+        let ds = Dataset::open(dir, data.inputs)?;
         datasets.push((
             match axis {
                 Axis::Speed => "exp3-speed".into(),
@@ -253,6 +258,7 @@ pub fn reproduce(
             plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
             stage_seconds: Vec::new(),
             datasets,
+            inputs: Some(data.inputs),
         },
         tuning: vec![st, dt],
         exp1: e1,
@@ -270,10 +276,12 @@ pub fn reproduce(
     Ok(results)
 }
 
-/// One `evtac train` command line for `spec` on `dataset`, writing into `dir`.
+/// One `evtac train` command line for `spec` on `dataset` opened with `inputs`, writing into
+/// `dir`.
 pub fn train_command(
     exe: &str,
     dataset: &Path,
+    inputs: Inputs,
     spec: &TrainSpec,
     splits_seed: u64,
     dir: &Path,
@@ -310,6 +318,7 @@ pub fn train_command(
             args.push("--train-on-stop".into());
         }
     }
+    args.extend(inputs.flags());
     args.extend(["--out".into(), dir.display().to_string()]);
     args.push("--quiet".into());
     jobs::command_line(&args)
@@ -337,7 +346,7 @@ pub fn export_jobs(
     exe: &str,
 ) -> Result<Vec<String>, Error> {
     let models = out.join("models");
-    let ds1 = Dataset::open(&data.exp1)?;
+    let ds1 = Dataset::open(&data.exp1, data.inputs)?;
     ds1.splits(seed)?;
     let mut lines = Vec::new();
     let mut tuned = Vec::new();
@@ -358,6 +367,7 @@ pub fn export_jobs(
                 lines.push(train_command(
                     exe,
                     &data.exp1,
+                    data.inputs,
                     &tuning::spec(p.config, plan, seed),
                     seed,
                     &dir,
@@ -372,14 +382,21 @@ pub fn export_jobs(
         let reprs = exp1::representations(s, d);
         for j in exp1::jobs(&reprs, plan, seed, &models) {
             if !exp1::finished(&j.dir) {
-                lines.push(train_command(exe, &data.exp1, &j.spec, seed, &j.dir));
+                lines.push(train_command(
+                    exe,
+                    &data.exp1,
+                    data.inputs,
+                    &j.spec,
+                    seed,
+                    &j.dir,
+                ));
             }
         }
         if let Some(d2) = &data.exp2 {
-            Dataset::open(d2)?.splits(seed)?;
+            Dataset::open(d2, data.inputs)?.splits(seed)?;
             for j in exp2::jobs(&reprs, plan, seed, &models) {
                 if !exp1::finished(&j.dir) {
-                    lines.push(train_command(exe, d2, &j.spec, seed, &j.dir));
+                    lines.push(train_command(exe, d2, data.inputs, &j.spec, seed, &j.dir));
                 }
             }
         }

@@ -165,6 +165,14 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(md, "| {name} | {n} |");
     }
     let _ = writeln!(md);
+    if let Some(inputs) = &r.run.inputs {
+        let _ = writeln!(
+            md,
+            "Calibration: {}. No-contact mask: {}.\n",
+            inputs.calibration_text(),
+            inputs.mask_text()
+        );
+    }
     let get = |k: &str| plan.get(k).map_or("?".to_string(), |v| v.to_string());
     let _ = writeln!(
         md,

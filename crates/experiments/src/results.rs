@@ -214,6 +214,10 @@ pub struct RunInfo {
     pub stage_seconds: Vec<(String, f64)>,
     /// Trials per dataset.
     pub datasets: Vec<(String, usize)>,
+    /// Where every dataset's calibration and mask came from (absent in results written before
+    /// this was recorded).
+    #[serde(default)]
+    pub inputs: Option<crate::inputs::Inputs>,
 }
 
 /// Example curves of one pause trial (Experiment 2's figure).

@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
+use crate::inputs::Inputs;
 use crate::io::IoError;
 use crate::jobs::{self, Progress};
 use crate::pipeline::{self, Datasets};
@@ -235,6 +236,8 @@ pub struct Reproduction {
     pub out: PathBuf,
     /// Existing datasets, or `None` to simulate them into `out/data`.
     pub data: Option<PathBuf>,
+    /// Where the datasets' calibration and mask come from (the opt-out flags).
+    pub inputs: Inputs,
 }
 
 impl Reproduction {
@@ -255,6 +258,7 @@ impl Reproduction {
         if let Some(data) = &self.data {
             args.extend(["--data".into(), data.display().to_string()]);
         }
+        args.extend(self.inputs.flags());
         jobs::command_line(&args)
     }
 
@@ -307,7 +311,10 @@ impl Reproduction {
                 .collect();
             check(slurm, "simulate", &job, &unfinished, &logs)?;
         }
-        let data = Datasets::in_dir(self.data.as_deref().unwrap_or(&self.sim_dir()));
+        let data = Datasets {
+            inputs: self.inputs,
+            ..Datasets::in_dir(self.data.as_deref().unwrap_or(&self.sim_dir()))
+        };
         let report = [self.local_command()];
         let submitted = std::time::SystemTime::now();
         let mut round = 0;

@@ -3,6 +3,7 @@
 use crate::simulate;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
+use evtac_experiments::inputs::Inputs;
 use evtac_experiments::plan;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_sim::Protocol;
@@ -11,7 +12,7 @@ use evtac_sim::Protocol;
 fn second_run_computes_no_features_and_loads_the_same() {
     let dir = tempfile::tempdir().unwrap();
     simulate(dir.path(), Protocol::Exp1, 3);
-    let ds = Dataset::open(dir.path()).unwrap();
+    let ds = Dataset::open(dir.path(), Inputs::FROM_FILES).unwrap();
     let cache = FeatureCache::new(&ds).unwrap();
     let trials: Vec<_> = ds.manifest.trials.iter().collect();
     let configs = [

@@ -1,6 +1,9 @@
 //! Integration tests of evtac-experiments on small simulated datasets.
 
 mod cache;
+mod check;
+mod import;
+mod inputs;
 mod resume;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};

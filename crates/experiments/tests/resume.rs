@@ -4,6 +4,7 @@ use crate::simulate;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
 use evtac_experiments::exp1;
+use evtac_experiments::inputs::Inputs;
 use evtac_experiments::jobs::{self, Quiet};
 use evtac_experiments::plan::{self, Plan};
 use evtac_learn::ModelBundle;
@@ -15,7 +16,7 @@ fn resumed_run_redoes_only_the_unfinished_job() {
     let data = dir.path().join("exp1");
     let out = dir.path().join("out");
     simulate(&data, Protocol::Exp1, 6);
-    let ds = Dataset::open(&data).unwrap();
+    let ds = Dataset::open(&data, Inputs::FROM_FILES).unwrap();
     let splits = ds.splits(1).unwrap();
     assert!(data.join("splits.json").is_file());
     let cache = FeatureCache::new(&ds).unwrap();

@@ -23,14 +23,47 @@ pub fn labels_path(dataset_dir: impl AsRef<Path>, trial: &str) -> PathBuf {
         .join(format!("{trial}.csv"))
 }
 
-/// Reads `<dataset_dir>/calibration.json`.
+/// The command-line flag (without its dashes) that labels with the identity rotation instead of
+/// a dataset's `calibration.json`; errors about a missing calibration name it.
+pub const IDENTITY_CALIBRATION_FLAG: &str = "identity-calibration";
+
+/// Where a dataset's IMU-to-sensor rotation comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CalibrationSource {
+    /// The dataset's `calibration.json`, which must exist.
+    File,
+    /// [`Calibration::default`] (the identity rotation), asked for explicitly: a real sensor
+    /// whose IMU is not aligned with the dome would otherwise get wrong labels without a word.
+    Identity,
+}
+
+/// The calibration of the dataset in `dataset_dir` from `source`: [`read_calibration`] or the
+/// identity.
+pub fn dataset_calibration(
+    dataset_dir: impl AsRef<Path>,
+    source: CalibrationSource,
+) -> Result<Calibration, Error> {
+    match source {
+        CalibrationSource::File => read_calibration(dataset_dir),
+        CalibrationSource::Identity => Ok(Calibration::default()),
+    }
+}
+
+/// Reads `<dataset_dir>/calibration.json`; a missing file is [`Error::MissingCalibration`].
 pub fn read_calibration(dataset_dir: impl AsRef<Path>) -> Result<Calibration, Error> {
     let path = dataset_dir.as_ref().join(CALIBRATION_FILE);
     let bad = |message: String| Error::Calibration {
         path: path.clone(),
         message,
     };
-    let text = std::fs::read_to_string(&path).map_err(|e| bad(e.to_string()))?;
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(Error::MissingCalibration { path });
+        }
+        Err(e) => return Err(bad(e.to_string())),
+    };
     let calibration: Calibration = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let m = calibration.imu_to_sensor;
     // A rotation's rows are orthonormal; anything else would silently scale the gyroscope.

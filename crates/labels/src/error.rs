@@ -86,6 +86,16 @@ pub enum Error {
     /// The manifest `trials.csv` could not be read.
     #[error(transparent)]
     Manifest(#[from] ManifestError),
+    /// The dataset has no `calibration.json`.
+    #[error(
+        "{path} is missing: add the IMU-to-sensor rotation there, or pass --{flag} to label \
+         with the identity rotation",
+        flag = crate::dataset::IDENTITY_CALIBRATION_FLAG
+    )]
+    MissingCalibration {
+        /// The file that is missing.
+        path: PathBuf,
+    },
     /// `calibration.json` could not be read or parsed.
     #[error("cannot read the calibration {path}: {message}")]
     Calibration {

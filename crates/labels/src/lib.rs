@@ -50,7 +50,10 @@ pub mod series;
 pub mod trial;
 pub mod validation;
 
-pub use dataset::{DatasetLabels, TrialReport, label_dataset, label_trial, read_calibration};
+pub use dataset::{
+    CalibrationSource, DatasetLabels, TrialReport, dataset_calibration, label_dataset, label_trial,
+    read_calibration,
+};
 pub use error::{Error, TrialError};
 pub use scale::ScaleMethod;
 pub use series::LabelSeries;

@@ -81,6 +81,19 @@ impl Default for LabelConfig {
     }
 }
 
+impl LabelConfig {
+    /// How long the sensor must be still, with IMU samples, before each motion onset: the
+    /// stationary segment the gyroscope bias is taken from plus the margin before the onset.
+    pub fn still_lead_in_us(&self) -> i64 {
+        self.min_stationary_us + self.bias_margin_us
+    }
+
+    /// The lowest IMU rate that gives the stationary segment its fewest accepted samples, Hz.
+    pub fn min_imu_rate_hz(&self) -> f64 {
+        self.min_stationary_samples.max(2) as f64 / (self.min_stationary_us as f64 * 1e-6)
+    }
+}
+
 /// A commanded mid-motion stop.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Stop {

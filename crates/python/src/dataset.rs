@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use evtac_events::manifest::Manifest;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
+use evtac_experiments::inputs::Inputs;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_labels::dataset::{DatasetLabels, label_and_write};
 use evtac_labels::{LabelConfig, read_calibration};
@@ -138,7 +139,8 @@ type FeatureArrays<'py> = (
 /// The features (N x 900) and labels (N x 2: pitch, roll) of `trials` (default: all, in
 /// manifest order) of the dataset in `dataset_dir` for `representation`'s config, through the
 /// dataset's feature cache as `evtac train` reads them (computed and cached when missing; the
-/// mask comes from the dataset's `no_contact.aedat4`). Also returns, per sample, the index of
+/// mask comes from the dataset's `no_contact.aedat4` and the labels use its `calibration.json`,
+/// both required). Also returns, per sample, the index of
 /// its trial in the returned names, its time, and whether it is a stop-phase sample.
 #[pyfunction]
 #[pyo3(signature = (dataset_dir, representation, trials = None, motion_points = 50, stop_points = 10))]
@@ -166,7 +168,7 @@ pub fn dataset_features<'py>(
         stop_points,
     };
     let (loaded, names) = py.detach(|| -> PyResult<_> {
-        let ds = Dataset::open(&dataset_dir).map_err(error::file)?;
+        let ds = Dataset::open(&dataset_dir, Inputs::FROM_FILES).map_err(error::file)?;
         let names =
             trials.unwrap_or_else(|| ds.manifest.trials.iter().map(|t| t.trial.clone()).collect());
         let metas = ds.trials(&names).map_err(error::value)?;

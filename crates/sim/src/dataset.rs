@@ -154,7 +154,7 @@ pub fn simulate_dataset(
         .par_iter()
         .map(|spec| {
             let recording = sim.simulate(spec);
-            let file = format!("{}.aedat4", spec.name);
+            let file = evtac_events::layout::trial_file(&spec.name);
             let truth = format!("{TRUTH_DIR}/{}.csv", spec.name);
             write_recording(
                 &out_dir.join(&file),

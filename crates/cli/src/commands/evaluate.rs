@@ -28,13 +28,16 @@ pub struct Args {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Opting out of the dataset's calibration or mask (as the model was trained).
+    #[command(flatten)]
+    pub inputs: crate::inputs::InputArgs,
 }
 
 /// Runs `evtac evaluate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let model = Model::load(&args.model)
         .with_context(|| format!("loading model {}", args.model.display()))?;
-    let ds = Dataset::open(&args.dataset)
+    let ds = Dataset::open(&args.dataset, args.inputs.inputs())
         .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
     let names: Vec<String> = if args.split == "all" {
         ds.manifest.trials.iter().map(|t| t.trial.clone()).collect()

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use serde::Serialize;
+use evtac_events::Summary;
 
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
@@ -15,79 +15,13 @@ pub struct Args {
     pub json: bool,
 }
 
-/// What `evtac info` reports (also its JSON output).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Summary {
-    /// Format name (`AEDAT4`, `AEDAT3.1`, `AEDAT2`, `EVT2`, `EVT21`, `EVT3`, `CSV`, `NPY`).
-    pub format: String,
-    /// Camera the file names, if any.
-    pub source: Option<String>,
-    /// Sensor width, if the file states it.
-    pub width: Option<u16>,
-    /// Sensor height, if the file states it.
-    pub height: Option<u16>,
-    /// Number of events.
-    pub events: u64,
-    /// Number of ON (positive) events.
-    pub on_events: u64,
-    /// First event timestamp (us).
-    pub first_t_us: Option<i64>,
-    /// Last event timestamp (us).
-    pub last_t_us: Option<i64>,
-    /// Number of IMU samples.
-    pub imu_samples: u64,
-    /// Mean IMU rate over the IMU time span (Hz).
-    pub imu_rate_hz: Option<f64>,
-    /// First IMU timestamp (us).
-    pub first_imu_t_us: Option<i64>,
-    /// Last IMU timestamp (us).
-    pub last_imu_t_us: Option<i64>,
-    /// Number of triggers.
-    pub triggers: u64,
-}
-
 /// Reads the whole file in chunks (with a byte progress bar on a terminal) and summarises it.
 pub fn summarise(path: &std::path::Path) -> anyhow::Result<Summary> {
     let mut reader = evtac_events::open(path)?;
     let bar = crate::progress::bytes(reader.file_len(), "reading");
-    let mut s = Summary {
-        format: reader.format().name().to_string(),
-        source: reader.source().map(str::to_string),
-        width: reader.resolution().map(|r| r.width),
-        height: reader.resolution().map(|r| r.height),
-        events: 0,
-        on_events: 0,
-        first_t_us: None,
-        last_t_us: None,
-        imu_samples: 0,
-        imu_rate_hz: None,
-        first_imu_t_us: None,
-        last_imu_t_us: None,
-        triggers: 0,
-    };
-    while let Some(chunk) = reader.next_chunk()? {
-        if let (Some(first), Some(last)) = (chunk.events.first(), chunk.events.last()) {
-            s.first_t_us.get_or_insert(first.t);
-            s.last_t_us = Some(last.t);
-        }
-        s.events += chunk.events.len() as u64;
-        s.on_events += chunk.events.iter().filter(|e| e.polarity).count() as u64;
-        if let (Some(first), Some(last)) = (chunk.imu.first(), chunk.imu.last()) {
-            s.first_imu_t_us.get_or_insert(first.t);
-            s.last_imu_t_us = Some(last.t);
-        }
-        s.imu_samples += chunk.imu.len() as u64;
-        s.triggers += chunk.triggers.len() as u64;
-        bar.set_position(reader.position());
-    }
+    let summary = Summary::read(&mut reader, |position| bar.set_position(position))?;
     bar.finish_and_clear();
-    if let (Some(first), Some(last)) = (s.first_imu_t_us, s.last_imu_t_us)
-        && last > first
-    {
-        // Samples per second over the span between the first and the last sample.
-        s.imu_rate_hz = Some((s.imu_samples - 1) as f64 / ((last - first) as f64 * 1e-6));
-    }
-    Ok(s)
+    Ok(summary)
 }
 
 fn or_dash<T: std::fmt::Display>(v: Option<T>) -> String {

@@ -9,8 +9,9 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use evtac_events::manifest::Manifest;
+use evtac_labels::dataset::IDENTITY_CALIBRATION_FLAG;
 use evtac_labels::dataset::{DatasetLabels, label_and_write};
-use evtac_labels::{LabelConfig, ScaleMethod, read_calibration};
+use evtac_labels::{CalibrationSource, LabelConfig, ScaleMethod, dataset_calibration};
 use rayon::prelude::*;
 
 /// Arguments of `evtac labels`.
@@ -32,6 +33,10 @@ pub struct Args {
     /// (overrides the config).
     #[arg(long, value_name = "METHOD", value_parser = parse_scale)]
     pub scale: Option<ScaleMethod>,
+    /// Label with the identity IMU-to-sensor rotation instead of the dataset's calibration.json
+    /// (which may then be absent). Only right when the IMU's axes are the sensor's.
+    #[arg(long = IDENTITY_CALIBRATION_FLAG)]
+    pub identity_calibration: bool,
 }
 
 fn parse_scale(s: &str) -> Result<ScaleMethod, String> {
@@ -59,7 +64,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         config.scale = scale;
     }
     let manifest = Manifest::read(dir)?;
-    let calibration = read_calibration(dir)?;
+    let source = if args.identity_calibration {
+        CalibrationSource::Identity
+    } else {
+        CalibrationSource::File
+    };
+    let calibration = dataset_calibration(dir, source)?;
     anyhow::ensure!(
         !manifest.trials.is_empty(),
         "{} lists no trials",

@@ -1,7 +1,9 @@
 //! One module per subcommand: its clap arguments (`Args`) and its `run`.
 
+pub mod check;
 pub mod convert;
 pub mod evaluate;
+pub mod import;
 pub mod info;
 pub mod jobs;
 pub mod labels;

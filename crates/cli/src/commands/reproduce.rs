@@ -26,6 +26,9 @@ pub struct Args {
     /// (simulated into `OUT/data` when not given).
     #[arg(long)]
     pub data: Option<PathBuf>,
+    /// Opting out of the `--data` datasets' calibration or mask (simulated datasets have both).
+    #[command(flatten)]
+    pub inputs: crate::inputs::InputArgs,
     /// Master seed (simulation, splits, training).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -123,6 +126,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         seed: args.seed,
         out: absolute(&args.out)?,
         data: args.data.as_ref().map(absolute).transpose()?,
+        inputs: args.inputs.inputs(),
     };
     let slurm = Slurm {
         sbatch_args: args
@@ -182,7 +186,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             d
         }
     };
-    let data = Datasets::in_dir(&data_dir);
+    let data = Datasets {
+        inputs: args.inputs.inputs(),
+        ..Datasets::in_dir(&data_dir)
+    };
     anyhow::ensure!(
         data.exp1
             .join(evtac_events::layout::MANIFEST_FILE)

@@ -106,6 +106,9 @@ pub struct Args {
     /// Model folder to write (a model bundle).
     #[arg(long)]
     pub out: PathBuf,
+    /// Opting out of the dataset's calibration or mask.
+    #[command(flatten)]
+    pub inputs: crate::inputs::InputArgs,
     /// Train again even when `OUT` holds a finished model.
     #[arg(long)]
     pub force: bool,
@@ -126,7 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let repr = args.repr.config()?;
-    let ds = Dataset::open(&args.dataset)
+    let ds = Dataset::open(&args.dataset, args.inputs.inputs())
         .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
     let splits = ds.splits(args.splits_seed)?;
     let cache = FeatureCache::new(&ds)?;

@@ -39,6 +39,9 @@ pub struct Args {
     /// Output folder for the runs' models and `tuning-<repr>.json` (default: DATASET/tuning).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Opting out of the dataset's calibration or mask.
+    #[command(flatten)]
+    pub inputs: crate::inputs::InputArgs,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -58,7 +61,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| args.dataset.join("tuning"));
-    let ds = Dataset::open(&args.dataset)
+    let ds = Dataset::open(&args.dataset, args.inputs.inputs())
         .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
     let splits = ds.splits(args.seed)?;
     let cache = FeatureCache::new(&ds)?;

@@ -6,7 +6,10 @@ use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, EventWriter, ImuSample, Resolution};
 use evtac_labels::dataset::{label_and_write, labels_path};
 use evtac_labels::geometry::Calibration;
-use evtac_labels::{LabelConfig, LabelSeries, label_dataset, label_trial, read_calibration};
+use evtac_labels::{
+    CalibrationSource, LabelConfig, LabelSeries, dataset_calibration, label_dataset, label_trial,
+    read_calibration,
+};
 
 use crate::synthetic::{Gyro, Profile, rotated_calibration};
 
@@ -133,6 +136,11 @@ fn calibration_errors_name_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let err = read_calibration(dir.path()).unwrap_err().to_string();
     assert!(err.contains("calibration.json"), "{err}");
+    assert!(err.contains("--identity-calibration"), "{err}");
+    assert_eq!(
+        dataset_calibration(dir.path(), CalibrationSource::Identity).unwrap(),
+        Calibration::default()
+    );
     let mut skewed = Calibration::default();
     skewed.imu_to_sensor[0][0] = 1.1;
     std::fs::write(

@@ -1,0 +1,114 @@
+//! `evtac import`: a recording session and the robot's log of its motions in, a dataset folder
+//! out (one AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when
+//! given), written into a temporary folder and renamed at the end. The work is
+//! `evtac_experiments::import`'s.
+
+use anyhow::Context;
+use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
+use evtac_experiments::import::{
+    DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, import_session,
+};
+use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
+use evtac_experiments::robot_log::RobotLog;
+use std::path::PathBuf;
+
+/// Arguments of `evtac import`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The session recording (AEDAT4 with a data table is read fastest; any format evtac reads).
+    pub session: PathBuf,
+    /// The robot's log: a CSV with the manifest's columns except file and truth, one row per
+    /// motion (trial, direction_deg, speed_deg_s, depth_mm, total_deg, motion_start_us,
+    /// motion_end_us; optionally stop_start_us, stop_end_us, stop_deg, group).
+    #[arg(long, value_name = "LOG.csv")]
+    pub log: PathBuf,
+    /// The dataset folder to write (must not exist).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Added to the log's times to put them on the recording's clock, microseconds (for a log
+    /// on the robot's clock).
+    #[arg(
+        long,
+        default_value_t = 0,
+        allow_negative_numbers = true,
+        value_name = "N"
+    )]
+    pub clock_offset_us: i64,
+    /// Kept before each motion's onset, ms (cut at the previous motion's end).
+    #[arg(long, default_value_t = DEFAULT_PRE_MS)]
+    pub pre_ms: u64,
+    /// Kept after each motion's end, ms.
+    #[arg(long, default_value_t = DEFAULT_POST_MS)]
+    pub post_ms: u64,
+    /// A recording of the sensor without contact (for the static representation's mask).
+    #[arg(long, value_name = "FILE", conflicts_with = "no_contact_range")]
+    pub no_contact: Option<PathBuf>,
+    /// The time range A..B (microseconds on the recording's clock) of the session in which the
+    /// sensor is out of contact, written as the no-contact recording.
+    #[arg(long, value_name = "A..B", value_parser = parse_range)]
+    pub no_contact_range: Option<(i64, i64)>,
+    /// The IMU-to-sensor rotation (a calibration.json), copied into the dataset.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
+}
+
+fn parse_range(s: &str) -> Result<(i64, i64), String> {
+    let bad = || format!("`{s}` is not a range A..B of microseconds with A < B");
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let a: i64 = a.trim().parse().map_err(|_| bad())?;
+    let b: i64 = b.trim().parse().map_err(|_| bad())?;
+    if a < b { Ok((a, b)) } else { Err(bad()) }
+}
+
+/// Runs `evtac import`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let log = RobotLog::read(&args.log, args.clock_offset_us)?;
+    let config = ImportConfig {
+        pre_us: i64::try_from(args.pre_ms)
+            .ok()
+            .and_then(|ms| ms.checked_mul(1000))
+            .context("--pre-ms is too large")?,
+        post_us: i64::try_from(args.post_ms)
+            .ok()
+            .and_then(|ms| ms.checked_mul(1000))
+            .context("--post-ms is too large")?,
+        no_contact: match (&args.no_contact, args.no_contact_range) {
+            (Some(file), _) => Some(NoContact::File(file.clone())),
+            (None, Some((a, b))) => Some(NoContact::Range(a, b)),
+            (None, None) => None,
+        },
+        calibration: args.calibration.clone(),
+    };
+    let bar = crate::progress::bar(log.rows.len() as u64, "trials");
+    let summary = import_session(&args.session, &log, &args.out, &config, &|| bar.inc(1))
+        .with_context(|| format!("importing {}", args.session.display()))?;
+    bar.finish_and_clear();
+    if let Some(reason) = summary.index.as_ref().and_then(|i| i.fallback()) {
+        eprintln!(
+            "note: {} was read from its start for every trial: {reason}",
+            args.session.display()
+        );
+    }
+    println!(
+        "imported {} trials ({} events) from {} into {}",
+        summary.trials,
+        summary.events,
+        args.session.display(),
+        summary.out.display()
+    );
+    if config.calibration.is_none() {
+        println!(
+            "no calibration given: add {}, or pass --{IDENTITY_CALIBRATION_FLAG} to the commands \
+             that read the dataset",
+            summary.out.join(CALIBRATION_FILE).display()
+        );
+    }
+    if config.no_contact.is_none() {
+        println!(
+            "no no-contact recording given: add {}, or pass --{NO_MASK_FLAG} to the commands \
+             that read the dataset",
+            summary.out.join(NO_CONTACT_FILE).display()
+        );
+    }
+    Ok(())
+}

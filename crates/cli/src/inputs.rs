@@ -1,0 +1,25 @@
+//! `--identity-calibration` and `--no-mask`: the explicit opt-outs of a dataset's
+//! `calibration.json` and `no_contact.aedat4`, flattened into each command that opens a dataset
+//! (`evtac_experiments::inputs` says why they are not silent fallbacks).
+
+use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, NO_MASK_FLAG};
+
+/// The opt-out flags.
+#[derive(Debug, Clone, clap::Args)]
+pub struct InputArgs {
+    /// Use the identity IMU-to-sensor rotation instead of the dataset's calibration.json (which
+    /// may then be absent). Only right when the IMU's axes are the sensor's.
+    #[arg(long = IDENTITY_CALIBRATION_FLAG)]
+    pub identity_calibration: bool,
+    /// Build the static representation without a no-contact mask instead of from the dataset's
+    /// no_contact.aedat4 (which may then be absent).
+    #[arg(long = NO_MASK_FLAG)]
+    pub no_mask: bool,
+}
+
+impl InputArgs {
+    /// The inputs these flags ask for.
+    pub fn inputs(&self) -> Inputs {
+        Inputs::from_flags(self.identity_calibration, self.no_mask)
+    }
+}

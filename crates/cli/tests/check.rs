@@ -1,0 +1,51 @@
+//! Tests of `evtac check`: exit status 0 and a summary for a simulated dataset, 1 and a table
+//! of problems for a damaged one.
+
+use crate::common::{evtac, run_ok, simulate_tiny};
+
+#[test]
+fn passes_a_simulated_dataset_and_tables_the_problems_of_a_damaged_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("ds");
+    let ds_s = ds.to_str().unwrap();
+    simulate_tiny("exp1", 5, &ds, 2);
+    let out = run_ok(&["check", ds_s]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        text,
+        format!("{ds_s}: no problems in 1 dataset (2 trials, 3 recordings checked)\n")
+    );
+
+    std::fs::remove_file(ds.join("calibration.json")).unwrap();
+    std::fs::remove_file(ds.join("t0001.aedat4")).unwrap();
+    let out = evtac().args(["check", ds_s]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "{text}");
+    let cells = |l: &str| l.split_whitespace().take(3).collect::<Vec<_>>().join(" ");
+    assert_eq!(cells(lines[0]), "file line field");
+    assert!(
+        lines[0].contains(" problem ") && lines[0].ends_with(" fix"),
+        "{text}"
+    );
+    assert_eq!(cells(lines[1]), "calibration.json - -");
+    assert!(lines[1].contains("--identity-calibration"), "{text}");
+    assert_eq!(cells(lines[2]), "t0001.aedat4 3 file");
+    assert_eq!(
+        lines[3],
+        "2 problems in 1 dataset (2 trials, 3 recordings checked)"
+    );
+
+    let out = evtac()
+        .args(["check", ds_s, "--identity-calibration", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let problems = json["problems"].as_array().unwrap();
+    assert_eq!(problems.len(), 1, "{json}");
+    assert_eq!(problems[0]["line"], 3);
+    assert_eq!(problems[0]["field"], "file");
+    assert_eq!(problems[0]["problem"], "missing");
+}

@@ -1,0 +1,90 @@
+//! Tests of `evtac import`: a one-trial session imported back into a dataset that `evtac check`
+//! passes, and bad logs failing with the log's line and column, writing nothing.
+
+use crate::common::{evtac, run_ok, simulate_tiny};
+use evtac_events::manifest::Manifest;
+use evtac_events::read_recording;
+
+#[test]
+fn imports_a_session_and_refuses_bad_logs() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("sim");
+    simulate_tiny("exp1", 2, &ds, 1);
+    // The trial's own recording is a session of one motion; the log is on a clock 5 s behind.
+    let t = &Manifest::read(&ds).unwrap().trials[0];
+    let log = dir.path().join("log.csv");
+    let write_log = |speed: f64| {
+        let text = format!(
+            "trial,direction_deg,speed_deg_s,depth_mm,total_deg,motion_start_us,motion_end_us\n\
+             {},{},{speed},{},{},{},{}\n",
+            t.trial,
+            t.direction_deg,
+            t.depth_mm,
+            t.total_deg,
+            t.motion_start_us - 5_000_000,
+            t.motion_end_us - 5_000_000
+        );
+        std::fs::write(&log, text).unwrap();
+    };
+    write_log(t.speed_deg_s);
+    let session = ds.join(&t.file);
+    let out = dir.path().join("imported");
+    let (session_s, log_s, out_s) = (
+        session.to_str().unwrap(),
+        log.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    let no_contact = ds.join("no_contact.aedat4");
+    let calibration = ds.join("calibration.json");
+    let args = [
+        "import",
+        session_s,
+        "--log",
+        log_s,
+        "--out",
+        out_s,
+        "--clock-offset-us",
+        "5000000",
+        "--no-contact",
+        no_contact.to_str().unwrap(),
+        "--calibration",
+        calibration.to_str().unwrap(),
+    ];
+    let stdout = String::from_utf8(run_ok(&args).stdout).unwrap();
+    assert!(stdout.starts_with("imported 1 trials ("), "{stdout}");
+    let (a, b) = (
+        read_recording(&session).unwrap(),
+        read_recording(out.join(&t.file)).unwrap(),
+    );
+    assert!(
+        a.events == b.events && a.imu == b.imu,
+        "the trial changed on import"
+    );
+    assert_eq!(
+        Manifest::read(&out).unwrap().trials[0].motion_start_us,
+        t.motion_start_us
+    );
+    run_ok(&["check", out_s]);
+
+    // Writing over an existing folder, a negative speed, a missing column: errors, nothing new.
+    let fails = |args: &[&str], want: &str| {
+        let o = evtac().args(args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(want), "{want}: {err}");
+    };
+    fails(&args, "exists already");
+    let fresh = dir.path().join("fresh");
+    let mut again = args;
+    again[5] = fresh.to_str().unwrap();
+    write_log(-2.0);
+    fails(&again, "log.csv:2: column `speed_deg_s`");
+    std::fs::write(&log, "trial,direction_deg\n").unwrap();
+    fails(&again, "log.csv:1: column `speed_deg_s` is missing");
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["imported", "log.csv", "sim"]);
+}
