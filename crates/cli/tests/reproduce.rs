@@ -2,7 +2,10 @@
 //! figure, resuming, and the exported job list.
 
 use crate::common::run_ok;
-use evtac_experiments::report::FIGURES;
+use evtac_experiments::choices;
+use evtac_experiments::plan::Plan;
+use evtac_experiments::report::{CHOICES_TITLE, FIGURES};
+use evtac_sim::{Scale, SimParams};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -59,7 +62,19 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
             "{fig} not referenced"
         );
     }
+    // Every value the paper leaves open, as this run used it: simulated with the defaults.
+    assert!(report.contains(&format!("## {CHOICES_TITLE}")));
+    let sim = SimParams::default();
+    let expected = choices::of_run(&Plan::for_scale(Scale::Tiny), 1, Some(&sim), Some(&sim));
+    for c in &expected {
+        let row = format!("| {} | {} | {} | {} |", c.what, c.value, c.why, c.change);
+        assert!(report.contains(&row), "no choice row `{row}` in:\n{report}");
+    }
     let results = results(out);
+    assert_eq!(
+        results["choices"].as_array().map(Vec::len),
+        Some(expected.len())
+    );
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
     assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
     let speeds = results["exp3_speed"].as_array().unwrap();

@@ -5,7 +5,7 @@
 use crate::io::IoError;
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
-use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR, NO_CONTACT_FILE};
+use evtac_events::layout::{CALIBRATION_FILE, LABELS_DIR, NO_CONTACT_FILE, SIMULATOR_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_labels::geometry::Calibration;
@@ -66,6 +66,14 @@ pub enum Error {
         path: PathBuf,
         /// The cause.
         source: evtac_repr::ReprError,
+    },
+    /// `simulator.json` has no readable `params` (the simulator's parameters).
+    #[error("{path}: not a simulator record: {source}")]
+    Simulator {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: serde_json::Error,
     },
     /// A trial name is not in the manifest.
     #[error("{dir}: no trial `{trial}` in trials.csv")]
@@ -178,6 +186,24 @@ impl Dataset {
             .any(|t| t.stop_start_us.is_some() && t.stop_end_us.is_some())
     }
 
+    /// The simulator parameters the dataset was made with (`simulator.json`'s `params`), or
+    /// `None` for recorded data (no such file).
+    pub fn simulator_params(&self) -> Result<Option<evtac_sim::SimParams>, Error> {
+        #[derive(serde::Deserialize)]
+        struct Record {
+            params: evtac_sim::SimParams,
+        }
+        let path = self.dir.join(SIMULATOR_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(io_err(&path)(e)),
+        };
+        let record: Record =
+            serde_json::from_str(&text).map_err(|source| Error::Simulator { path, source })?;
+        Ok(Some(record.params))
+    }
+
     /// The labels file of `trial`.
     pub fn labels_path(&self, trial: &str) -> PathBuf {
         self.dir.join(LABELS_DIR).join(format!("{trial}.csv"))
@@ -236,8 +262,8 @@ impl Dataset {
         read_cropped(&path).map(Some)
     }
 
-    /// The no-contact mask for `config` (built with its static part's settings, as the paper's
-    /// rule implies), or `None` for a dynamic config or a dataset without a no-contact
+    /// The no-contact mask for `config` (built with its static part's settings: evtac's choice,
+    /// the paper does not say which settings its no-contact frame used), or `None` for a dynamic config or a dataset without a no-contact
     /// recording.
     pub fn mask_for(
         &self,

@@ -1,5 +1,6 @@
-//! The paper's protocol on datasets of trials: splits, sampling, feature caches, training jobs,
-//! Experiments 1-3, the latency study, and the report with its figures.
+//! The paper's experiments on datasets of trials: splits, sampling, feature caches, training
+//! jobs, Experiments 1-3, the latency study, and the report with its figures. Where the paper
+//! states no value evtac chose one; [`choices`] lists them all, with the value used.
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing.
@@ -13,7 +14,8 @@
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
 //!   experiments; [`pipeline`] runs them all; [`results`], [`report`] and [`plots`] write
-//!   `report.md`, `results.json` and the PNG figures.
+//!   `report.md`, `results.json` and the PNG figures; [`choices`] lists the values evtac chose
+//!   where the paper states none.
 //!
 //! ```no_run
 //! use evtac_experiments::jobs::Quiet;
@@ -30,6 +32,7 @@
 //! ```
 
 pub mod cache;
+pub mod choices;
 pub mod context;
 pub mod dataset;
 pub mod examples;

@@ -14,7 +14,7 @@ use crate::splits::Split;
 use crate::stage::Stage;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
-use crate::{examples, exp1, exp2, exp3, latency, report};
+use crate::{choices, examples, exp1, exp2, exp3, latency, report};
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -174,8 +174,11 @@ pub fn reproduce(
 
     let mut e2 = Vec::new();
     let mut example = None;
+    let exp1_sim = ds1.simulator_params()?;
+    let mut exp2_sim = None;
     if let Some(dir) = &data.exp2 {
         let ds2 = Dataset::open(dir)?;
+        exp2_sim = ds2.simulator_params()?;
         datasets.push(("exp2".into(), ds2.manifest.trials.len()));
         let splits2 = ds2.splits(seed)?;
         let cache2 = FeatureCache::new(&ds2)?;
@@ -261,6 +264,7 @@ pub fn reproduce(
         exp3_depth: e3d,
         latency: lat,
         example,
+        choices: choices::of_run(plan, seed, exp1_sim.as_ref(), exp2_sim.as_ref()),
         overlays,
     };
     results.run.stage_seconds = stages.list.clone();

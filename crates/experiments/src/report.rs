@@ -354,7 +354,36 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(md);
         figure(&mut md, figures, 5);
     }
+    choices_section(&mut md, &r.choices);
     md
+}
+
+/// The title of the section listing the values evtac chose where the paper states none.
+pub const CHOICES_TITLE: &str = "Choices the paper does not state";
+
+/// The section listing [`crate::choices::Choice`]s: what, value used, why, how to change it.
+fn choices_section(md: &mut String, choices: &[crate::choices::Choice]) {
+    let _ = writeln!(md, "## {CHOICES_TITLE}\n");
+    if choices.is_empty() {
+        let _ = writeln!(md, "Not recorded by the run that wrote `results.json`.\n");
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "The paper leaves these open; evtac chose them. Results that depend on them are evtac's \
+         as much as the method's. Every value below is the one this run used, read from the \
+         code and the datasets.\n"
+    );
+    let _ = writeln!(md, "| choice | value used | why | changed by |");
+    let _ = writeln!(md, "| --- | --- | --- | --- |");
+    for c in choices {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} |",
+            c.what, c.value, c.why, c.change
+        );
+    }
+    let _ = writeln!(md);
 }
 
 fn figure(md: &mut String, present: &[&str], i: usize) {

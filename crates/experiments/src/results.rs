@@ -269,6 +269,9 @@ pub struct Results {
     pub latency: Vec<LatencyCell>,
     /// The Experiment 2 example trial.
     pub example: Option<ExampleTrial>,
+    /// The values evtac chose where the paper states none (absent from older results).
+    #[serde(default)]
+    pub choices: Vec<crate::choices::Choice>,
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,
