@@ -29,9 +29,15 @@ pub fn tiny_run() -> &'static Path {
         ];
         run_ok(&args);
         let exp1 = |out: &Path| results(out)["exp1"].clone();
-        let first = exp1(&out);
+        let noise = |out: &Path| results(out)["noise"].clone();
+        let (first, first_noise) = (exp1(&out), noise(&out));
         run_ok(&args);
         assert_eq!(exp1(&out), first, "a resumed run changed Experiment 1");
+        assert_eq!(
+            noise(&out),
+            first_noise,
+            "a resumed run changed the noise study"
+        );
         (dir, out)
     });
     out
@@ -76,6 +82,34 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         Some(expected.len())
     );
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
+    // Experiment 1 at every noise level of the plan, for the three representations; x1 is
+    // Experiment 1 itself, and no noise means no background events.
+    let levels = Plan::for_scale(Scale::Tiny).noise_levels;
+    let noise = results["noise"].as_array().unwrap();
+    assert_eq!(noise.len(), 3 * levels.len());
+    for p in noise {
+        let level = p["level"].as_f64().unwrap();
+        assert!(levels.contains(&level), "{p}");
+        let rate = p["no_contact_events_per_s"].as_f64().unwrap();
+        assert_eq!(
+            rate == 0.0,
+            level == 0.0,
+            "background rate {rate} at x{level}"
+        );
+        if level == 1.0 {
+            let e1 = results["exp1"].as_array().unwrap();
+            let same = e1.iter().find(|e| e["name"] == p["name"]).unwrap();
+            assert_eq!(same["test"], p["test"], "x1 is not Experiment 1");
+        }
+        assert!(p["test"]["overall"]["mean"].as_f64().unwrap() > 0.0);
+    }
+    for level in levels {
+        assert!(
+            report.contains(&format!("| x{level} | ")),
+            "no x{level} row"
+        );
+    }
+    assert!(report.contains("Dynamic minus static test MAE: "));
     assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
     let speeds = results["exp3_speed"].as_array().unwrap();
     assert!(

@@ -293,6 +293,16 @@ pub fn of_run(
             "`evtac reproduce --seed`",
         ),
         row(
+            "Background noise study",
+            format!(
+                "Experiment 1 at noise x{} (leak, shot and hot pixels scaled together), with the \
+                 settings tuned at x1",
+                list(&plan.noise_levels).replace(", ", ", x")
+            ),
+            "not in the paper: it tells the simulator's noise apart from the representations",
+            "`evtac reproduce --noise-levels`",
+        ),
+        row(
             "Latency study",
             format!(
                 "intervals {} ms, up to {} test trials, the first seed's model of each \
@@ -343,6 +353,9 @@ mod tests {
         assert!(value(&c, "Seeds").contains("seeds 7, 8"));
         assert!(value(&c, "Split balancing").starts_with("70:15:15"));
         assert!(value(&c, "Activation").starts_with("ReLU"));
+        assert!(
+            value(&c, "Background noise study").starts_with("Experiment 1 at noise x0, x1, x3")
+        );
         assert!(value(&c, "Stop angle (Experiment 2)").starts_with(&format!(
             "uniform in {}..{} deg",
             sim.timeline.stop_range_deg[0], sim.timeline.stop_range_deg[1]

@@ -67,7 +67,7 @@ pub enum Error {
         /// The cause.
         source: evtac_repr::ReprError,
     },
-    /// `simulator.json` has no readable `params` (the simulator's parameters).
+    /// `simulator.json` is not a simulator record (protocol, scale, seed, params).
     #[error("{path}: not a simulator record: {source}")]
     Simulator {
         /// The file.
@@ -83,6 +83,19 @@ pub enum Error {
         /// The name.
         trial: String,
     },
+}
+
+/// What `simulator.json` says about a simulated dataset (the fields evtac reads back).
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct Simulated {
+    /// The protocol simulated.
+    pub protocol: evtac_sim::Protocol,
+    /// Its scale.
+    pub scale: evtac_sim::Scale,
+    /// The dataset seed.
+    pub seed: u64,
+    /// Every simulator parameter.
+    pub params: evtac_sim::SimParams,
 }
 
 /// An opened dataset folder.
@@ -186,22 +199,18 @@ impl Dataset {
             .any(|t| t.stop_start_us.is_some() && t.stop_end_us.is_some())
     }
 
-    /// The simulator parameters the dataset was made with (`simulator.json`'s `params`), or
-    /// `None` for recorded data (no such file).
-    pub fn simulator_params(&self) -> Result<Option<evtac_sim::SimParams>, Error> {
-        #[derive(serde::Deserialize)]
-        struct Record {
-            params: evtac_sim::SimParams,
-        }
+    /// How the simulator made the dataset (`simulator.json`), or `None` for recorded data (no
+    /// such file).
+    pub fn simulator(&self) -> Result<Option<Simulated>, Error> {
         let path = self.dir.join(SIMULATOR_FILE);
         let text = match std::fs::read_to_string(&path) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(io_err(&path)(e)),
         };
-        let record: Record =
-            serde_json::from_str(&text).map_err(|source| Error::Simulator { path, source })?;
-        Ok(Some(record.params))
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|source| Error::Simulator { path, source })
     }
 
     /// The labels file of `trial`.
@@ -263,8 +272,8 @@ impl Dataset {
     }
 
     /// The no-contact mask for `config` (built with its static part's settings: evtac's choice,
-    /// the paper does not say which settings its no-contact frame used), or `None` for a dynamic config or a dataset without a no-contact
-    /// recording.
+    /// the paper does not say which settings its no-contact frame used), or `None` for a dynamic
+    /// config or a dataset without a no-contact recording.
     pub fn mask_for(
         &self,
         config: &ReprConfig,

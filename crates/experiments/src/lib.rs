@@ -12,7 +12,7 @@
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
-//! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
+//! - [`plan`], [`tuning`], [`exp1`], [`noise`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
 //!   experiments; [`pipeline`] runs them all; [`results`], [`report`] and [`plots`] write
 //!   `report.md`, `results.json` and the PNG figures; [`choices`] lists the values evtac chose
 //!   where the paper states none.
@@ -42,6 +42,7 @@ pub mod exp3;
 pub mod io;
 pub mod jobs;
 pub mod latency;
+pub mod noise;
 pub mod pipeline;
 pub mod plan;
 pub mod plots;

@@ -43,7 +43,15 @@ pub struct Plan {
     pub latency_trials: usize,
     /// Sampling intervals of the latency study, ms.
     pub latency_intervals_ms: Vec<u32>,
+    /// Background-noise factors Experiment 1 is repeated at (leak, shot and hot pixels scaled
+    /// together; 1 is Experiment 1 itself). Absent from older plans: none.
+    #[serde(default)]
+    pub noise_levels: Vec<f64>,
 }
+
+/// The background-noise factors of every scale (`evtac reproduce --noise-levels`): without
+/// noise, the simulator's default, three times it.
+pub const NOISE_LEVELS: [f64; 3] = [0.0, 1.0, 3.0];
 
 impl Plan {
     /// The plan of a scale.
@@ -66,6 +74,7 @@ impl Plan {
                 exp2_seeds: 10,
                 latency_trials: 150,
                 latency_intervals_ms: vec![1, 2, 5, 10],
+                noise_levels: NOISE_LEVELS.to_vec(),
             },
             Scale::Small => Plan {
                 scale,
@@ -82,6 +91,7 @@ impl Plan {
                 exp2_seeds: 3,
                 latency_trials: 20,
                 latency_intervals_ms: vec![1, 2, 5, 10],
+                noise_levels: NOISE_LEVELS.to_vec(),
             },
             Scale::Tiny => Plan {
                 scale,
@@ -98,6 +108,7 @@ impl Plan {
                 exp2_seeds: 2,
                 latency_trials: 2,
                 latency_intervals_ms: vec![1, 2, 5, 10],
+                noise_levels: NOISE_LEVELS.to_vec(),
             },
         }
     }
