@@ -21,16 +21,21 @@ use crate::stage::{FeatureSet, Stage};
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 
-/// The factors that need their own dataset: every one but 1 (Experiment 1's), each once, in
-/// the order given.
-pub fn simulated_levels(levels: &[f64]) -> Vec<f64> {
+/// Each factor of `levels` once, in the order given.
+fn unique(levels: &[f64]) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::new();
     for &l in levels {
-        if l != 1.0 && !out.contains(&l) {
+        if !out.contains(&l) {
             out.push(l);
         }
     }
     out
+}
+
+/// The factors that need their own dataset: every one but 1 (Experiment 1's), each once, in
+/// the order given.
+pub fn simulated_levels(levels: &[f64]) -> Vec<f64> {
+    unique(levels).into_iter().filter(|&l| l != 1.0).collect()
 }
 
 /// The dataset folder of factor `level` under the run's output folder.
@@ -100,12 +105,7 @@ pub fn run(
     };
     let seconds = sim.params.timeline.no_contact_s;
     let mut all = Vec::new();
-    let mut seen = Vec::new();
-    for &level in &run.plan.noise_levels {
-        if seen.contains(&level) {
-            continue;
-        }
-        seen.push(level);
+    for level in unique(&run.plan.noise_levels) {
         if level == 1.0 {
             all.extend(points(level, background_rate(ds1, seconds)?, e1));
             continue;
