@@ -3,10 +3,12 @@
 //! `paper` does what the paper states (every combination of the grid, 100 epochs, ten runs) on
 //! grid values that are evtac's choice (the paper names only some of the values it tried).
 //! `small` and `tiny` keep its structure with fewer runs so that `evtac reproduce --scale small`
-//! finishes well under 20 minutes on a 2-core machine: `small` searches a full 4 x 4 grid per representation with
-//! fewer epochs and seeds (about 9 minutes on 2 cores); `tiny`, for tests, walks a cross through
-//! the paper's chosen settings (one parameter varied while the other is fixed, as the paper's
-//! tuning figure shows). The report states the plan it ran.
+//! finishes well under 20 minutes on a 2-core machine: `small` searches a full 4 x 4 grid per
+//! representation with fewer epochs and seeds (about 9 minutes on 2 cores, before the noise
+//! study; its two more Experiment 1 datasets and runs add about 4.5 minutes by `stage.rs`'s cost
+//! model); `tiny`, for tests, walks a cross through the paper's chosen settings (one parameter
+//! varied while the other is fixed, as the paper's tuning figure shows). The report states the
+//! plan it ran.
 
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 use evtac_sim::Scale;
