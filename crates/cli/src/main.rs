@@ -34,7 +34,8 @@ enum Command {
     Info(commands::info::Args),
     /// Convert an event recording to AEDAT4, CSV or NPY (chosen by the output's extension).
     Convert(commands::convert::Args),
-    /// Simulate NeuroTac trials of one of the paper's protocols into a dataset folder.
+    /// Simulate NeuroTac trials of one of the paper's experiments (with evtac's sensor model and
+    /// timing) into a dataset folder.
     Simulate(commands::simulate::Args),
     /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log).
     Import(commands::import::Args),

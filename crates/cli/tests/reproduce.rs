@@ -2,7 +2,10 @@
 //! figure, resuming, and the exported job list.
 
 use crate::common::run_ok;
-use evtac_experiments::report::FIGURES;
+use evtac_experiments::choices;
+use evtac_experiments::plan::Plan;
+use evtac_experiments::report::{CHOICES_TITLE, FIGURES};
+use evtac_sim::{Scale, SimParams};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -19,9 +22,15 @@ pub fn tiny_run() -> &'static Path {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         run_ok(&args);
         let exp1 = |out: &Path| results(out)["exp1"].clone();
-        let first = exp1(&out);
+        let noise = |out: &Path| results(out)["noise"].clone();
+        let (first, first_noise) = (exp1(&out), noise(&out));
         run_ok(&args);
         assert_eq!(exp1(&out), first, "a resumed run changed Experiment 1");
+        assert_eq!(
+            noise(&out),
+            first_noise,
+            "a resumed run changed the noise study"
+        );
         (dir, out)
     });
     out
@@ -60,8 +69,48 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
             "{fig} not referenced"
         );
     }
+    // Every value the paper leaves open, as this run used it: simulated with the defaults.
+    assert!(report.contains(&format!("## {CHOICES_TITLE}")));
+    let sim = SimParams::default();
+    let expected = choices::of_run(&Plan::for_scale(Scale::Tiny), 1, Some(&sim), Some(&sim));
+    for c in &expected {
+        let row = format!("| {} | {} | {} | {} |", c.what, c.value, c.why, c.change);
+        assert!(report.contains(&row), "no choice row `{row}` in:\n{report}");
+    }
     let results = results(out);
+    assert_eq!(
+        results["choices"].as_array().map(Vec::len),
+        Some(expected.len())
+    );
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
+    // Experiment 1 at every noise level of the plan, for the three representations; x1 is
+    // Experiment 1 itself, and no noise means no background events.
+    let levels = Plan::for_scale(Scale::Tiny).noise_levels;
+    let noise = results["noise"].as_array().unwrap();
+    assert_eq!(noise.len(), 3 * levels.len());
+    for p in noise {
+        let level = p["level"].as_f64().unwrap();
+        assert!(levels.contains(&level), "{p}");
+        let rate = p["no_contact_events_per_s"].as_f64().unwrap();
+        assert_eq!(
+            rate == 0.0,
+            level == 0.0,
+            "background rate {rate} at x{level}"
+        );
+        if level == 1.0 {
+            let e1 = results["exp1"].as_array().unwrap();
+            let same = e1.iter().find(|e| e["name"] == p["name"]).unwrap();
+            assert_eq!(same["test"], p["test"], "x1 is not Experiment 1");
+        }
+        assert!(p["test"]["overall"]["mean"].as_f64().unwrap() > 0.0);
+    }
+    for level in levels {
+        assert!(
+            report.contains(&format!("| x{level} | ")),
+            "no x{level} row"
+        );
+    }
+    assert!(report.contains("Dynamic minus static test MAE: "));
     assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
     let speeds = results["exp3_speed"].as_array().unwrap();
     assert!(

@@ -11,6 +11,7 @@
 //!   no_contact.aedat4   a recording without contact, for the static representation's mask
 //!   labels/<trial>.csv  (pitch, roll) over time, computed from the IMU (evtac-labels)
 //!   truth/<trial>.csv   the simulator's true angles (simulated datasets only)
+//!   simulator.json      how the simulator made it (simulated datasets only)
 //!   splits.json         the train/validation/test trials (evtac-experiments)
 //!   cache/              features per representation config (evtac-experiments)
 //! ```
@@ -25,6 +26,8 @@ pub const NO_CONTACT_FILE: &str = "no_contact.aedat4";
 pub const LABELS_DIR: &str = "labels";
 /// The folder of the simulator's true angles, `<trial>.csv` each.
 pub const TRUTH_DIR: &str = "truth";
+/// How the simulator made the dataset: protocol, scale, seed and every parameter (`params`).
+pub const SIMULATOR_FILE: &str = "simulator.json";
 /// The train/validation/test split.
 pub const SPLITS_FILE: &str = "splits.json";
 /// The feature cache folder.

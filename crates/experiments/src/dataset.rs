@@ -8,7 +8,7 @@ use crate::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use crate::io::IoError;
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
-use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE};
+use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE, SIMULATOR_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_labels::geometry::Calibration;
@@ -74,6 +74,14 @@ pub enum Error {
         /// The cause.
         source: evtac_repr::ReprError,
     },
+    /// `simulator.json` is not a simulator record (protocol, scale, seed, params).
+    #[error("{path}: not a simulator record: {source}")]
+    Simulator {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: serde_json::Error,
+    },
     /// A trial name is not in the manifest.
     #[error("{dir}: no trial `{trial}` in trials.csv")]
     UnknownTrial {
@@ -82,6 +90,19 @@ pub enum Error {
         /// The name.
         trial: String,
     },
+}
+
+/// What `simulator.json` says about a simulated dataset (the fields evtac reads back).
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct Simulated {
+    /// The protocol simulated.
+    pub protocol: evtac_sim::Protocol,
+    /// Its scale.
+    pub scale: evtac_sim::Scale,
+    /// The dataset seed.
+    pub seed: u64,
+    /// Every simulator parameter.
+    pub params: evtac_sim::SimParams,
 }
 
 /// An opened dataset folder.
@@ -185,6 +206,20 @@ impl Dataset {
             .any(|t| t.stop_start_us.is_some() && t.stop_end_us.is_some())
     }
 
+    /// How the simulator made the dataset (`simulator.json`), or `None` for recorded data (no
+    /// such file).
+    pub fn simulator(&self) -> Result<Option<Simulated>, Error> {
+        let path = self.dir.join(SIMULATOR_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(io_err(&path)(e)),
+        };
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|source| Error::Simulator { path, source })
+    }
+
     /// The labels file of `trial`.
     pub fn labels_path(&self, trial: &str) -> PathBuf {
         self.dir.join(LABELS_DIR).join(format!("{trial}.csv"))
@@ -242,8 +277,9 @@ impl Dataset {
         }
     }
 
-    /// The no-contact mask for `config` (built with its static part's settings, as the paper's
-    /// rule implies), or `None` for a dynamic config or a dataset opened without a mask.
+    /// The no-contact mask for `config` (built with its static part's settings: evtac's choice,
+    /// the paper does not say which settings its no-contact frame used), or `None` for a dynamic
+    /// config or a dataset opened without a mask.
     pub fn mask_for(
         &self,
         config: &ReprConfig,

@@ -73,7 +73,7 @@ pub fn example_trial(
     })
 }
 
-/// The time at which `meta` reaches half its total tilt (10 degrees in the paper's protocol).
+/// The time at which `meta` reaches half its total tilt (10 degrees: the paper tilts to 20).
 fn mid_tilt_time(meta: &TrialMeta) -> i64 {
     let t = meta.motion_start_us + (meta.total_deg / 2.0 / meta.speed_deg_s.max(1e-9) * 1e6) as i64;
     t.clamp(meta.motion_start_us, meta.motion_end_us)

@@ -133,6 +133,24 @@ pub fn run(
     reprs: &[(&'static str, ReprConfig)],
     run: &RunContext<'_>,
 ) -> Result<Vec<Exp1Repr>, Error> {
+    run_as(
+        cache,
+        splits,
+        reprs,
+        run,
+        (FeatureSet::Exp1, Stage::Exp1Training),
+    )
+}
+
+/// [`run`] on another dataset of Experiment 1's protocol (e.g. at another background noise),
+/// reporting its features and training as `stages`.
+pub fn run_as(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    reprs: &[(&'static str, ReprConfig)],
+    run: &RunContext<'_>,
+    stages: (FeatureSet, Stage),
+) -> Result<Vec<Exp1Repr>, Error> {
     let RunContext {
         plan,
         seed,
@@ -140,7 +158,6 @@ pub fn run(
         progress,
     } = *run;
     let jobs = jobs(reprs, plan, seed, out);
-    let stages = (FeatureSet::Exp1, Stage::Exp1Training);
     features_then_training(
         cache,
         splits,

@@ -1,5 +1,6 @@
-//! The paper's protocol on datasets of trials: splits, sampling, feature caches, training jobs,
-//! Experiments 1-3, the latency study, and the report with its figures.
+//! The paper's experiments on datasets of trials: splits, sampling, feature caches, training
+//! jobs, Experiments 1-3, the latency study, and the report with its figures. Where the paper
+//! states no value evtac chose one; [`choices`] lists them all, with the value used.
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
@@ -14,10 +15,10 @@
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
-//! - [`plan`], [`tuning`], [`exp1`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
+//! - [`plan`], [`tuning`], [`exp1`], [`noise`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
 //!   experiments; [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm
 //!   cluster); [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the
-//!   PNG figures.
+//!   PNG figures; [`choices`] lists the values evtac chose where the paper states none.
 //!
 //! ```no_run
 //! use evtac_experiments::jobs::Quiet;
@@ -35,6 +36,7 @@
 
 pub mod cache;
 pub mod check;
+pub mod choices;
 pub mod context;
 pub mod dataset;
 pub mod examples;
@@ -46,6 +48,7 @@ pub mod inputs;
 pub mod io;
 pub mod jobs;
 pub mod latency;
+pub mod noise;
 pub mod pipeline;
 pub mod plan;
 pub mod plots;

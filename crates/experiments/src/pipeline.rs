@@ -15,7 +15,7 @@ use crate::splits::Split;
 use crate::stage::Stage;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
-use crate::{examples, exp1, exp2, exp3, latency, report};
+use crate::{choices, examples, exp1, exp2, exp3, latency, noise, report};
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -176,11 +176,18 @@ pub fn reproduce(
 
     let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
     stages.done("experiment 1");
+    let noise = noise::run(&ds1, &e1, &reprs, &run, out)?;
+    if !noise.is_empty() {
+        stages.done("experiment 1 at other noise");
+    }
 
     let mut e2 = Vec::new();
     let mut example = None;
+    let exp1_sim = ds1.simulator()?;
+    let mut exp2_sim = None;
     if let Some(dir) = &data.exp2 {
         let ds2 = Dataset::open(dir, data.inputs)?;
+        exp2_sim = ds2.simulator()?.map(|s| s.params);
         datasets.push(("exp2".into(), ds2.manifest.trials.len()));
         let splits2 = ds2.splits(seed)?;
         let cache2 = FeatureCache::new(&ds2)?;
@@ -266,7 +273,14 @@ pub fn reproduce(
         exp3_speed: e3s,
         exp3_depth: e3d,
         latency: lat,
+        noise,
         example,
+        choices: choices::of_run(
+            plan,
+            seed,
+            exp1_sim.as_ref().map(|s| &s.params),
+            exp2_sim.as_ref(),
+        ),
         overlays,
     };
     results.run.stage_seconds = stages.list.clone();

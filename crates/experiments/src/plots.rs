@@ -5,7 +5,7 @@
 //! `assets/fonts/LICENSE-DejaVu.txt`), so figures look the same on every machine and need no
 //! system fonts.
 
-use crate::results::{ExampleTrial, Exp2Cell, Exp3Point, LatencyCell, Overlay, Tuning};
+use crate::results::{ExampleTrial, Exp2Cell, Exp3Point, LatencyCell, NoisePoint, Overlay, Tuning};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -235,23 +235,13 @@ pub fn tuning_curves(path: &Path, tuning: &[Tuning]) -> Result<(), Error> {
     for (area, c) in areas.iter().zip(&panels) {
         let xr = padded(c.points.iter().map(|p| p.0), false);
         let yr = padded(c.points.iter().map(|p| p.1), false);
-        let mut chart = ChartBuilder::on(area)
-            .caption(&c.title, (FAMILY, 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(65)
-            .build_cartesian_2d(xr, yr)
-            .map_err(&e)?;
-        chart
-            .configure_mesh()
-            .x_desc(&c.x_desc)
-            .y_desc("validation MAE (deg)")
-            .label_style((FAMILY, 16))
-            .axis_desc_style((FAMILY, 18))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .draw()
-            .map_err(&e)?;
+        let mut chart = xy_chart(
+            area,
+            (xr, yr),
+            &c.title,
+            (&c.x_desc, "validation MAE (deg)"),
+            path,
+        )?;
         chart
             .draw_series(LineSeries::new(
                 c.points.clone(),
@@ -518,98 +508,175 @@ pub fn overlays(path: &Path, panels: &[Overlay]) -> Result<(), Error> {
     Ok(())
 }
 
-/// Test MAE (mean ± std over the Experiment 1 models) against speed (left) and depth (right);
-/// unseen (interpolated) values drawn as hollow markers.
-pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Result<(), Error> {
+/// A captioned x-y chart on `area` over `ranges`, its mesh labelled `descs` (x, y), as every
+/// line figure draws it.
+fn xy_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (xr, yr): (std::ops::Range<f64>, std::ops::Range<f64>),
+    caption: &str,
+    (x_desc, y_desc): (&str, &str),
+    path: &Path,
+) -> Result<
+    ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    Error,
+>
+where
+    DB::ErrorType: 'static,
+{
     let e = draw_err(path);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FAMILY, 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(65)
+        .build_cartesian_2d(xr, yr)
+        .map_err(&e)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FAMILY, 16))
+        .axis_desc_style((FAMILY, 18))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .draw()
+        .map_err(&e)?;
+    Ok(chart)
+}
+
+/// One marker of an error-vs-condition panel: a representation's test MAE at `x`.
+struct Marker<'a> {
+    name: &'a str,
+    x: f64,
+    stats: crate::results::MeanStd,
+    /// Filled (seen during training) or hollow (unseen).
+    filled: bool,
+}
+
+impl<'a> Marker<'a> {
+    fn new(name: &'a str, x: f64, stats: crate::results::MeanStd, filled: bool) -> Self {
+        Self {
+            name,
+            x,
+            stats,
+            filled,
+        }
+    }
+}
+
+/// One panel of test MAE (mean ± std) against a condition, a line per representation.
+fn mae_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    markers: &[Marker<'_>],
+    (caption, desc): (&str, &str),
+    path: &Path,
+) -> Result<(), Error>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err(path);
+    let xr = padded(markers.iter().map(|p| p.x), false);
+    let yr = padded(
+        markers
+            .iter()
+            .flat_map(|p| [p.stats.mean - p.stats.std, p.stats.mean + p.stats.std]),
+        false,
+    );
+    let mut chart = xy_chart(area, (xr, yr), caption, (desc, "test MAE (deg)"), path)?;
+    for name in ["Static", "Dynamic", "Combined"] {
+        let color = repr_color(name);
+        let mut pts: Vec<&Marker> = markers.iter().filter(|p| p.name == name).collect();
+        pts.sort_by(|a, b| a.x.total_cmp(&b.x));
+        if pts.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(
+                pts.iter().map(|p| (p.x, p.stats.mean)),
+                color.stroke_width(2),
+            ))
+            .map_err(&e)?
+            .label(name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        let half = (pts[pts.len() - 1].x - pts[0].x).abs().max(1.0) * 0.012;
+        for p in &pts {
+            let s = p.stats;
+            chart
+                .draw_series(error_bar(
+                    p.x,
+                    s.mean - s.std,
+                    s.mean + s.std,
+                    half,
+                    color.stroke_width(1),
+                ))
+                .map_err(&e)?;
+        }
+        chart
+            .draw_series(pts.iter().map(|p| {
+                let style = if p.filled {
+                    color.filled()
+                } else {
+                    WHITE.filled()
+                };
+                Circle::new((p.x, p.stats.mean), 6, style)
+            }))
+            .map_err(&e)?;
+        chart
+            .draw_series(
+                pts.iter()
+                    .map(|p| Circle::new((p.x, p.stats.mean), 6, color.stroke_width(2))),
+            )
+            .map_err(&e)?;
+    }
+    legend(&mut chart, SeriesLabelPosition::UpperRight, 16, path)
+}
+
+/// Experiment 3: test MAE against speed (left) and depth (right) per representation, mean ±
+/// std over seeds; hollow markers are unseen levels.
+pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Result<(), Error> {
     let root = canvas(path, (1300, 520), !(speed.is_empty() && depth.is_empty()))?;
     let halves = root.split_evenly((1, 2));
-    for (area, (points, desc)) in halves
-        .iter()
-        .zip([(speed, "speed (deg/s)"), (depth, "depth (mm)")])
-    {
+    for (area, (points, axis, desc)) in halves.iter().zip([
+        (speed, "speed", "speed (deg/s)"),
+        (depth, "depth", "depth (mm)"),
+    ]) {
         if points.is_empty() {
             continue;
         }
-        let xr = padded(points.iter().map(|p| p.value), false);
-        let yr = padded(
-            points.iter().flat_map(|p| {
-                [
-                    p.stats.overall.mean - p.stats.overall.std,
-                    p.stats.overall.mean + p.stats.overall.std,
-                ]
-            }),
-            false,
-        );
-        let mut chart = ChartBuilder::on(area)
-            .caption(
-                format!("Error vs {}", desc.split(' ').next().unwrap_or(desc)),
-                (FAMILY, 22),
-            )
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(65)
-            .build_cartesian_2d(xr, yr)
-            .map_err(&e)?;
-        chart
-            .configure_mesh()
-            .x_desc(desc)
-            .y_desc("test MAE (deg)")
-            .label_style((FAMILY, 16))
-            .axis_desc_style((FAMILY, 18))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .draw()
-            .map_err(&e)?;
-        for name in ["Static", "Dynamic", "Combined"] {
-            let color = repr_color(name);
-            let mut pts: Vec<&Exp3Point> = points.iter().filter(|p| p.name == name).collect();
-            pts.sort_by(|a, b| a.value.total_cmp(&b.value));
-            if pts.is_empty() {
-                continue;
-            }
-            chart
-                .draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.value, p.stats.overall.mean)),
-                    color.stroke_width(2),
-                ))
-                .map_err(&e)?
-                .label(name)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            let half = (pts[pts.len() - 1].value - pts[0].value).abs().max(1.0) * 0.012;
-            for p in &pts {
-                let s = p.stats.overall;
-                chart
-                    .draw_series(error_bar(
-                        p.value,
-                        s.mean - s.std,
-                        s.mean + s.std,
-                        half,
-                        color.stroke_width(1),
-                    ))
-                    .map_err(&e)?;
-            }
-            chart
-                .draw_series(pts.iter().map(|p| {
-                    let style = if p.seen {
-                        color.filled()
-                    } else {
-                        WHITE.filled()
-                    };
-                    Circle::new((p.value, p.stats.overall.mean), 6, style)
-                }))
-                .map_err(&e)?;
-            chart
-                .draw_series(pts.iter().map(|p| {
-                    Circle::new((p.value, p.stats.overall.mean), 6, color.stroke_width(2))
-                }))
-                .map_err(&e)?;
-        }
-        legend(&mut chart, SeriesLabelPosition::UpperRight, 16, path)?;
+        let markers: Vec<Marker> = points
+            .iter()
+            .map(|p| Marker::new(&p.name, p.value, p.stats.overall, p.seen))
+            .collect();
+        mae_panel(area, &markers, (&format!("Error vs {axis}"), desc), path)?;
     }
-    root.present().map_err(&e)?;
+    root.present().map_err(draw_err(path))?;
+    Ok(())
+}
+
+/// Experiment 1 at other background noise: test MAE against the noise factor per
+/// representation, mean ± std over seeds.
+pub fn noise(path: &Path, points: &[NoisePoint]) -> Result<(), Error> {
+    let root = canvas(path, (800, 520), !points.is_empty())?;
+    let markers: Vec<Marker> = points
+        .iter()
+        .map(|p| Marker::new(&p.name, p.level, p.test.overall, true))
+        .collect();
+    mae_panel(
+        &root,
+        &markers,
+        (
+            "Error vs background noise",
+            "noise factor (leak, shot, hot pixels)",
+        ),
+        path,
+    )?;
+    root.present().map_err(draw_err(path))?;
     Ok(())
 }
 

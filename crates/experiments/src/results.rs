@@ -144,6 +144,22 @@ pub struct Exp1Repr {
     pub test: MaeStats,
 }
 
+/// Experiment 1 at one background-noise level, for one representation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NoisePoint {
+    /// The factor on the simulator's leak, shot and hot-pixel noise (1: Experiment 1 itself).
+    pub level: f64,
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// Events per second in the 240x240 crop of the dataset's no-contact recording: the
+    /// background activity at this level.
+    pub no_contact_events_per_s: f64,
+    /// Test MAE per seed.
+    pub runs: Vec<Mae>,
+    /// Test MAE statistics over seeds.
+    pub test: MaeStats,
+}
+
 /// Experiment 2 for one (training setting, representation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp2Cell {
@@ -273,6 +289,12 @@ pub struct Results {
     pub latency: Vec<LatencyCell>,
     /// The Experiment 2 example trial.
     pub example: Option<ExampleTrial>,
+    /// Experiment 1 per background-noise level and representation (absent from older results).
+    #[serde(default)]
+    pub noise: Vec<NoisePoint>,
+    /// The values evtac chose where the paper states none (absent from older results).
+    #[serde(default)]
+    pub choices: Vec<crate::choices::Choice>,
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,

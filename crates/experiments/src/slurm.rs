@@ -238,6 +238,8 @@ pub struct Reproduction {
     pub data: Option<PathBuf>,
     /// Where the datasets' calibration and mask come from (the opt-out flags).
     pub inputs: Inputs,
+    /// `--noise-levels` as given, or `None` for the plan's default.
+    pub noise_levels: Option<Vec<f64>>,
 }
 
 impl Reproduction {
@@ -259,6 +261,13 @@ impl Reproduction {
             args.extend(["--data".into(), data.display().to_string()]);
         }
         args.extend(self.inputs.flags());
+        if let Some(levels) = &self.noise_levels {
+            args.push("--noise-levels".into());
+            if !levels.is_empty() {
+                let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
+                args.push(levels.join(","));
+            }
+        }
         jobs::command_line(&args)
     }
 

@@ -32,6 +32,8 @@ pub enum FeatureSet {
     Exp3Speed,
     /// Experiment 3's depth levels.
     Exp3Depth,
+    /// Experiment 1 at a scaled background noise.
+    Noise,
 }
 
 /// One stage of a reproduction; its units of work are given with it.
@@ -51,6 +53,10 @@ pub enum Stage {
     Latency,
     /// Tasks of a Slurm job array, run by the cluster (units: tasks).
     SlurmTasks,
+    /// Simulating Experiment 1's dataset at a scaled background noise (units: trials).
+    NoiseSimulating,
+    /// Experiment 1's training runs at a scaled background noise (units: runs).
+    NoiseTraining,
 }
 
 impl std::fmt::Display for Stage {
@@ -65,8 +71,11 @@ impl std::fmt::Display for Stage {
             Stage::Tuning(k) => write!(f, "tuning {}", k.name()),
             Stage::Exp1Training => f.write_str("experiment 1 training"),
             Stage::Exp2Training => f.write_str("experiment 2 training"),
+            Stage::Features(FeatureSet::Noise) => f.write_str("features (noise)"),
             Stage::Latency => f.write_str("latency"),
             Stage::SlurmTasks => f.write_str("Slurm tasks"),
+            Stage::NoiseSimulating => f.write_str("simulating exp1 at other noise"),
+            Stage::NoiseTraining => f.write_str("noise training"),
         }
     }
 }
@@ -159,10 +168,12 @@ impl CostModel {
         let units = units as f64;
         let train = |n: usize| n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
         match stage {
-            Stage::Simulating(_) => units * cost::SIMULATE_TRIAL,
+            Stage::Simulating(_) | Stage::NoiseSimulating => units * cost::SIMULATE_TRIAL,
             Stage::Features(_) => units * cost::FEATURES_TRIAL,
             Stage::Tuning(_) => units * plan.tuning_epochs as f64 * train(counts.exp1),
-            Stage::Exp1Training => units * plan.epochs as f64 * train(counts.exp1),
+            Stage::Exp1Training | Stage::NoiseTraining => {
+                units * plan.epochs as f64 * train(counts.exp1)
+            }
             Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
             Stage::Latency => {
                 let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
@@ -192,6 +203,12 @@ impl CostModel {
         if counts.exp2 > 0 {
             sum += c(Stage::Exp2Training, 9 * plan.exp2_seeds);
         }
+        // Every noise level but Experiment 1's own: a dataset, its features and the runs.
+        let levels = crate::noise::simulated_levels(&plan.noise_levels).len();
+        sum += levels as f64
+            * (c(Stage::NoiseSimulating, counts.exp1)
+                + c(Stage::Features(FeatureSet::Noise), counts.exp1)
+                + c(Stage::NoiseTraining, 3 * plan.seeds));
         sum
     }
 }
@@ -228,5 +245,18 @@ mod tests {
         let with_exp2 = CostModel::new(&plan, TrialCounts { exp2: 30, ..counts });
         assert!(with_exp2.total_seconds() > model.total_seconds());
         assert_eq!(model.seconds(Stage::Exp2Training, 0), 0.0);
+        let quiet = Plan {
+            noise_levels: vec![1.0],
+            ..plan.clone()
+        };
+        let without_noise = CostModel::new(&quiet, counts).total_seconds();
+        let noise = model.total_seconds() - without_noise;
+        let per_level = model.seconds(Stage::NoiseSimulating, 60)
+            + model.seconds(Stage::Features(FeatureSet::Noise), 60)
+            + model.seconds(Stage::NoiseTraining, 3 * plan.seeds as u64);
+        assert!(
+            (noise - 2.0 * per_level).abs() < 1e-9,
+            "{noise} vs 2 x {per_level}"
+        );
     }
 }

@@ -22,7 +22,8 @@ pub enum Error {
 /// Mean absolute error in degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Mae {
-    /// Mean of the pitch and roll MAEs (the paper's "overall").
+    /// Mean of the pitch and roll MAEs: evtac's reading of the paper's "overall" (not defined
+    /// there; its table's overall values are the means of its pitch and roll ones, to rounding).
     pub overall: f64,
     /// Pitch MAE.
     pub pitch: f64,

@@ -23,6 +23,10 @@ pub const OUTPUTS: usize = 2;
 pub const LAYER_SIZES: [usize; 5] = [INPUTS, 256, 128, 64, OUTPUTS];
 /// Number of linear layers.
 pub const LAYERS: usize = LAYER_SIZES.len() - 1;
+/// The hidden layers' activation, by name (for reports; the paper states none): every hidden
+/// layer applies it, the output layer is linear. [`Mlp::forward`], [`Parameters::forward_f64`]
+/// and the [`crate::Predictor`] all apply `max(0, x)`.
+pub const ACTIVATION: &str = "ReLU";
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]

@@ -13,7 +13,7 @@ use evtac_sim::{Protocol, Scale, SimParams, Simulator, plan};
 use std::ops::ControlFlow;
 
 /// Simulator settings for short trials: a 5 degree tilt instead of 20, half a second of
-/// no-contact recording (indentation, settling and holding as in the paper's protocol).
+/// no-contact recording (indentation, settling and holding as evtac's simulated protocol has them).
 fn short_params() -> SimParams {
     let mut params = SimParams::default();
     params.timeline.total_deg = 5.0;

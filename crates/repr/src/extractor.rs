@@ -188,7 +188,8 @@ impl FeatureExtractor {
     }
 
     /// As [`Self::new`] with one mask per config (e.g. a mask built with each config's own
-    /// accumulator settings, as the paper's rule implies for a tau grid).
+    /// accumulator settings, evtac's choice for a tau grid: the paper does not say which settings
+    /// its no-contact frame used).
     pub fn new_with_masks(
         configs: &[ReprConfig],
         frame: Resolution,

@@ -14,7 +14,7 @@
 //! seed (see [`crate::protocol::trial_seed`]), so the same seed gives the same bytes whatever
 //! the number of threads.
 
-use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE, TRUTH_DIR};
+use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE, SIMULATOR_FILE, TRUTH_DIR};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -172,7 +172,7 @@ pub fn simulate_dataset(
 
     write_json(&out_dir.join(CALIBRATION_FILE), sim.calibration())?;
     write_json(
-        &out_dir.join("simulator.json"),
+        &out_dir.join(SIMULATOR_FILE),
         &SimulatorRecord {
             generator: format!("evtac-sim {}", env!("CARGO_PKG_VERSION")),
             protocol: config.protocol,

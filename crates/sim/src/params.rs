@@ -229,6 +229,20 @@ impl DvsParams {
             ..Self::default()
         }
     }
+
+    /// These pixels with their background activity scaled by `factor`: the leak and shot noise
+    /// rates multiplied, the number of hot pixels multiplied and rounded (the camera's first hot
+    /// pixels stay where they were, as they are drawn first). 0 gives [`Self::noiseless`]'s noise,
+    /// 1 these pixels.
+    pub fn with_noise_scaled(&self, factor: f64) -> Self {
+        let factor = factor.max(0.0);
+        Self {
+            leak_rate_hz: self.leak_rate_hz * factor,
+            shot_noise_rate_hz: self.shot_noise_rate_hz * factor,
+            hot_pixels: (f64::from(self.hot_pixels) * factor).round() as u32,
+            ..self.clone()
+        }
+    }
 }
 
 /// The IMU: gyroscope and accelerometer with the usual error terms.
@@ -327,6 +341,19 @@ mod tests {
         assert_eq!(s.pin_count(), 331);
         s.rings = 6;
         assert_eq!(s.pin_count(), 127);
+    }
+
+    #[test]
+    fn noise_scales_leak_shot_and_hot_pixels_together() {
+        let d = DvsParams::default();
+        assert_eq!(d.with_noise_scaled(1.0), d);
+        assert_eq!(d.with_noise_scaled(0.0), DvsParams::noiseless());
+        let x3 = d.with_noise_scaled(3.0);
+        assert_eq!(x3.leak_rate_hz, 3.0 * d.leak_rate_hz);
+        assert_eq!(x3.shot_noise_rate_hz, 3.0 * d.shot_noise_rate_hz);
+        assert_eq!(x3.hot_pixels, 3 * d.hot_pixels);
+        assert_eq!(x3.hot_pixel_rate_hz, d.hot_pixel_rate_hz);
+        assert_eq!(x3.pos_thres, d.pos_thres);
     }
 
     #[test]

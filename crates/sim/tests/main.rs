@@ -2,3 +2,4 @@
 
 mod behaviour;
 mod dataset;
+mod docs_table;

@@ -35,6 +35,11 @@ pub struct Args {
     /// Output folder: models, report, figures.
     #[arg(long)]
     pub out: PathBuf,
+    /// Background-noise factors to repeat Experiment 1 at (leak, shot and hot-pixel noise of
+    /// the simulator scaled together; 1 is Experiment 1 itself), comma-separated; empty to skip.
+    /// Default: the plan's (0,1,3 at every scale). Needs simulated Experiment 1 data.
+    #[arg(long, value_delimiter = ',', num_args = 0..)]
+    pub noise_levels: Option<Vec<f64>>,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -127,6 +132,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         out: absolute(&args.out)?,
         data: args.data.as_ref().map(absolute).transpose()?,
         inputs: args.inputs.inputs(),
+        noise_levels: args.noise_levels.clone(),
     };
     let slurm = Slurm {
         sbatch_args: args
@@ -154,7 +160,13 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
 /// Runs `evtac reproduce`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let plan = Plan::for_scale(args.scale);
+    let mut plan = Plan::for_scale(args.scale);
+    if let Some(levels) = &args.noise_levels {
+        if let Some(bad) = levels.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
+            anyhow::bail!("--noise-levels: {bad} is not a factor (finite and at least 0)");
+        }
+        plan.noise_levels = levels.clone();
+    }
     anyhow::ensure!(
         args.slurm_args.is_none() || args.executor == Executor::Slurm,
         "--slurm-args is for --executor slurm"

@@ -1,4 +1,5 @@
-//! `evtac simulate`: simulate one of the paper's protocols into a dataset folder.
+//! `evtac simulate`: simulate one of the paper's experiments into a dataset folder (the sensor
+//! model, its noise and the trial timing are evtac's choices: `docs/simulator.md`).
 
 use std::path::PathBuf;
 

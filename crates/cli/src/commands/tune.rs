@@ -27,7 +27,8 @@ pub struct Args {
     /// Representation to tune: static or dynamic.
     #[arg(long, value_enum)]
     pub repr: TuneKind,
-    /// Grid and epochs of this scale: tiny, small or paper (the paper's full grid, 100 epochs).
+    /// Grid and epochs of this scale: tiny, small or paper (every combination of evtac's grid,
+    /// as the paper searches every combination of its own; 100 epochs).
     #[arg(long, default_value = "paper")]
     pub scale: Scale,
     /// Epochs per run (overrides the scale's).

@@ -1,0 +1,148 @@
+//! Experiment 1 at other background noise: the simulator's leak, shot and hot-pixel noise scaled
+//! together by each factor of [`crate::plan::Plan::noise_levels`], the three representations
+//! with the settings tuned at factor 1 trained and tested on each, so a report can tell what
+//! the simulator's noise does to their gap.
+//!
+//! Factor 1 is Experiment 1 itself (its dataset, models and results). Every other factor is a
+//! dataset simulated like Experiment 1's (same protocol, scale, seed and parameters, so the same
+//! trials, splits and camera) with only the noise scaled, under `OUT/noise/x<factor>/`, and its
+//! models under `models/noise/x<factor>/`; both mark their folders done, so a run resumes. It
+//! needs a simulated Experiment 1 dataset (`simulator.json`): recordings cannot be re-recorded at
+//! another noise.
+
+use crate::cache::FeatureCache;
+use crate::context::RunContext;
+use crate::dataset::{Dataset, Simulated};
+use crate::exp1;
+use crate::jobs;
+use crate::pipeline::Error;
+use crate::results::{Exp1Repr, NoisePoint};
+use crate::stage::{FeatureSet, Stage};
+use evtac_repr::ReprConfig;
+use std::path::{Path, PathBuf};
+
+/// Each factor of `levels` once, in the order given.
+fn unique(levels: &[f64]) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for &l in levels {
+        if !out.contains(&l) {
+            out.push(l);
+        }
+    }
+    out
+}
+
+/// The factors that need their own dataset: every one but 1 (Experiment 1's), each once, in
+/// the order given.
+pub fn simulated_levels(levels: &[f64]) -> Vec<f64> {
+    unique(levels).into_iter().filter(|&l| l != 1.0).collect()
+}
+
+/// The dataset folder of factor `level` under the run's output folder.
+pub fn dataset_dir(out: &Path, level: f64) -> PathBuf {
+    out.join("noise").join(format!("x{level}"))
+}
+
+/// Simulates (or resumes) the dataset of factor `level` from Experiment 1's simulation `sim`.
+fn simulate(sim: &Simulated, level: f64, dir: &Path, run: &RunContext<'_>) -> Result<(), Error> {
+    if jobs::is_done(dir) {
+        return Ok(());
+    }
+    let mut params = sim.params.clone();
+    params.dvs = params.dvs.with_noise_scaled(level);
+    let config = evtac_sim::DatasetConfig {
+        params,
+        ..evtac_sim::DatasetConfig::new(sim.protocol, sim.scale, sim.seed)
+    };
+    let n = evtac_sim::plan(sim.protocol, sim.scale, sim.seed, &config.params.timeline).len();
+    run.progress.stage(Stage::NoiseSimulating, n as u64);
+    evtac_sim::simulate_dataset(&config, dir, |_| run.progress.advance(1)).map_err(|source| {
+        Error::Simulation {
+            protocol: sim.protocol,
+            dir: dir.to_path_buf(),
+            source: Box::new(source),
+        }
+    })?;
+    jobs::mark_done(dir)?;
+    Ok(())
+}
+
+/// Events per second in the crop of `ds`'s no-contact recording, which lasts `seconds`.
+fn background_rate(ds: &Dataset, seconds: f64) -> Result<f64, Error> {
+    let n = ds.no_contact_events()?.map_or(0, |e| e.len());
+    Ok(if seconds > 0.0 {
+        n as f64 / seconds
+    } else {
+        0.0
+    })
+}
+
+fn points(level: f64, rate: f64, results: &[Exp1Repr]) -> Vec<NoisePoint> {
+    results
+        .iter()
+        .map(|r| NoisePoint {
+            level,
+            name: r.name.clone(),
+            no_contact_events_per_s: rate,
+            runs: r.runs.clone(),
+            test: r.test,
+        })
+        .collect()
+}
+
+/// Experiment 1 at every factor of the plan's noise levels, for `reprs` (the settings tuned on
+/// `ds1`); `e1` are Experiment 1's results (factor 1), `out` the run's output folder. Empty when
+/// `ds1` was not simulated.
+pub fn run(
+    ds1: &Dataset,
+    e1: &[Exp1Repr],
+    reprs: &[(&'static str, ReprConfig)],
+    run: &RunContext<'_>,
+    out: &Path,
+) -> Result<Vec<NoisePoint>, Error> {
+    let Some(sim) = ds1.simulator()? else {
+        return Ok(Vec::new());
+    };
+    let seconds = sim.params.timeline.no_contact_s;
+    let mut all = Vec::new();
+    for level in unique(&run.plan.noise_levels) {
+        if level == 1.0 {
+            all.extend(points(level, background_rate(ds1, seconds)?, e1));
+            continue;
+        }
+        let dir = dataset_dir(out, level);
+        simulate(&sim, level, &dir, run)?;
+        let ds = Dataset::open(&dir, ds1.inputs)?;
+        let splits = ds.splits(run.seed)?;
+        let cache = FeatureCache::new(&ds)?;
+        let models = dataset_dir(run.models, level);
+        let at_level = RunContext {
+            models: &models,
+            ..*run
+        };
+        let results = exp1::run_as(
+            &cache,
+            &splits,
+            reprs,
+            &at_level,
+            (FeatureSet::Noise, Stage::NoiseTraining),
+        )?;
+        all.extend(points(level, background_rate(&ds, seconds)?, &results));
+    }
+    Ok(all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn factor_one_is_experiment_1_and_repeats_count_once() {
+        assert_eq!(simulated_levels(&[0.0, 1.0, 3.0, 0.0]), vec![0.0, 3.0]);
+        assert!(simulated_levels(&[1.0]).is_empty());
+        assert_eq!(
+            dataset_dir(Path::new("out"), 0.5),
+            Path::new("out/noise/x0.5")
+        );
+    }
+}
