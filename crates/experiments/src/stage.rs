@@ -87,9 +87,10 @@ mod cost {
     pub const SIMULATE_TRIAL: f64 = 0.116;
     /// Features of one trial for every configuration of one pass.
     pub const FEATURES_TRIAL: f64 = 0.03;
-    /// One training epoch of one run, per training trial (about 0.13 s per epoch for the 84
-    /// training trials of the small Experiment 1 dataset).
-    pub const EPOCH_TRAIN_TRIAL: f64 = 0.0015;
+    /// One training epoch of one run, per training trial (Experiment 1 at the small scale,
+    /// 15 runs x 60 epochs on 88 training trials, took 53 s on 2 cores with the sparse backward
+    /// pass: 0.06 s per epoch).
+    pub const EPOCH_TRAIN_TRIAL: f64 = 0.0007;
     /// One latency measurement (representation x interval) per test trial.
     pub const LATENCY_TRIAL: f64 = 0.033;
     /// Share of a dataset's trials in its training split.
