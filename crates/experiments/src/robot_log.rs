@@ -11,11 +11,11 @@
 
 use crate::check::range_problems;
 use evtac_events::layout::trial_file;
-use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, TrialMeta};
+use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, NOT_IN_LOG, TrialMeta};
 use std::path::{Path, PathBuf};
 
 /// The manifest's columns a log does not have: the import fills them in.
-pub const FILLED_IN: [&str; 2] = ["file", "truth"];
+pub const FILLED_IN: [&str; 2] = NOT_IN_LOG;
 
 /// The columns a log may have.
 pub const OPTIONAL: [&str; 4] = ["stop_start_us", "stop_end_us", "stop_deg", "group"];
