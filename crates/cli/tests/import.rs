@@ -88,3 +88,65 @@ fn imports_a_session_and_refuses_bad_logs() {
     names.sort();
     assert_eq!(names, ["imported", "log.csv", "sim"]);
 }
+
+/// `evtac simulate --session` writes what `evtac import --sync trigger` reads, without an
+/// offset; giving one too is refused.
+#[test]
+fn imports_a_simulated_session_synchronised_by_its_triggers() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("session");
+    let s = session.to_str().unwrap();
+    run_ok(&[
+        "simulate",
+        "--session",
+        "--protocol",
+        "exp1",
+        "--scale",
+        "tiny",
+        "--seed",
+        "4",
+        "--limit",
+        "2",
+        "--out",
+        s,
+    ]);
+    let out = dir.path().join("imported");
+    let (file, log, no_contact, calibration) = (
+        session.join("session.aedat4"),
+        session.join("robot_log.csv"),
+        session.join("no_contact.aedat4"),
+        session.join("calibration.json"),
+    );
+    let mut args = vec![
+        "import",
+        file.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--sync",
+        "trigger",
+        "--no-contact",
+        no_contact.to_str().unwrap(),
+        "--calibration",
+        calibration.to_str().unwrap(),
+    ];
+    let o = run_ok(&args);
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("imported 2 trials ("));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("clock offsets from the triggers: median "),
+        "{err}"
+    );
+    run_ok(&["check", out.to_str().unwrap()]);
+    let again = dir.path().join("again");
+    args[5] = again.to_str().unwrap();
+    args.extend(["--clock-offset-us", "5"]);
+    let o = evtac().args(&args).output().unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--clock-offset-us is for --sync offset"),
+        "{err}"
+    );
+}

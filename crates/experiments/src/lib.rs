@@ -5,7 +5,8 @@
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
-//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]).
+//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
+//!   on the recording's clock by [`sync`].
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -54,5 +55,6 @@ pub mod robot_log;
 pub mod sampling;
 pub mod splits;
 pub mod stage;
+pub mod sync;
 pub mod training;
 pub mod tuning;

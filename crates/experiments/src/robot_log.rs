@@ -179,6 +179,7 @@ impl RobotLog {
         }
         let mut rows = parsed.trials;
         for (line, t) in &mut rows {
+            shift(t, clock_offset_us);
             if t.trial.contains(['/', '\\']) {
                 return Err(row_error(
                     path,
@@ -186,17 +187,6 @@ impl RobotLog {
                     "trial",
                     "must not contain / or \\ (it names the trial's file)".into(),
                 ));
-            }
-            for v in [
-                Some(&mut t.motion_start_us),
-                Some(&mut t.motion_end_us),
-                t.stop_start_us.as_mut(),
-                t.stop_end_us.as_mut(),
-            ]
-            .into_iter()
-            .flatten()
-            {
-                *v = v.saturating_add(clock_offset_us);
             }
             if let Some(p) = range_problems(path, *line, t).into_iter().next() {
                 let column = p.field.unwrap_or_default();
@@ -215,6 +205,21 @@ impl RobotLog {
         })
     }
 
+    /// The log with each row's times moved by its own offset (`offsets[i]` for row `i`, in log
+    /// order), as a per-motion synchronisation finds them; the motions must still not overlap.
+    pub fn shifted(mut self, offsets: &[i64]) -> Result<Self, LogError> {
+        for ((_, t), by) in self.rows.iter_mut().zip(offsets) {
+            shift(t, *by);
+        }
+        check_overlaps(&self.path, &self.rows)?;
+        Ok(self)
+    }
+
+    /// The row indices in the order of their motions' onsets.
+    pub fn by_onset(&self) -> Vec<usize> {
+        by_start(&self.rows)
+    }
+
     /// For each row (in log order), the end of the motion before it in time, if any.
     pub fn previous_ends(&self) -> Vec<Option<i64>> {
         let order = by_start(&self.rows);
@@ -223,6 +228,21 @@ impl RobotLog {
             out[pair[1]] = Some(self.rows[pair[0]].1.motion_end_us);
         }
         out
+    }
+}
+
+/// Moves every time of `t` by `by` microseconds.
+fn shift(t: &mut TrialMeta, by: i64) {
+    for v in [
+        Some(&mut t.motion_start_us),
+        Some(&mut t.motion_end_us),
+        t.stop_start_us.as_mut(),
+        t.stop_end_us.as_mut(),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        *v = v.saturating_add(by);
     }
 }
 

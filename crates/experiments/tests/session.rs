@@ -1,11 +1,14 @@
-//! A simulated session (`evtac simulate --session`) imported back into a dataset: its labels
-//! match the simulator's truth as closely as the per-trial simulated dataset's do.
+//! A simulated session (`evtac simulate --session`) imported back into a dataset, its log put
+//! on the recording's clock by each sync mode: its labels match the simulator's truth as
+//! closely as the per-trial simulated dataset's do.
 
+use evtac_events::Trigger;
 use evtac_events::manifest::Manifest;
 use evtac_experiments::check::check;
 use evtac_experiments::import::{ImportConfig, NoContact, import_session};
 use evtac_experiments::inputs::Inputs;
 use evtac_experiments::robot_log::RobotLog;
+use evtac_experiments::sync::{Sync, SyncError, synchronise};
 use evtac_labels::dataset::{label_trial, read_calibration};
 use evtac_labels::{LabelConfig, LabelSeries, TruthError};
 use evtac_sim::{
@@ -106,4 +109,57 @@ fn a_session_imported_with_its_clock_offset_labels_as_well_as_per_trial_files() 
     let per_trial = per_trial_errors(dir.path());
     eprintln!("labels vs truth, RMS deg: imported {imported:?}, per-trial {per_trial:?}");
     assert_as_close(&imported, &per_trial);
+}
+
+#[test]
+fn a_session_synchronised_by_its_triggers_labels_as_well_as_per_trial_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = simulate(dir.path());
+    let session = dir.path().join("session");
+    let log = RobotLog::read(&session.join("robot_log.csv"), 0).unwrap();
+    let synced = synchronise(
+        &session.join("session.aedat4"),
+        log.clone(),
+        Sync::Trigger(Trigger::RISING_EDGE),
+    )
+    .unwrap();
+    // Each row's onset is its trigger, so exactly the true onset; the other times are off by
+    // at most the jitter of two logged times.
+    for ((_, row), truth) in synced.log.rows.iter().zip(&record.trials) {
+        assert_eq!(row.motion_start_us, truth.motion_start_us);
+        let error = row.motion_end_us - truth.motion_end_us;
+        assert!(error.abs() <= 2 * record.jitter_us, "{error}");
+    }
+    let [lo, _, hi] = synced.offset_range().unwrap();
+    assert!(
+        (lo - record.clock_offset_us).abs() <= record.jitter_us
+            && (hi - record.clock_offset_us).abs() <= record.jitter_us,
+        "{lo} .. {hi} vs {}",
+        record.clock_offset_us
+    );
+    let out = import(dir.path(), &synced.log, "imported");
+    let truths = Manifest {
+        trials: record.trials.clone(),
+    };
+    let imported = label_errors(&out, &session, &truths);
+    let per_trial = per_trial_errors(dir.path());
+    eprintln!("labels vs truth, RMS deg: imported {imported:?}, per-trial {per_trial:?}");
+    assert_as_close(&imported, &per_trial);
+
+    // A log with a row fewer than the triggers names both files.
+    let mut short = log;
+    short.rows.pop();
+    let err = synchronise(
+        &session.join("session.aedat4"),
+        short,
+        Sync::Trigger(Trigger::RISING_EDGE),
+    )
+    .unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, SyncError::TriggerCount { .. }), "{text}");
+    assert!(
+        text.contains("session.aedat4: 4 trigger(s) of type 1")
+            && text.contains("robot_log.csv has 3 row(s)"),
+        "{text}"
+    );
 }

@@ -1,0 +1,113 @@
+//! Putting a robot's log on the recording's clock (`evtac import --sync`): a given offset, or
+//! one found from the recording itself.
+//!
+//! - [`Sync::Offset`]: recording time = robot time + the offset, for every row.
+//! - [`Sync::Trigger`]: the robot pulses the camera's trigger input at each motion's onset, and
+//!   DV records the pulses as an AEDAT4 `Trigger` stream: the k-th trigger (of the given type)
+//!   marks the k-th motion's onset (rows in the order of their onsets), so each row gets its own
+//!   offset, which also absorbs the controller's timestamp jitter and slow clock drift. A count
+//!   of triggers that differs from the log's rows is an error naming both files.
+
+use crate::robot_log::{LogError, RobotLog};
+use std::path::{Path, PathBuf};
+
+/// How the log's times are put on the recording's clock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sync {
+    /// Recording time = robot time + this offset, microseconds.
+    Offset(i64),
+    /// The k-th trigger of this type code marks the k-th motion's onset.
+    Trigger(i8),
+}
+
+/// Errors of a synchronisation; each names the files at fault.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SyncError {
+    /// The session could not be read.
+    #[error(transparent)]
+    Recording(#[from] evtac_events::Error),
+    /// The synchronised log is not a log (its motions overlap).
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The session's triggers and the log's rows do not pair up.
+    #[error(
+        "{}: {triggers} trigger(s) of type {kind}, but {} has {rows} row(s): with --sync trigger \
+         the k-th trigger marks the k-th motion's onset (check the trigger wiring and \
+         --trigger-kind, or give the offset with --clock-offset-us)",
+        session.display(),
+        log.display()
+    )]
+    TriggerCount {
+        /// The session recording.
+        session: PathBuf,
+        /// The log.
+        log: PathBuf,
+        /// Triggers of type `kind` in the session.
+        triggers: usize,
+        /// Rows of the log.
+        rows: usize,
+        /// The trigger type code counted.
+        kind: i8,
+    },
+}
+
+/// What a synchronisation found: each row's offset (recording time minus robot time, in log
+/// order).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Synced {
+    /// The log on the recording's clock.
+    pub log: RobotLog,
+    /// Each row's offset, microseconds, in log order.
+    pub offsets: Vec<i64>,
+}
+
+impl Synced {
+    /// The smallest, median and largest offset, microseconds (`None` for an empty log).
+    pub fn offset_range(&self) -> Option<[i64; 3]> {
+        let mut sorted = self.offsets.clone();
+        sorted.sort_unstable();
+        Some([*sorted.first()?, sorted[sorted.len() / 2], *sorted.last()?])
+    }
+}
+
+/// Puts `log` (read on the robot's clock, offset 0) on the clock of the recording `session`.
+pub fn synchronise(session: &Path, log: RobotLog, sync: Sync) -> Result<Synced, SyncError> {
+    let offsets = match sync {
+        Sync::Offset(offset) => vec![offset; log.rows.len()],
+        Sync::Trigger(kind) => trigger_offsets(session, &log, kind)?,
+    };
+    let log = log.shifted(&offsets)?;
+    Ok(Synced { log, offsets })
+}
+
+/// Each row's offset from the session's triggers of type `kind` (rows paired with triggers in
+/// the order of their onsets), in log order.
+fn trigger_offsets(session: &Path, log: &RobotLog, kind: i8) -> Result<Vec<i64>, SyncError> {
+    let mut reader = evtac_events::open(session)?;
+    let mut triggers = Vec::new();
+    while let Some(chunk) = reader.next_chunk()? {
+        triggers.extend(
+            chunk
+                .triggers
+                .iter()
+                .filter(|t| t.kind == kind)
+                .map(|t| t.t),
+        );
+    }
+    triggers.sort_unstable();
+    if triggers.len() != log.rows.len() {
+        return Err(SyncError::TriggerCount {
+            session: session.to_path_buf(),
+            log: log.path.clone(),
+            triggers: triggers.len(),
+            rows: log.rows.len(),
+            kind,
+        });
+    }
+    let mut offsets = vec![0; log.rows.len()];
+    for (row, trigger) in log.by_onset().into_iter().zip(triggers) {
+        offsets[row] = trigger - log.rows[row].1.motion_start_us;
+    }
+    Ok(offsets)
+}
