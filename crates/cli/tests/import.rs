@@ -89,8 +89,8 @@ fn imports_a_session_and_refuses_bad_logs() {
     assert_eq!(names, ["imported", "log.csv", "sim"]);
 }
 
-/// `evtac simulate --session` writes what `evtac import --sync trigger` reads, without an
-/// offset; giving one too is refused.
+/// `evtac simulate --session` writes what `evtac import --sync trigger` and `--sync imu` read,
+/// without an offset; giving one too is refused.
 #[test]
 fn imports_a_simulated_session_synchronised_by_its_triggers() {
     let dir = tempfile::tempdir().unwrap();
@@ -139,6 +139,14 @@ fn imports_a_simulated_session_synchronised_by_its_triggers() {
         "{err}"
     );
     run_ok(&["check", out.to_str().unwrap()]);
+    // No trigger wiring: the gyroscope.
+    let by_imu = dir.path().join("by-imu");
+    let mut imu_args = args.clone();
+    imu_args[5] = by_imu.to_str().unwrap();
+    imu_args[7] = "imu";
+    let err = String::from_utf8(run_ok(&imu_args).stderr).unwrap();
+    assert!(err.contains("clock offset from the IMU: "), "{err}");
+    run_ok(&["check", by_imu.to_str().unwrap()]);
     let again = dir.path().join("again");
     args[5] = again.to_str().unwrap();
     args.extend(["--clock-offset-us", "5"]);

@@ -7,7 +7,10 @@
 //!   marks the k-th motion's onset (rows in the order of their onsets), so each row gets its own
 //!   offset, which also absorbs the controller's timestamp jitter and slow clock drift. A count
 //!   of triggers that differs from the log's rows is an error naming both files.
+//! - [`Sync::Imu`]: one offset, the one that best aligns the gyroscope's rate magnitude with the
+//!   rate the log commands ([`crate::imu_sync`]), reported with its residual.
 
+use crate::imu_sync::{ImuSyncError, imu_offset};
 use crate::robot_log::{LogError, RobotLog};
 use std::path::{Path, PathBuf};
 
@@ -18,6 +21,8 @@ pub enum Sync {
     Offset(i64),
     /// The k-th trigger of this type code marks the k-th motion's onset.
     Trigger(i8),
+    /// The offset that best aligns the gyroscope with the commanded rate.
+    Imu,
 }
 
 /// Errors of a synchronisation; each names the files at fault.
@@ -27,6 +32,9 @@ pub enum SyncError {
     /// The session could not be read.
     #[error(transparent)]
     Recording(#[from] evtac_events::Error),
+    /// The gyroscope could not be aligned with the log.
+    #[error(transparent)]
+    Imu(#[from] ImuSyncError),
     /// The synchronised log is not a log (its motions overlap).
     #[error(transparent)]
     Log(#[from] LogError),
@@ -60,6 +68,9 @@ pub struct Synced {
     pub log: RobotLog,
     /// Each row's offset, microseconds, in log order.
     pub offsets: Vec<i64>,
+    /// With [`Sync::Imu`]: the RMS of the gyroscope's rate magnitude minus the commanded rate
+    /// at the offset found, deg/s.
+    pub residual_deg_s: Option<f64>,
 }
 
 impl Synced {
@@ -73,12 +84,22 @@ impl Synced {
 
 /// Puts `log` (read on the robot's clock, offset 0) on the clock of the recording `session`.
 pub fn synchronise(session: &Path, log: RobotLog, sync: Sync) -> Result<Synced, SyncError> {
+    let mut residual_deg_s = None;
     let offsets = match sync {
         Sync::Offset(offset) => vec![offset; log.rows.len()],
         Sync::Trigger(kind) => trigger_offsets(session, &log, kind)?,
+        Sync::Imu => {
+            let fit = imu_offset(session, &log)?;
+            residual_deg_s = Some(fit.residual_deg_s);
+            vec![fit.offset_us; log.rows.len()]
+        }
     };
     let log = log.shifted(&offsets)?;
-    Ok(Synced { log, offsets })
+    Ok(Synced {
+        log,
+        offsets,
+        residual_deg_s,
+    })
 }
 
 /// Each row's offset from the session's triggers of type `kind` (rows paired with triggers in

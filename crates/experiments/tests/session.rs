@@ -163,3 +163,28 @@ fn a_session_synchronised_by_its_triggers_labels_as_well_as_per_trial_files() {
         "{text}"
     );
 }
+
+#[test]
+fn a_session_synchronised_by_its_imu_recovers_the_offset_within_a_millisecond() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = simulate(dir.path());
+    let session = dir.path().join("session");
+    let log = RobotLog::read(&session.join("robot_log.csv"), 0).unwrap();
+    let synced = synchronise(&session.join("session.aedat4"), log, Sync::Imu).unwrap();
+    let [lo, offset, hi] = synced.offset_range().unwrap();
+    assert_eq!(lo, hi, "one offset for every row");
+    let residual = synced.residual_deg_s.unwrap();
+    eprintln!(
+        "offset from the IMU {offset} us, true {} us, residual {residual:.3} deg/s",
+        record.clock_offset_us
+    );
+    assert!((offset - record.clock_offset_us).abs() <= 1000);
+    // The gyroscope's bias and the log's missing accelerations, nothing more.
+    assert!(residual < 1.5, "{residual}");
+    let out = import(dir.path(), &synced.log, "imported");
+    let truths = Manifest {
+        trials: record.trials.clone(),
+    };
+    let imported = label_errors(&out, &session, &truths);
+    assert_as_close(&imported, &per_trial_errors(dir.path()));
+}

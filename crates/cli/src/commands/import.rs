@@ -21,6 +21,9 @@ pub enum SyncMode {
     Offset,
     /// The k-th trigger (of --trigger-kind) marks the k-th motion's onset: one offset per row.
     Trigger,
+    /// The offset that best aligns the gyroscope's rate magnitude with the log's commanded
+    /// rate (reported with the fit's residual).
+    Imu,
 }
 
 /// Arguments of `evtac import`.
@@ -36,8 +39,9 @@ pub struct Args {
     /// The dataset folder to write (must not exist).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// How the log's times are put on the recording's clock: offset (add --clock-offset-us)
-    /// or trigger (the k-th trigger marks the k-th motion's onset).
+    /// How the log's times are put on the recording's clock: offset (add --clock-offset-us),
+    /// trigger (the k-th trigger marks the k-th motion's onset) or imu (the offset that best
+    /// aligns the gyroscope with the commanded rate).
     #[arg(long, value_enum, default_value_t = SyncMode::Offset)]
     pub sync: SyncMode,
     /// Added to the log's times to put them on the recording's clock, microseconds (for a log
@@ -90,12 +94,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sync = match args.sync {
         SyncMode::Offset => Sync::Offset(args.clock_offset_us),
         SyncMode::Trigger => Sync::Trigger(args.trigger_kind),
+        SyncMode::Imu => Sync::Imu,
     };
     let synced = synchronise(&args.session, RobotLog::read(&args.log, 0)?, sync)?;
     if let (SyncMode::Trigger, Some([lo, median, hi])) = (args.sync, synced.offset_range()) {
         eprintln!(
             "clock offsets from the triggers: median {median} us, {lo} .. {hi} us over {} rows",
             synced.offsets.len()
+        );
+    }
+    if let (Some(residual), Some([_, offset, _])) = (synced.residual_deg_s, synced.offset_range()) {
+        eprintln!(
+            "clock offset from the IMU: {offset} us (gyroscope rate vs the commanded rate: \
+             {residual:.3} deg/s RMS)"
         );
     }
     let log = synced.log;
