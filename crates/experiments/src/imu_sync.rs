@@ -356,6 +356,14 @@ mod tests {
         )
         .unwrap();
         let err = imu_offset(&session, &long).unwrap_err().to_string();
+        // Nor can a session without IMU.
+        let silent = dir.path().join("silent.aedat4");
+        EventWriter::create(&silent, Some(Resolution::new(640, 480)), None)
+            .unwrap()
+            .finish()
+            .unwrap();
+        let none = imu_offset(&silent, &log).unwrap_err().to_string();
+        assert!(none.contains("silent.aedat4: 0 IMU sample(s)"), "{none}");
         assert!(
             err.starts_with("log.csv: its motions span 29.000 s, longer than the 19.999"),
             "{err}"
