@@ -6,13 +6,21 @@
 //!   DV records the pulses as an AEDAT4 `Trigger` stream: the k-th trigger (of the given type)
 //!   marks the k-th motion's onset (rows in the order of their onsets), so each row gets its own
 //!   offset, which also absorbs the controller's timestamp jitter and slow clock drift. A count
-//!   of triggers that differs from the log's rows is an error naming both files.
+//!   of triggers that differs from the log's rows is an error naming both files, and so is an
+//!   offset that jumps by more than [`MAX_OFFSET_STEP_US`] from one motion to the next (a
+//!   missed pulse and an extra one elsewhere pair every row between them with the wrong
+//!   trigger, though the counts agree).
 //! - [`Sync::Imu`]: one offset, the one that best aligns the gyroscope's rate magnitude with the
 //!   rate the log commands ([`crate::imu_sync`]), reported with its residual.
 
 use crate::imu_sync::{ImuSyncError, imu_offset};
 use crate::robot_log::{LogError, RobotLog};
 use std::path::{Path, PathBuf};
+
+/// The most the trigger offsets of two motions in a row may differ, us: far more than a
+/// controller's timestamp jitter or a clock's drift between two motions, far less than the time
+/// between two motions, which a wrongly paired trigger adds.
+pub const MAX_OFFSET_STEP_US: i64 = 100_000;
 
 /// How the log's times are put on the recording's clock.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,6 +43,27 @@ pub enum SyncError {
     /// The gyroscope could not be aligned with the log.
     #[error(transparent)]
     Imu(#[from] ImuSyncError),
+    /// A row's trigger offset jumps from the row before it.
+    #[error(
+        "{}:{line}: column `motion_start_us`: the trigger paired with this motion puts it \
+         {jump_us} us off the motion before it (line {previous}); a missed or extra trigger \
+         pairs every motion after it with the wrong one (check {} for spurious or missing \
+         pulses, or give the offset with --clock-offset-us)",
+        log.display(),
+        session.display()
+    )]
+    TriggerJump {
+        /// The session recording.
+        session: PathBuf,
+        /// The log.
+        log: PathBuf,
+        /// The row's line in the log.
+        line: usize,
+        /// The line of the motion before it.
+        previous: usize,
+        /// Its offset minus the previous motion's, us.
+        jump_us: i64,
+    },
     /// The synchronised log is not a log (its motions overlap).
     #[error(transparent)]
     Log(#[from] LogError),
@@ -126,9 +155,22 @@ fn trigger_offsets(session: &Path, log: &RobotLog, kind: i8) -> Result<Vec<i64>,
             kind,
         });
     }
+    let order = log.by_onset();
     let mut offsets = vec![0; log.rows.len()];
-    for (row, trigger) in log.by_onset().into_iter().zip(triggers) {
+    for (&row, trigger) in order.iter().zip(triggers) {
         offsets[row] = trigger - log.rows[row].1.motion_start_us;
+    }
+    for pair in order.windows(2) {
+        let jump_us = offsets[pair[1]] - offsets[pair[0]];
+        if jump_us.abs() > MAX_OFFSET_STEP_US {
+            return Err(SyncError::TriggerJump {
+                session: session.to_path_buf(),
+                log: log.path.clone(),
+                line: log.rows[pair[1]].0,
+                previous: log.rows[pair[0]].0,
+                jump_us,
+            });
+        }
     }
     Ok(offsets)
 }

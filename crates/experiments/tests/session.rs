@@ -146,6 +146,24 @@ fn a_session_synchronised_by_its_triggers_labels_as_well_as_per_trial_files() {
     eprintln!("labels vs truth, RMS deg: imported {imported:?}, per-trial {per_trial:?}");
     assert_as_close(&imported, &per_trial);
 
+    // A motion logged a second late is paired with a trigger a second early: its line is named.
+    let mut late = log.clone();
+    late.rows[2].1.motion_start_us += 1_000_000;
+    late.rows[2].1.motion_end_us += 1_000_000;
+    let err = synchronise(
+        &session.join("session.aedat4"),
+        late,
+        Sync::Trigger(Trigger::RISING_EDGE),
+    )
+    .unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, SyncError::TriggerJump { .. }), "{text}");
+    assert!(
+        text.contains("robot_log.csv:4: column `motion_start_us`")
+            && text.contains("off the motion before it (line 3)"),
+        "{text}"
+    );
+
     // A log with a row fewer than the triggers names both files.
     let mut short = log;
     short.rows.pop();
