@@ -182,6 +182,24 @@ pub enum ManifestError {
     },
 }
 
+impl TrialMeta {
+    /// Moves every time of the trial (motion and stop) by `by_us`, saturating: onto another
+    /// clock, or to where the trial lies in a longer recording.
+    pub fn shift(&mut self, by_us: i64) {
+        for v in [
+            Some(&mut self.motion_start_us),
+            Some(&mut self.motion_end_us),
+            self.stop_start_us.as_mut(),
+            self.stop_end_us.as_mut(),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            *v = v.saturating_add(by_us);
+        }
+    }
+}
+
 impl Manifest {
     /// The path of the manifest inside `dataset_dir`.
     pub fn path(dataset_dir: impl AsRef<Path>) -> PathBuf {

@@ -179,7 +179,7 @@ impl RobotLog {
         }
         let mut rows = parsed.trials;
         for (line, t) in &mut rows {
-            shift(t, clock_offset_us);
+            t.shift(clock_offset_us);
             if t.trial.contains(['/', '\\']) {
                 return Err(row_error(
                     path,
@@ -209,7 +209,7 @@ impl RobotLog {
     /// order), as a per-motion synchronisation finds them; the motions must still not overlap.
     pub fn shifted(mut self, offsets: &[i64]) -> Result<Self, LogError> {
         for ((_, t), by) in self.rows.iter_mut().zip(offsets) {
-            shift(t, *by);
+            t.shift(*by);
         }
         check_overlaps(&self.path, &self.rows)?;
         Ok(self)
@@ -228,21 +228,6 @@ impl RobotLog {
             out[pair[1]] = Some(self.rows[pair[0]].1.motion_end_us);
         }
         out
-    }
-}
-
-/// Moves every time of `t` by `by` microseconds.
-fn shift(t: &mut TrialMeta, by: i64) {
-    for v in [
-        Some(&mut t.motion_start_us),
-        Some(&mut t.motion_end_us),
-        t.stop_start_us.as_mut(),
-        t.stop_end_us.as_mut(),
-    ]
-    .into_iter()
-    .flatten()
-    {
-        *v = v.saturating_add(by);
     }
 }
 

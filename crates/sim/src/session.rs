@@ -103,6 +103,40 @@ pub struct SessionRecord {
 /// apart from those of the dataset (camera, no-contact recording, protocols).
 const SESSION_STREAM: usize = usize::MAX - 16;
 
+/// A session's random draws, all made up front so that they do not depend on the batching.
+struct Draws {
+    /// Recording time minus robot time, us.
+    clock_offset_us: i64,
+    /// The still time before each trial and after the last, us.
+    gaps_us: Vec<i64>,
+    /// Each row's logged errors: onset, end, stop start, stop end, us.
+    jitters: Vec<[i64; 4]>,
+}
+
+impl Draws {
+    fn new(config: &SessionConfig, seed: u64, trials: usize, period_us: i64) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let max_offset = config.max_clock_offset_us.abs();
+        let clock_offset_us = rng.random_range(-max_offset..=max_offset);
+        let [lo, hi] = config.gap_s;
+        let gaps_us = (0..=trials)
+            .map(|_| {
+                let s = lo + (hi - lo).max(0.0) * rng.random::<f64>();
+                ((s * 1e6 / period_us as f64).round() as i64).max(1) * period_us
+            })
+            .collect();
+        let jitter = config.jitter_us.abs();
+        let jitters = (0..trials)
+            .map(|_| std::array::from_fn(|_| rng.random_range(-jitter..=jitter)))
+            .collect();
+        Self {
+            clock_offset_us,
+            gaps_us,
+            jitters,
+        }
+    }
+}
+
 /// Simulates the session `config` into `out_dir` (created if missing; files of the same names
 /// are replaced). `on_trial` is called after each trial is written, with its true row.
 pub fn simulate_session(
@@ -121,25 +155,16 @@ pub fn simulate_session(
         trials,
     } = set_up(dataset, out_dir)?;
 
-    // Every draw up front, so that they do not depend on the batching.
-    let session_seed = trial_seed(dataset.seed, SESSION_STREAM);
-    let mut rng = ChaCha8Rng::seed_from_u64(session_seed);
-    let max_offset = config.max_clock_offset_us.abs();
-    let clock_offset_us = rng.random_range(-max_offset..=max_offset);
     // Gaps are whole IMU periods, so that the IMU keeps its rate across the whole session.
     let period_us = (1e6 / dataset.params.imu.rate_hz.max(1.0)).round().max(1.0) as i64;
-    let [lo, hi] = config.gap_s;
-    let gaps_us: Vec<i64> = (0..=trials.len())
-        .map(|_| {
-            let s = lo + (hi - lo).max(0.0) * rng.random::<f64>();
-            ((s * 1e6 / period_us as f64).round() as i64).max(1) * period_us
-        })
-        .collect();
-    let jitter = config.jitter_us.abs();
-    let jitters: Vec<[i64; 4]> = trials
-        .iter()
-        .map(|_| std::array::from_fn(|_| rng.random_range(-jitter..=jitter)))
-        .collect();
+    let session_seed = trial_seed(dataset.seed, SESSION_STREAM);
+    let draws = Draws::new(config, session_seed, trials.len(), period_us);
+    let Draws {
+        clock_offset_us,
+        gaps_us,
+        jitters,
+    } = &draws;
+    let clock_offset_us = *clock_offset_us;
     let idle = |k: usize| {
         sim.simulate_idle(
             "idle",
@@ -176,13 +201,15 @@ pub fn simulate_session(
             let name = &recording.spec.name;
             let truth = format!("{TRUTH_DIR}/{name}.csv");
             write_truth(&out_dir.join(&truth), &recording.truth, t0)?;
-            let meta = shifted(recording.meta(&trial_file(name), Some(&truth), total), t0);
-            let mut robot = shifted(meta.clone(), -clock_offset_us);
-            let [a, b, c, d] = jitters[k];
-            robot.motion_start_us += a;
-            robot.motion_end_us += b;
-            robot.stop_start_us = robot.stop_start_us.map(|t| t + c);
-            robot.stop_end_us = robot.stop_end_us.map(|t| t + d);
+            let mut meta = recording.meta(&trial_file(name), Some(&truth), total);
+            meta.shift(t0);
+            let mut robot = meta.clone();
+            robot.shift(-clock_offset_us);
+            let [start, end, stop_start, stop_end] = jitters[k];
+            robot.motion_start_us += start;
+            robot.motion_end_us += end;
+            robot.stop_start_us = robot.stop_start_us.map(|t| t + stop_start);
+            robot.stop_end_us = robot.stop_end_us.map(|t| t + stop_end);
             on_trial(&meta);
             truths.push(meta);
             logged.push(robot);
@@ -205,20 +232,11 @@ pub fn simulate_session(
         seed: dataset.seed,
         start_us: config.start_us,
         clock_offset_us,
-        jitter_us: jitter,
+        jitter_us: config.jitter_us.abs(),
         gap_s: config.gap_s,
         trials: truths,
         params: dataset.params.clone(),
     };
     write_json(&out_dir.join(SESSION_RECORD_FILE), &record)?;
     Ok(record)
-}
-
-/// `meta` with every time `by` later.
-fn shifted(mut meta: TrialMeta, by: i64) -> TrialMeta {
-    meta.motion_start_us += by;
-    meta.motion_end_us += by;
-    meta.stop_start_us = meta.stop_start_us.map(|t| t + by);
-    meta.stop_end_us = meta.stop_end_us.map(|t| t + by);
-    meta
 }
