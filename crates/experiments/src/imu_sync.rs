@@ -13,9 +13,13 @@
 //! motion (so the coarse best lies on the true peak), then scans ten times finer around the
 //! best, down to [`FINEST_STEP_US`].
 //!
-//! A gyroscope bias adds `|bias|` to `g` at rest and about as much in motion, the same at both
-//! edges of a motion, so it shifts `C` without moving its peak. The fit's residual, the RMS of
-//! `g - c` over the log's span, says how well the log describes what the gyroscope saw.
+//! A gyroscope bias moves that peak: in a ramp's first milliseconds `|ramp + bias|` is not
+//! `|bias|` plus the ramp (it can even dip below `|bias|`), so `C` gets two maxima a few ms
+//! either side of the true offset (2.6 ms off on a simulated session). A second search, within
+//! 20 ms of the first, fits `|omega - bias|` instead, with each motion's bias taken from
+//! the still segment before its onset that the labels take it from. The fit's residual, the RMS
+//! of `g - c` over the log's span (bias included), says how well the log describes what the
+//! gyroscope saw.
 
 use crate::robot_log::RobotLog;
 use evtac_events::manifest::TrialMeta;
