@@ -20,7 +20,7 @@ pub struct Args {
     /// Seed: the same seed gives the same bytes.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Output dataset folder (created if missing).
+    /// Output folder, a dataset or with --session a session (created if missing).
     #[arg(long)]
     pub out: PathBuf,
     /// Worker threads.
