@@ -1,5 +1,6 @@
 //! Tests of `evtac import`: a one-trial session imported back into a dataset that `evtac check`
-//! passes, and bad logs failing with the log's line and column, writing nothing.
+//! passes, bad logs failing with the log's line and column, writing nothing, and a simulated
+//! session imported by each sync mode and reproduced.
 
 use crate::common::{evtac, run_ok, simulate_tiny};
 use evtac_events::manifest::Manifest;
@@ -87,4 +88,90 @@ fn imports_a_session_and_refuses_bad_logs() {
         .collect();
     names.sort();
     assert_eq!(names, ["imported", "log.csv", "sim"]);
+}
+
+/// `evtac simulate --session` writes what `evtac import --sync trigger` and `--sync imu` read,
+/// without an offset (giving one too is refused), and the imported dataset reproduces.
+#[test]
+fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("session");
+    let s = session.to_str().unwrap();
+    run_ok(&[
+        "simulate",
+        "--session",
+        "--protocol",
+        "exp1",
+        "--scale",
+        "tiny",
+        "--seed",
+        "4",
+        "--out",
+        s,
+    ]);
+    let data = dir.path().join("data");
+    let out = data.join("exp1");
+    let (file, log, no_contact, calibration) = (
+        session.join("session.aedat4"),
+        session.join("robot_log.csv"),
+        session.join("no_contact.aedat4"),
+        session.join("calibration.json"),
+    );
+    let mut args = vec![
+        "import",
+        file.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--sync",
+        "trigger",
+        "--no-contact",
+        no_contact.to_str().unwrap(),
+        "--calibration",
+        calibration.to_str().unwrap(),
+    ];
+    let o = run_ok(&args);
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("imported 16 trials ("));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("clock offsets from the triggers: median "),
+        "{err}"
+    );
+    run_ok(&["check", out.to_str().unwrap()]);
+    // No trigger wiring: the gyroscope.
+    let by_imu = dir.path().join("by-imu");
+    let mut imu_args = args.clone();
+    imu_args[5] = by_imu.to_str().unwrap();
+    imu_args[7] = "imu";
+    let err = String::from_utf8(run_ok(&imu_args).stderr).unwrap();
+    assert!(err.contains("clock offset from the IMU: "), "{err}");
+    run_ok(&["check", by_imu.to_str().unwrap()]);
+    // The imported Experiment 1 dataset goes through the whole protocol (the end-to-end
+    // path: simulate a session, import, check, label, reproduce).
+    let report = dir.path().join("out");
+    run_ok(&[
+        "reproduce",
+        "--scale",
+        "tiny",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        text.contains("Calibration: calibration.json. No-contact mask: no_contact.aedat4."),
+        "{text}"
+    );
+    let again = dir.path().join("again");
+    args[5] = again.to_str().unwrap();
+    args.extend(["--clock-offset-us", "5"]);
+    let o = evtac().args(&args).output().unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--clock-offset-us is for --sync offset"),
+        "{err}"
+    );
 }

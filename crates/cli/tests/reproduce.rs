@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// One tiny reproduction shared by the tests of `train`, `evaluate`, `tune` and `reproduce`
-/// (simulated once per test binary, and the only end-to-end reproduction in the test suite):
+/// (simulated once per test binary, and the only end-to-end reproduction of every protocol in
+/// the test suite; `import.rs` reproduces an imported Experiment 1 session):
 /// its output folder. It runs twice: the second run resumes the finished one, and must find
 /// every job done and give the same Experiment 1 results.
 pub fn tiny_run() -> &'static Path {

@@ -15,6 +15,17 @@
 //!   splits.json         the train/validation/test trials (evtac-experiments)
 //!   cache/              features per representation config (evtac-experiments)
 //! ```
+//!
+//! A session folder is what a rig writes in one sitting, before `evtac import` cuts it into a
+//! dataset; `evtac simulate --session` writes one:
+//!
+//! ```text
+//! SESSION/
+//!   session.aedat4      every trial back to back: events, IMU, a trigger at each motion onset
+//!   robot_log.csv       the robot's log of its motions, on the robot's clock
+//!   no_contact.aedat4, calibration.json, truth/<trial>.csv (on the session's clock)
+//!   session.json        what the simulator did, with the true clock offset
+//! ```
 
 /// The manifest, one row per trial.
 pub const MANIFEST_FILE: &str = "trials.csv";
@@ -32,6 +43,12 @@ pub const SIMULATOR_FILE: &str = "simulator.json";
 pub const SPLITS_FILE: &str = "splits.json";
 /// The feature cache folder.
 pub const CACHE_DIR: &str = "cache";
+/// A session's recording.
+pub const SESSION_FILE: &str = "session.aedat4";
+/// A session's robot log.
+pub const ROBOT_LOG_FILE: &str = "robot_log.csv";
+/// What the simulator did to make a session (its parameters and the true clock offset).
+pub const SESSION_RECORD_FILE: &str = "session.json";
 
 /// The recording of the trial named `trial`, as the simulator and `evtac import` name it.
 pub fn trial_file(trial: &str) -> String {

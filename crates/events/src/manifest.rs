@@ -63,6 +63,10 @@ pub const COLUMNS: [&str; 13] = [
     "group",
 ];
 
+/// The columns a robot's log does not have: `evtac import` names the files. A log's columns are
+/// the other [`COLUMNS`], in any order.
+pub const NOT_IN_LOG: [&str; 2] = ["file", "truth"];
+
 /// One trial of a dataset: where its recording is, the conditions it was taken under and the
 /// times of its phases (microseconds on the recording's clock).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -178,6 +182,24 @@ pub enum ManifestError {
     },
 }
 
+impl TrialMeta {
+    /// Moves every time of the trial (motion and stop) by `by_us`, saturating: onto another
+    /// clock, or to where the trial lies in a longer recording.
+    pub fn shift(&mut self, by_us: i64) {
+        for v in [
+            Some(&mut self.motion_start_us),
+            Some(&mut self.motion_end_us),
+            self.stop_start_us.as_mut(),
+            self.stop_end_us.as_mut(),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            *v = v.saturating_add(by_us);
+        }
+    }
+}
+
 impl Manifest {
     /// The path of the manifest inside `dataset_dir`.
     pub fn path(dataset_dir: impl AsRef<Path>) -> PathBuf {
@@ -280,6 +302,25 @@ impl Manifest {
                     .transpose()?
                     .unwrap_or_default(),
             ];
+            out.push_str(&cells.join(","));
+            out.push('\n');
+        }
+        Ok(out)
+    }
+
+    /// The manifest as a robot's log (what `evtac import --log` reads): [`Self::to_csv`]
+    /// without the [`NOT_IN_LOG`] columns.
+    pub fn to_log_csv(&self) -> Result<String, ManifestError> {
+        let keep: Vec<bool> = COLUMNS.iter().map(|c| !NOT_IN_LOG.contains(c)).collect();
+        // No cell holds a comma (the writer refuses them), so a split finds the cells.
+        let text = self.to_csv()?;
+        let mut out = String::with_capacity(text.len());
+        for line in text.lines() {
+            let cells: Vec<&str> = line
+                .split(',')
+                .zip(&keep)
+                .filter_map(|(c, k)| k.then_some(c))
+                .collect();
             out.push_str(&cells.join(","));
             out.push('\n');
         }

@@ -45,6 +45,11 @@ pub struct Trigger {
     pub kind: i8,
 }
 
+impl Trigger {
+    /// The type code of an external signal's rising edge, as DV records a robot's sync pulse.
+    pub const RISING_EDGE: i8 = 1;
+}
+
 /// Width and height of a sensor (or of a crop of it), in pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Resolution {

@@ -6,7 +6,8 @@
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
-//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]).
+//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
+//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -44,6 +45,7 @@ pub mod exp1;
 pub mod exp2;
 pub mod exp3;
 pub mod import;
+pub mod imu_sync;
 pub mod inputs;
 pub mod io;
 pub mod jobs;
@@ -59,5 +61,6 @@ pub mod sampling;
 pub mod slurm;
 pub mod splits;
 pub mod stage;
+pub mod sync;
 pub mod training;
 pub mod tuning;

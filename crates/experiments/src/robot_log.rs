@@ -11,11 +11,11 @@
 
 use crate::check::range_problems;
 use evtac_events::layout::trial_file;
-use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, TrialMeta};
+use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, NOT_IN_LOG, TrialMeta};
 use std::path::{Path, PathBuf};
 
 /// The manifest's columns a log does not have: the import fills them in.
-pub const FILLED_IN: [&str; 2] = ["file", "truth"];
+pub const FILLED_IN: [&str; 2] = NOT_IN_LOG;
 
 /// The columns a log may have.
 pub const OPTIONAL: [&str; 4] = ["stop_start_us", "stop_end_us", "stop_deg", "group"];
@@ -179,6 +179,7 @@ impl RobotLog {
         }
         let mut rows = parsed.trials;
         for (line, t) in &mut rows {
+            t.shift(clock_offset_us);
             if t.trial.contains(['/', '\\']) {
                 return Err(row_error(
                     path,
@@ -186,17 +187,6 @@ impl RobotLog {
                     "trial",
                     "must not contain / or \\ (it names the trial's file)".into(),
                 ));
-            }
-            for v in [
-                Some(&mut t.motion_start_us),
-                Some(&mut t.motion_end_us),
-                t.stop_start_us.as_mut(),
-                t.stop_end_us.as_mut(),
-            ]
-            .into_iter()
-            .flatten()
-            {
-                *v = v.saturating_add(clock_offset_us);
             }
             if let Some(p) = range_problems(path, *line, t).into_iter().next() {
                 let column = p.field.unwrap_or_default();
@@ -213,6 +203,21 @@ impl RobotLog {
             path: path.to_path_buf(),
             rows,
         })
+    }
+
+    /// The log with each row's times moved by its own offset (`offsets[i]` for row `i`, in log
+    /// order), as a per-motion synchronisation finds them; the motions must still not overlap.
+    pub fn shifted(mut self, offsets: &[i64]) -> Result<Self, LogError> {
+        for ((_, t), by) in self.rows.iter_mut().zip(offsets) {
+            t.shift(*by);
+        }
+        check_overlaps(&self.path, &self.rows)?;
+        Ok(self)
+    }
+
+    /// The row indices in the order of their motions' onsets.
+    pub fn by_onset(&self) -> Vec<usize> {
+        by_start(&self.rows)
     }
 
     /// For each row (in log order), the end of the motion before it in time, if any.

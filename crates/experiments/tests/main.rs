@@ -5,6 +5,7 @@ mod check;
 mod import;
 mod inputs;
 mod resume;
+mod session;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
 use std::path::Path;

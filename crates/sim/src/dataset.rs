@@ -15,17 +15,18 @@
 //! the number of threads.
 
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE, SIMULATOR_FILE, TRUTH_DIR};
-use std::io::Write;
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use evtac_events::Resolution;
 use evtac_events::aedat::{AedatError, AedatWriter, Compression, WriterConfig};
 use evtac_events::manifest::{Manifest, ManifestError, TrialMeta};
+use evtac_events::{Event, ImuSample, Resolution};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::params::SimParams;
-use crate::protocol::{Protocol, Scale, plan, trial_seed};
+use crate::protocol::{Protocol, Scale, TrialSpec, plan, trial_seed};
 use crate::trial::{Simulator, TrialRecording, TruthSample};
 
 /// The camera name written into every AEDAT4 file.
@@ -116,6 +117,51 @@ fn camera_seed(seed: u64) -> u64 {
     trial_seed(seed, usize::MAX)
 }
 
+impl DatasetConfig {
+    /// The trials to simulate: the plan, cut at the limit.
+    pub fn trials(&self) -> Vec<TrialSpec> {
+        let mut trials = plan(self.protocol, self.scale, self.seed, &self.params.timeline);
+        trials.truncate(self.limit.unwrap_or(usize::MAX));
+        trials
+    }
+}
+
+/// What a dataset and a session share: the sensor and the trials.
+pub(crate) struct Setup {
+    /// The sensor.
+    pub sim: Simulator,
+    /// Its camera's resolution.
+    pub resolution: Resolution,
+    /// The trials.
+    pub trials: Vec<TrialSpec>,
+}
+
+/// Creates `out_dir` and its truth folder, writes the no-contact recording and the
+/// calibration, and returns the sensor and the trials of `config`.
+pub(crate) fn set_up(config: &DatasetConfig, out_dir: &Path) -> Result<Setup, DatasetError> {
+    let truth_dir = out_dir.join(TRUTH_DIR);
+    std::fs::create_dir_all(&truth_dir).map_err(|source| DatasetError::Io {
+        path: truth_dir.clone(),
+        source,
+    })?;
+    let sim = Simulator::new(config.params.clone(), camera_seed(config.seed));
+    let camera = &config.params.camera;
+    let resolution = Resolution::new(camera.width, camera.height);
+    let rest = sim.simulate_rest(trial_seed(config.seed, usize::MAX - 1));
+    write_recording(
+        &out_dir.join(NO_CONTACT_FILE),
+        &rest,
+        resolution,
+        config.compression,
+    )?;
+    write_json(&out_dir.join(CALIBRATION_FILE), sim.calibration())?;
+    Ok(Setup {
+        sim,
+        resolution,
+        trials: config.trials(),
+    })
+}
+
 /// Simulates `config` into `out_dir` (created if missing; existing files of the same names are
 /// replaced). `on_trial_done` is called, from worker threads, after each trial's files are
 /// written. Returns the manifest written to `out_dir/trials.csv`.
@@ -124,31 +170,11 @@ pub fn simulate_dataset(
     out_dir: &Path,
     on_trial_done: impl Fn(&TrialMeta) + Sync,
 ) -> Result<Manifest, DatasetError> {
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| DatasetError::Io { path, source }
-    };
-    let truth_dir = out_dir.join(TRUTH_DIR);
-    std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
-    let sim = Simulator::new(config.params.clone(), camera_seed(config.seed));
-    let mut trials = plan(
-        config.protocol,
-        config.scale,
-        config.seed,
-        &config.params.timeline,
-    );
-    trials.truncate(config.limit.unwrap_or(usize::MAX));
-
-    let rest = sim.simulate_rest(trial_seed(config.seed, usize::MAX - 1));
-    let camera = &config.params.camera;
-    let resolution = Resolution::new(camera.width, camera.height);
-    write_recording(
-        &out_dir.join(NO_CONTACT_FILE),
-        &rest,
+    let Setup {
+        sim,
         resolution,
-        config.compression,
-    )?;
-
+        trials,
+    } = set_up(config, out_dir)?;
     let total = config.params.timeline.total_deg;
     let metas = trials
         .par_iter()
@@ -162,7 +188,7 @@ pub fn simulate_dataset(
                 resolution,
                 config.compression,
             )?;
-            write_truth(&out_dir.join(&truth), &recording.truth)?;
+            write_truth(&out_dir.join(&truth), &recording.truth, 0)?;
             let meta = recording.meta(&file, Some(&truth), total);
             on_trial_done(&meta);
             Ok(meta)
@@ -170,7 +196,6 @@ pub fn simulate_dataset(
         .collect::<Result<Vec<_>, DatasetError>>()?;
     let manifest = Manifest { trials: metas };
 
-    write_json(&out_dir.join(CALIBRATION_FILE), sim.calibration())?;
     write_json(
         &out_dir.join(SIMULATOR_FILE),
         &SimulatorRecord {
@@ -194,32 +219,72 @@ pub fn write_recording(
     resolution: Resolution,
     compression: Compression,
 ) -> Result<(), DatasetError> {
-    let aedat = |source| DatasetError::Aedat {
-        path: path.to_path_buf(),
-        source,
-    };
+    let mut writer = create_writer(path, resolution, compression)?;
+    write_shifted(&mut writer, recording, 0, i64::MAX).map_err(aedat_error(path))?;
+    writer.finish().map_err(aedat_error(path))?;
+    Ok(())
+}
+
+/// The AEDAT4 writer of a simulated `resolution` sensor at `path`.
+pub(crate) fn create_writer(
+    path: &Path,
+    resolution: Resolution,
+    compression: Compression,
+) -> Result<AedatWriter<BufWriter<File>>, DatasetError> {
     let config = WriterConfig {
         resolution,
         source_name: SOURCE_NAME.into(),
         compression,
     };
-    let mut writer = AedatWriter::create(path, config).map_err(aedat)?;
-    // Interleave by time so that readers see IMU and events side by side, as from a camera.
-    let mut imu = recording.imu.as_slice();
-    for chunk in recording.events.chunks(4096) {
-        let until = chunk.last().map_or(i64::MIN, |e| e.t);
-        let n = imu.partition_point(|s| s.t <= until);
-        writer.write_imu(&imu[..n]).map_err(aedat)?;
-        imu = &imu[n..];
-        writer.write_events(chunk).map_err(aedat)?;
-    }
-    writer.write_imu(imu).map_err(aedat)?;
-    writer.finish().map_err(aedat)?;
-    Ok(())
+    AedatWriter::create(path, config).map_err(aedat_error(path))
 }
 
-/// Writes ground truth as `t_us,theta_deg,pitch_deg,roll_deg`.
-pub fn write_truth(path: &Path, truth: &[TruthSample]) -> Result<(), DatasetError> {
+/// The error of the writer of `path`.
+pub(crate) fn aedat_error(path: &Path) -> impl Fn(AedatError) -> DatasetError + '_ {
+    move |source| DatasetError::Aedat {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Writes the events and IMU samples of `recording` before `until_us` (its own clock) into
+/// `writer`, `shift_us` later.
+pub(crate) fn write_shifted<W: std::io::Write>(
+    writer: &mut AedatWriter<W>,
+    recording: &TrialRecording,
+    shift_us: i64,
+    until_us: i64,
+) -> Result<(), AedatError> {
+    let events = &recording.events[..recording.events.partition_point(|e| e.t < until_us)];
+    let mut imu = &recording.imu[..recording.imu.partition_point(|s| s.t < until_us)];
+    let mut shifted = Vec::with_capacity(4096);
+    let shift_imu = |samples: &[ImuSample]| -> Vec<ImuSample> {
+        samples
+            .iter()
+            .map(|s| ImuSample {
+                t: s.t + shift_us,
+                ..*s
+            })
+            .collect()
+    };
+    // Interleave by time so that readers see IMU and events side by side, as from a camera.
+    for chunk in events.chunks(4096) {
+        let until = chunk.last().map_or(i64::MIN, |e| e.t);
+        let n = imu.partition_point(|s| s.t <= until);
+        writer.write_imu(&shift_imu(&imu[..n]))?;
+        imu = &imu[n..];
+        shifted.clear();
+        shifted.extend(chunk.iter().map(|e| Event {
+            t: e.t + shift_us,
+            ..*e
+        }));
+        writer.write_events(&shifted)?;
+    }
+    writer.write_imu(&shift_imu(imu))
+}
+
+/// Writes ground truth as `t_us,theta_deg,pitch_deg,roll_deg`, `shift_us` later.
+pub fn write_truth(path: &Path, truth: &[TruthSample], shift_us: i64) -> Result<(), DatasetError> {
     let io = |source| DatasetError::Io {
         path: path.to_path_buf(),
         source,
@@ -231,14 +296,17 @@ pub fn write_truth(path: &Path, truth: &[TruthSample]) -> Result<(), DatasetErro
         writeln!(
             out,
             "{},{:.6},{:.6},{:.6}",
-            s.t_us, s.theta_deg, s.pitch_deg, s.roll_deg
+            s.t_us + shift_us,
+            s.theta_deg,
+            s.pitch_deg,
+            s.roll_deg
         )
         .map_err(io)?;
     }
     out.flush().map_err(io)
 }
 
-fn write_json(path: &Path, value: &impl Serialize) -> Result<(), DatasetError> {
+pub(crate) fn write_json(path: &Path, value: &impl Serialize) -> Result<(), DatasetError> {
     let text = serde_json::to_string_pretty(value).map_err(|source| DatasetError::Json {
         path: path.to_path_buf(),
         source,

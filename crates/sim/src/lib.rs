@@ -21,10 +21,12 @@ pub mod imu;
 pub mod params;
 pub mod protocol;
 pub mod sensor;
+pub mod session;
 pub mod trial;
 
 pub use dataset::{DatasetConfig, DatasetError, simulate_dataset};
 pub use params::SimParams;
 pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan};
 pub use sensor::SkinPose;
+pub use session::{SessionConfig, SessionRecord, simulate_session};
 pub use trial::{Simulator, TrialRecording, TruthSample};

@@ -137,8 +137,14 @@ impl Simulator {
 
     /// The `no_contact.aedat4` recording: the sensor at rest out of contact, noise only.
     pub fn simulate_rest(&self, seed: u64) -> TrialRecording {
+        self.simulate_idle("no_contact", seed, self.params.timeline.no_contact_s)
+    }
+
+    /// The sensor at rest out of contact for `duration_s`, noise only: the no-contact recording,
+    /// or a session's idle time between trials.
+    pub fn simulate_idle(&self, name: &str, seed: u64, duration_s: f64) -> TrialRecording {
         let spec = TrialSpec {
-            name: "no_contact".into(),
+            name: name.into(),
             direction_deg: 0.0,
             speed_deg_s: 0.0,
             depth_mm: 0.0,
@@ -147,10 +153,7 @@ impl Simulator {
             contact: false,
             seed,
         };
-        let motion = Motion::rest(
-            self.params.timeline.no_contact_s,
-            self.params.contact.no_contact_gap_mm,
-        );
+        let motion = Motion::rest(duration_s, self.params.contact.no_contact_gap_mm);
         self.run(&spec, &motion)
     }
 

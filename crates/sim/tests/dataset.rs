@@ -2,64 +2,24 @@
 
 use std::path::Path;
 
+use crate::{config, three_runs};
 use evtac_events::aedat::AedatReader;
 use evtac_events::manifest::Manifest;
 use evtac_labels::geometry::{Calibration, axial_rate};
-use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
-
-/// The first `limit` trials of a tiny dataset, tilting to 10 degrees only (stops at 2-8) to
-/// keep the tests fast.
-fn config(protocol: Protocol, seed: u64, limit: usize) -> DatasetConfig {
-    let mut config = DatasetConfig {
-        limit: Some(limit),
-        ..DatasetConfig::new(protocol, Scale::Tiny, seed)
-    };
-    config.params.timeline.total_deg = 10.0;
-    config.params.timeline.stop_range_deg = [2.0, 8.0];
-    config
-}
-
-/// Every file of a dataset folder, relative path and bytes, sorted.
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                let rel = path.strip_prefix(dir).unwrap().display().to_string();
-                out.push((rel, std::fs::read(&path).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
-}
+use evtac_sim::{Protocol, simulate_dataset};
 
 #[test]
 fn same_seed_same_bytes_different_seed_different_bytes() {
-    let (a, b, c) = (
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-    );
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let manifest = simulate_dataset(&config(Protocol::Exp2, 5, 2), a.path(), |_| {
-        done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    })
-    .unwrap();
-    assert_eq!(done.into_inner(), 2);
-    // A different thread count must not change anything.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
+    let manifest = std::sync::Mutex::new(None);
+    let [fa, fb, fc] = three_runs(5, |seed, dir| {
+        let m = simulate_dataset(&config(Protocol::Exp2, seed, 2), dir, |_| {
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
         .unwrap();
-    pool.install(|| simulate_dataset(&config(Protocol::Exp2, 5, 2), b.path(), |_| {}))
-        .unwrap();
-    simulate_dataset(&config(Protocol::Exp2, 6, 2), c.path(), |_| {}).unwrap();
-    let (fa, fb, fc) = (files(a.path()), files(b.path()), files(c.path()));
+        manifest.lock().unwrap().get_or_insert(m);
+    });
+    assert_eq!(done.into_inner(), 6);
     let names: Vec<&str> = fa.iter().map(|f| f.0.as_str()).collect();
     assert_eq!(
         names,
@@ -75,23 +35,27 @@ fn same_seed_same_bytes_different_seed_different_bytes() {
         ]
     );
     assert!(fa == fb, "same seed gave different bytes");
-    let differs = |name: &str| {
-        let get = |f: &[(String, Vec<u8>)]| f.iter().find(|x| x.0 == name).unwrap().1.clone();
-        get(&fa) != get(&fc)
-    };
+    let get =
+        |f: &[(String, Vec<u8>)], name: &str| f.iter().find(|x| x.0 == name).unwrap().1.clone();
+    let differs = |name: &str| get(&fa, name) != get(&fc, name);
     assert!(differs("t0000.aedat4") && differs("no_contact.aedat4") && differs("trials.csv"));
 
     // The manifest on disk is the one returned, with the stop columns filled in.
-    assert_eq!(Manifest::read(a.path()).unwrap(), manifest);
+    let manifest = manifest.into_inner().unwrap().unwrap();
+    let text = String::from_utf8(get(&fa, "trials.csv")).unwrap();
+    assert_eq!(
+        Manifest::parse(&text, Path::new("trials.csv")).unwrap(),
+        manifest
+    );
     for t in &manifest.trials {
         let (s0, s1) = (t.stop_start_us.unwrap(), t.stop_end_us.unwrap());
         assert!(t.motion_start_us < s0 && s1 - s0 == 500_000 && s1 < t.motion_end_us);
         assert_eq!(t.total_deg, 10.0);
-        let truth = std::fs::read_to_string(a.path().join(t.truth.as_ref().unwrap())).unwrap();
+        let truth = get(&fa, t.truth.as_ref().unwrap().to_str().unwrap());
+        let truth = String::from_utf8(truth).unwrap();
         assert!(truth.starts_with("t_us,theta_deg,pitch_deg,roll_deg\n0,0.000000,"));
     }
-    let cal: Calibration =
-        serde_json::from_slice(&std::fs::read(a.path().join("calibration.json")).unwrap()).unwrap();
+    let cal: Calibration = serde_json::from_slice(&get(&fa, "calibration.json")).unwrap();
     assert_ne!(
         cal,
         Calibration::default(),

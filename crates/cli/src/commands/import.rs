@@ -4,13 +4,27 @@
 //! `evtac_experiments::import`'s.
 
 use anyhow::Context;
+use evtac_events::Trigger;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_experiments::import::{
     DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, import_session,
 };
 use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
 use evtac_experiments::robot_log::RobotLog;
+use evtac_experiments::sync::{Sync, synchronise};
 use std::path::PathBuf;
+
+/// How `evtac import` puts the log on the recording's clock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SyncMode {
+    /// Recording time = robot time + --clock-offset-us.
+    Offset,
+    /// The k-th trigger (of --trigger-kind) marks the k-th motion's onset: one offset per row.
+    Trigger,
+    /// The offset that best aligns the gyroscope's rate magnitude with the log's commanded
+    /// rate (reported with the fit's residual).
+    Imu,
+}
 
 /// Arguments of `evtac import`.
 #[derive(Debug, clap::Args)]
@@ -25,8 +39,13 @@ pub struct Args {
     /// The dataset folder to write (must not exist).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// How the log's times are put on the recording's clock: offset (add --clock-offset-us),
+    /// trigger (the k-th trigger marks the k-th motion's onset) or imu (the offset that best
+    /// aligns the gyroscope with the commanded rate).
+    #[arg(long, value_enum, default_value_t = SyncMode::Offset)]
+    pub sync: SyncMode,
     /// Added to the log's times to put them on the recording's clock, microseconds (for a log
-    /// on the robot's clock).
+    /// on the robot's clock; --sync offset).
     #[arg(
         long,
         default_value_t = 0,
@@ -34,6 +53,10 @@ pub struct Args {
         value_name = "N"
     )]
     pub clock_offset_us: i64,
+    /// The trigger type code that marks a motion's onset with --sync trigger (DV: 1 external
+    /// rising edge, 2 falling edge, 3 pulse).
+    #[arg(long, default_value_t = Trigger::RISING_EDGE, value_name = "CODE")]
+    pub trigger_kind: i8,
     /// Kept before each motion's onset, ms (cut at the previous motion's end).
     #[arg(long, default_value_t = DEFAULT_PRE_MS)]
     pub pre_ms: u64,
@@ -62,7 +85,31 @@ fn parse_range(s: &str) -> Result<(i64, i64), String> {
 
 /// Runs `evtac import`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let log = RobotLog::read(&args.log, args.clock_offset_us)?;
+    anyhow::ensure!(
+        args.sync == SyncMode::Offset || args.clock_offset_us == 0,
+        "--clock-offset-us is for --sync offset: --sync {} finds the offsets itself",
+        clap::ValueEnum::to_possible_value(&args.sync)
+            .map_or_else(String::new, |v| v.get_name().to_string())
+    );
+    let sync = match args.sync {
+        SyncMode::Offset => Sync::Offset(args.clock_offset_us),
+        SyncMode::Trigger => Sync::Trigger(args.trigger_kind),
+        SyncMode::Imu => Sync::Imu,
+    };
+    let synced = synchronise(&args.session, RobotLog::read(&args.log, 0)?, sync)?;
+    if let (SyncMode::Trigger, Some([lo, median, hi])) = (args.sync, synced.offset_range()) {
+        eprintln!(
+            "clock offsets from the triggers: median {median} us, {lo} .. {hi} us over {} rows",
+            synced.offsets.len()
+        );
+    }
+    if let (Some(residual), Some([_, offset, _])) = (synced.residual_deg_s, synced.offset_range()) {
+        eprintln!(
+            "clock offset from the IMU: {offset} us (gyroscope rate vs the commanded rate: \
+             {residual:.3} deg/s RMS)"
+        );
+    }
+    let log = synced.log;
     let config = ImportConfig {
         pre_us: i64::try_from(args.pre_ms)
             .ok()

@@ -1,10 +1,13 @@
-//! `evtac simulate`: simulate one of the paper's experiments into a dataset folder (the sensor
-//! model, its noise and the trial timing are evtac's choices: `docs/simulator.md`).
+//! `evtac simulate`: simulate one of the paper's experiments into a dataset folder, or, with
+//! `--session`, into a session folder as a real rig records it (`evtac_sim::session`). The
+//! sensor model, its noise and the trial timing are evtac's choices: `docs/simulator.md`.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
-use evtac_sim::{DatasetConfig, Protocol, Scale, SimParams, simulate_dataset};
+use evtac_sim::{
+    DatasetConfig, Protocol, Scale, SessionConfig, SimParams, simulate_dataset, simulate_session,
+};
 
 /// Arguments of `evtac simulate`.
 #[derive(Debug, clap::Args)]
@@ -18,7 +21,7 @@ pub struct Args {
     /// Seed: the same seed gives the same bytes.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Output dataset folder (created if missing).
+    /// Output folder, a dataset or with --session a session (created if missing).
     #[arg(long)]
     pub out: PathBuf,
     /// Worker threads.
@@ -31,6 +34,16 @@ pub struct Args {
     /// Simulate only the first N trials of the protocol.
     #[arg(long)]
     pub limit: Option<usize>,
+    /// Write a recording session instead of a dataset: one session.aedat4 with every trial
+    /// back to back (still gaps between them, a trigger at each motion onset), the robot's log
+    /// robot_log.csv on its own clock (a seeded offset, jittered times), no_contact.aedat4,
+    /// calibration.json, truth/ on the session's clock and session.json (the true clock
+    /// offset); `evtac import` cuts it into a dataset.
+    #[arg(long)]
+    pub session: bool,
+    /// With --session: the largest error of a logged time, microseconds.
+    #[arg(long, default_value_t = 300, requires = "session", value_name = "US")]
+    pub jitter_us: i64,
 }
 
 /// Runs `evtac simulate`.
@@ -49,30 +62,40 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         limit: args.limit,
         ..DatasetConfig::new(args.protocol, args.scale, args.seed)
     };
-    let trials = evtac_sim::plan(
-        args.protocol,
-        args.scale,
-        args.seed,
-        &config.params.timeline,
-    )
-    .len()
-    .min(args.limit.unwrap_or(usize::MAX));
+    let trials = config.trials().len();
     let pool = args.workers.pool()?;
     let bar = crate::progress::bar(trials as u64, "simulating");
     let started = std::time::Instant::now();
-    let manifest = pool
-        .install(|| simulate_dataset(&config, &args.out, |_| bar.inc(1)))
-        .with_context(|| format!("simulating {} into {}", args.protocol, args.out.display()))?;
+    let what = if args.session { "session" } else { "dataset" };
+    let written = if args.session {
+        let session = SessionConfig {
+            dataset: config,
+            jitter_us: args.jitter_us,
+            ..SessionConfig::new(args.protocol, args.scale, args.seed)
+        };
+        let record = pool
+            .install(|| simulate_session(&session, &args.out, |_| bar.inc(1)))
+            .with_context(|| format!("simulating {} into {}", args.protocol, args.out.display()))?;
+        eprintln!(
+            "robot clock offset {} us (pass it as evtac import --clock-offset-us)",
+            record.clock_offset_us
+        );
+        record.trials.len()
+    } else {
+        pool.install(|| simulate_dataset(&config, &args.out, |_| bar.inc(1)))
+            .with_context(|| format!("simulating {} into {}", args.protocol, args.out.display()))?
+            .trials
+            .len()
+    };
     bar.finish_and_clear();
     // The dataset `evtac reproduce` would simulate here (default parameters, every trial) is
     // marked done as `reproduce` marks its own, so a reproduction (local or on Slurm, whose
-    // simulation tasks run this command) resumes from it.
-    if args.params.is_none() && args.limit.is_none() {
+    // simulation tasks run this command) resumes from it. A session is no such dataset.
+    if !args.session && args.params.is_none() && args.limit.is_none() {
         evtac_experiments::jobs::mark_done(&args.out)?;
     }
     eprintln!(
-        "simulated {} {} trials ({} scale, seed {}) into {} in {:.1} s",
-        manifest.trials.len(),
+        "simulated {written} {} trials ({} scale, seed {}) as a {what} into {} in {:.1} s",
         args.protocol,
         args.scale,
         args.seed,
