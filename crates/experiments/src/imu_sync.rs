@@ -24,6 +24,7 @@
 use crate::robot_log::RobotLog;
 use evtac_events::manifest::TrialMeta;
 use evtac_labels::LabelConfig;
+use evtac_labels::integration::CumulativeTrapezoid;
 use std::path::{Path, PathBuf};
 
 /// The coarse scan's step, us: a tenth of the shortest motion the protocols command (20 deg
@@ -89,63 +90,22 @@ pub struct ImuFit {
     pub residual_deg_s: f64,
 }
 
-/// The gyroscope's rate magnitude over time, linear between samples, with its running
-/// integrals.
-struct Rate {
-    /// Sample times, us, increasing.
-    t: Vec<i64>,
-    /// The magnitude at each sample, deg/s, and its square.
-    g: [Vec<f64>; 2],
-    /// Running integrals of the magnitude, deg, and of its square, deg^2/s.
-    sums: [Vec<f64>; 2],
-}
+/// The running integral of a series sampled at `(t_us, value)` (the labels' trapezoid, exact
+/// for the series linear between samples, so the fit is smooth in the offset and not drawn to
+/// the sample times), or `None` for an empty window, which contributes nothing. The callers'
+/// times are sorted and deduplicated, so an empty window is the only error
+/// [`CumulativeTrapezoid::new`] can give them.
+struct Integral(Option<CumulativeTrapezoid>);
 
-/// Which of [`Rate`]'s series: the magnitude or its square.
-#[derive(Clone, Copy)]
-enum Series {
-    Magnitude = 0,
-    Square = 1,
-}
-
-impl Rate {
+impl Integral {
     fn new(samples: &[(i64, f64)]) -> Self {
-        let g: Vec<f64> = samples.iter().map(|s| s.1).collect();
-        let g2: Vec<f64> = g.iter().map(|v| v * v).collect();
-        let sums = [&g, &g2].map(|values| {
-            let mut sum = vec![0.0];
-            for (w, v) in samples.windows(2).zip(values.windows(2)) {
-                let dt = (w[1].0 - w[0].0) as f64 * 1e-6;
-                sum.push(sum.last().copied().unwrap_or(0.0) + 0.5 * (v[0] + v[1]) * dt);
-            }
-            sum
-        });
-        Self {
-            t: samples.iter().map(|s| s.0).collect(),
-            g: [g, g2],
-            sums,
-        }
+        let (t, y): (Vec<i64>, Vec<f64>) = samples.iter().copied().unzip();
+        Self(CumulativeTrapezoid::new(&t, &y).ok())
     }
 
-    /// The running integral of `series` at `t`: exact for the series linear between samples,
-    /// so that it is smooth in `t` and the fit is not drawn to the sample times; flat outside.
-    fn at(&self, series: Series, t: i64) -> f64 {
-        let (values, sums) = (&self.g[series as usize], &self.sums[series as usize]);
-        let i = self.t.partition_point(|&s| s <= t);
-        if i == 0 {
-            return sums[0];
-        }
-        if i == self.t.len() {
-            return sums[i - 1];
-        }
-        let (t0, t1) = (self.t[i - 1], self.t[i]);
-        let dt = (t1 - t0) as f64 * 1e-6;
-        let x = (t - t0) as f64 / (t1 - t0) as f64;
-        let (a, b) = (values[i - 1], values[i]);
-        sums[i - 1] + dt * (a * x + 0.5 * (b - a) * x * x)
-    }
-
-    fn integral(&self, series: Series, from: i64, to: i64) -> f64 {
-        self.at(series, to) - self.at(series, from)
+    /// The integral from `from` to `to` (flat outside the samples).
+    fn between(&self, from: i64, to: i64) -> f64 {
+        self.0.as_ref().map_or(0.0, |i| i.between(from, to))
     }
 }
 
@@ -236,18 +196,18 @@ pub fn imu_offset(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyncError
             imu_s: (last.0 - first.0) as f64 * 1e-6,
         });
     }
-    let rate = Rate::new(&samples);
+    let rate = Integral::new(&samples);
     let correlation = |o: i64| -> f64 {
         pieces
             .iter()
-            .map(|&(a, b, v)| v * rate.integral(Series::Magnitude, a + o, b + o))
+            .map(|&(a, b, v)| v * rate.between(a + o, b + o))
             .sum()
     };
     let step = COARSE_STEP_US.max((hi - lo) / MAX_COARSE_STEPS);
     let rough = search(&correlation, lo, hi, step);
     // Again without each motion's gyroscope bias, taken where the labels take it.
     let still = LabelConfig::default();
-    let rows: Vec<(Rate, Vec<Piece>)> = log
+    let rows: Vec<(Integral, Vec<Piece>)> = log
         .rows
         .iter()
         .map(|(_, t)| {
@@ -265,7 +225,7 @@ pub fn imu_offset(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyncError
                 .iter()
                 .map(|s| (s.t, magnitude(s.gyroscope.map(f64::from), bias)))
                 .collect();
-            (Rate::new(&magnitudes), commanded_row(t))
+            (Integral::new(&magnitudes), commanded_row(t))
         })
         .collect();
     let unbiased = |o: i64| -> f64 {
@@ -273,7 +233,7 @@ pub fn imu_offset(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyncError
             .flat_map(|(rate, pieces)| {
                 pieces
                     .iter()
-                    .map(move |&(a, b, v)| v * rate.integral(Series::Magnitude, a + o, b + o))
+                    .map(move |&(a, b, v)| v * rate.between(a + o, b + o))
             })
             .sum()
     };
@@ -288,7 +248,8 @@ pub fn imu_offset(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyncError
         .iter()
         .map(|&(a, b, v)| v * v * (b - a) as f64 * 1e-6)
         .sum();
-    let g2 = rate.integral(Series::Square, log_from + best, log_to + best);
+    let squares: Vec<(i64, f64)> = samples.iter().map(|&(t, g)| (t, g * g)).collect();
+    let g2 = Integral::new(&squares).between(log_from + best, log_to + best);
     let sse = (g2 - 2.0 * correlation(best) + c2).max(0.0);
     Ok(ImuFit {
         offset_us: best,
