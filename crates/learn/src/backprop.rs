@@ -60,15 +60,8 @@ impl Network {
     /// (pitch, roll) for one sample.
     pub fn predict_one(&self, x: &[f32]) -> [f32; OUTPUTS] {
         let mut h1 = [0.0_f32; H1];
-        let mut h2 = [0.0_f32; LAYER_SIZES[2]];
-        let mut h3 = [0.0_f32; LAYER_SIZES[3]];
-        let mut out = [0.0_f32; OUTPUTS];
-        let [l0, l1, l2, l3] = &self.layers;
-        l0.forward(x, &mut h1, true);
-        l1.forward(&h1, &mut h2, true);
-        l2.forward(&h2, &mut h3, true);
-        l3.forward(&h3, &mut out, false);
-        out
+        self.layers[0].forward(x, &mut h1, true);
+        panels::after_first_layer(&self.layers, &h1)
     }
 }
 

@@ -13,6 +13,11 @@
 //! trained or evaluated on one x86-64 machine is the same bytes as on any other (a cluster's
 //! nodes need not match).
 
+use crate::model::{LAYER_SIZES, LAYERS, OUTPUTS};
+
+/// Width of the first hidden layer.
+const H1: usize = LAYER_SIZES[1];
+
 /// Outputs accumulated together: 64 floats, 4 AVX-512 or 8 AVX2 registers.
 pub(crate) const BLOCK: usize = 64;
 
@@ -75,6 +80,19 @@ impl Dense {
     pub fn forward(&self, x: &[f32], out: &mut [f32], relu: bool) {
         dense_forward(&self.weights, &self.bias, x, out, relu);
     }
+}
+
+/// The layers after the first of the 900-256-128-64-2 network, from the first layer's output:
+/// (pitch, roll). Shared by inference and training's validation pass.
+pub(crate) fn after_first_layer(layers: &[Dense; LAYERS], h1: &[f32; H1]) -> [f32; OUTPUTS] {
+    let mut h2 = [0.0_f32; LAYER_SIZES[2]];
+    let mut h3 = [0.0_f32; LAYER_SIZES[3]];
+    let mut out = [0.0_f32; OUTPUTS];
+    let [_, l1, l2, l3] = layers;
+    l1.forward(h1, &mut h2, true);
+    l2.forward(&h2, &mut h3, true);
+    l3.forward(&h3, &mut out, false);
+    out
 }
 
 /// Where weight `(input i, output o)` lives in the layout of a `fan_in x fan_out` layer.

@@ -18,8 +18,8 @@
 //! with identical results on all three.
 
 use crate::cell_layer::{self, CellLayer, CellSums};
-use crate::model::{self, INPUTS, LAYER_SIZES, OUTPUTS, Parameters};
-use crate::panels::Dense;
+use crate::model::{self, INPUTS, LAYER_SIZES, Parameters};
+use crate::panels::{self, Dense};
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
@@ -38,8 +38,6 @@ pub enum Error {
 
 /// Width of the first hidden layer.
 const H1: usize = LAYER_SIZES[1];
-const H2: usize = LAYER_SIZES[2];
-const H3: usize = LAYER_SIZES[3];
 
 /// A trained model ready for inference. Cheap to clone; `Send + Sync`, so one predictor can be
 /// shared by reference across threads.
@@ -105,14 +103,7 @@ impl Predictor {
 
     /// The layers after the first, from its output.
     fn after_first_layer(&self, h1: &[f32; H1]) -> [f32; 2] {
-        let mut h2 = [0.0_f32; H2];
-        let mut h3 = [0.0_f32; H3];
-        let mut out = [0.0_f32; OUTPUTS];
-        let [_, l1, l2, l3] = &self.layers;
-        l1.forward(h1, &mut h2, true);
-        l2.forward(&h2, &mut h3, true);
-        l3.forward(&h3, &mut out, false);
-        out
+        panels::after_first_layer(&self.layers, h1)
     }
 
     /// (pitch, roll) for the next sample of the stream whose state is `state`: bit for bit
@@ -156,6 +147,7 @@ impl Predictor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::OUTPUTS;
 
     #[test]
     fn matches_the_f64_reference() {
