@@ -21,7 +21,16 @@ pub fn tiny_run() -> &'static Path {
         let out = dir.path().join("out");
         let args = tiny_args(&out);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        run_ok(&args);
+        let log = String::from_utf8_lossy(&run_ok(&args).stderr).into_owned();
+        // Not a terminal: plain lines say each stage's start, end and the overall ETA.
+        for line in [
+            "estimated run time ",
+            "experiment 1 training: 6 to do (overall eta ",
+            "experiment 1 training: done in ",
+            "latency: done in ",
+        ] {
+            assert!(log.contains(line), "no `{line}` in the log:\n{log}");
+        }
         let exp1 = |out: &Path| results(out)["exp1"].clone();
         let noise = |out: &Path| results(out)["noise"].clone();
         let (first, first_noise) = (exp1(&out), noise(&out));

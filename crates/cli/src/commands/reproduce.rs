@@ -12,6 +12,7 @@ use evtac_experiments::plan::Plan;
 use evtac_experiments::slurm::{Reproduction, Slurm};
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_sim::Scale;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
@@ -68,13 +69,48 @@ pub enum Executor {
 }
 
 /// The stage bars plus an overall bar over the estimated cost of every stage: its ETA is the
-/// estimate of the time left for the whole run.
+/// estimate of the time left for the whole run. When stderr is not a terminal (a run under
+/// `nohup` writing to a log), the bars are hidden and [`Overall`] writes plain lines instead: each
+/// stage's start and end with its time, and every [`LOG_EVERY`] a line with the stage's count and
+/// the overall ETA, so a log of a long run says where it is.
 struct Overall<'a> {
     bars: &'a Bars,
     overall: indicatif::ProgressBar,
     costs: CostModel,
     /// Milliseconds of estimated cost per unit of the current stage.
     per_unit: Mutex<f64>,
+    /// The plain-line log, when stderr is not a terminal.
+    log: Option<Mutex<StageLog>>,
+}
+
+/// How often a plain-line log reports progress within a stage.
+const LOG_EVERY: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// What the plain-line log knows of the current stage.
+struct StageLog {
+    started: Instant,
+    stage: Option<(String, Instant, u64)>,
+    done: u64,
+    last_line: Instant,
+}
+
+impl StageLog {
+    /// Ends the current stage's line, if any.
+    fn end_stage(&mut self) {
+        if let Some((name, since, _)) = self.stage.take() {
+            eprintln!(
+                "[{}] {name}: done in {:.1} s",
+                clock(self.started.elapsed()),
+                since.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
+
+/// `h:mm:ss` of a duration.
+fn clock(d: std::time::Duration) -> String {
+    let s = d.as_secs();
+    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
 }
 
 impl<'a> Overall<'a> {
@@ -87,17 +123,46 @@ impl<'a> Overall<'a> {
             )
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
+        let log = (!std::io::stderr().is_terminal()).then(|| {
+            eprintln!(
+                "estimated run time {} (cost model of a 2-core reference machine); progress every {} s below",
+                clock(std::time::Duration::from_secs_f64(costs.total_seconds())),
+                LOG_EVERY.as_secs()
+            );
+            Mutex::new(StageLog {
+                started: Instant::now(),
+                stage: None,
+                done: 0,
+                last_line: Instant::now(),
+            })
+        });
         Self {
             bars,
             overall,
             costs,
             per_unit: Mutex::new(0.0),
+            log,
         }
+    }
+
+    /// The overall ETA from the cost done so far and the time it took.
+    fn eta(&self, elapsed: std::time::Duration) -> String {
+        let (done, total) = (self.overall.position(), self.overall.length().unwrap_or(1));
+        if done == 0 {
+            return "unknown".into();
+        }
+        let left = elapsed.as_secs_f64() * (total.saturating_sub(done)) as f64 / done as f64;
+        clock(std::time::Duration::from_secs_f64(left))
     }
 
     fn finish(&self) {
         self.overall.finish_and_clear();
         self.bars.finish();
+        if let Some(log) = &self.log
+            && let Ok(mut log) = log.lock()
+        {
+            log.end_stage();
+        }
     }
 }
 
@@ -108,11 +173,42 @@ impl Progress for Overall<'_> {
             let cost = self.costs.seconds(stage, total) * 1000.0;
             *per_unit = if total > 0 { cost / total as f64 } else { 0.0 };
         }
+        if let Some(log) = &self.log
+            && let Ok(mut log) = log.lock()
+        {
+            log.end_stage();
+            let elapsed = log.started.elapsed();
+            eprintln!(
+                "[{}] {stage}: {total} to do (overall eta {})",
+                clock(elapsed),
+                self.eta(elapsed)
+            );
+            log.stage = Some((stage.to_string(), Instant::now(), total));
+            log.done = 0;
+            log.last_line = Instant::now();
+        }
     }
     fn advance(&self, n: u64) {
         self.bars.advance(n);
         if let Ok(per_unit) = self.per_unit.lock() {
             self.overall.inc((*per_unit * n as f64).round() as u64);
+        }
+        if let Some(log) = &self.log
+            && let Ok(mut log) = log.lock()
+        {
+            log.done += n;
+            if log.last_line.elapsed() >= LOG_EVERY
+                && let Some((name, _, total)) = &log.stage
+            {
+                let elapsed = log.started.elapsed();
+                eprintln!(
+                    "[{}] {name}: {}/{total} (overall eta {})",
+                    clock(elapsed),
+                    log.done,
+                    self.eta(elapsed)
+                );
+                log.last_line = Instant::now();
+            }
         }
     }
     fn message(&self, text: &str) {
