@@ -50,14 +50,15 @@ fn labels_a_simulated_dataset() {
             rms <= 0.05,
             "{name}: RMS {rms} deg against the simulator's truth"
         );
+        // Against the command, the robot's repeatability (0.035 deg) dominates: 5 sigma.
         let stop = t["stop"]["error_deg"].as_f64().unwrap();
-        assert!(stop.abs() <= 0.05, "{name}: stop error {stop} deg");
+        assert!(stop.abs() <= 0.175, "{name}: stop error {stop} deg");
         let csv = std::fs::read_to_string(ds.join("labels").join(format!("{name}.csv"))).unwrap();
         assert!(csv.starts_with("t_us,theta_deg,pitch_deg,roll_deg\n"));
     }
     let stop = &json["stop_error_deg"];
     assert_eq!(stop["n"], 2);
-    assert!(stop["mean"].as_f64().unwrap().abs() <= 0.02, "{stop}");
+    assert!(stop["mean"].as_f64().unwrap().abs() <= 0.125, "{stop}");
 }
 
 #[test]

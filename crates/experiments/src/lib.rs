@@ -5,7 +5,8 @@
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
-//! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
+//! - [`check`]: a dataset validated before training, every problem listed (`evtac check`);
+//!   [`label_check`]: its labels against the commanded stop angles and the ground truth.
 //! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
 //!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
@@ -49,6 +50,7 @@ pub mod imu_sync;
 pub mod inputs;
 pub mod io;
 pub mod jobs;
+pub mod label_check;
 pub mod latency;
 pub mod noise;
 pub mod pipeline;

@@ -15,7 +15,7 @@ use crate::splits::Split;
 use crate::stage::Stage;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
-use crate::{choices, examples, exp1, exp2, exp3, latency, noise, report};
+use crate::{choices, examples, exp1, exp2, exp3, label_check, latency, noise, report};
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -185,8 +185,10 @@ pub fn reproduce(
     let mut example = None;
     let exp1_sim = ds1.simulator()?;
     let mut exp2_sim = None;
+    let mut labels = None;
     if let Some(dir) = &data.exp2 {
         let ds2 = Dataset::open(dir, data.inputs)?;
+        labels = Some(label_check::of_dataset(&ds2)?);
         exp2_sim = ds2.simulator()?.map(|s| s.params);
         datasets.push(("exp2".into(), ds2.manifest.trials.len()));
         let splits2 = ds2.splits(seed)?;
@@ -281,6 +283,7 @@ pub fn reproduce(
             exp1_sim.as_ref().map(|s| &s.params),
             exp2_sim.as_ref(),
         ),
+        labels,
         overlays,
     };
     results.run.stage_seconds = stages.list.clone();

@@ -218,6 +218,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     let total: f64 = r.run.stage_seconds.iter().map(|s| s.1).sum();
     let _ = writeln!(md, "| total | {total:.1} |\n");
 
+    md.push_str(&crate::label_check::section(r.labels.as_ref()));
     let _ = writeln!(md, "## Experiment 1: hyperparameter search\n");
     for t in &r.tuning {
         let (unit, paper_choice) = if t.repr == "static" {

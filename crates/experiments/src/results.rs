@@ -295,6 +295,10 @@ pub struct Results {
     /// The values evtac chose where the paper states none (absent from older results).
     #[serde(default)]
     pub choices: Vec<crate::choices::Choice>,
+    /// Experiment 2's labels against the commanded stop angles and the ground truth (absent
+    /// without Experiment 2, and from older results).
+    #[serde(default)]
+    pub labels: Option<crate::label_check::LabelCheck>,
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,

@@ -20,6 +20,7 @@ pub mod dvs;
 pub mod imu;
 pub mod params;
 pub mod protocol;
+pub mod rig;
 pub mod sensor;
 pub mod session;
 pub mod trial;

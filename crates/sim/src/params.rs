@@ -22,6 +22,8 @@ pub struct SimParams {
     pub imu: ImuParams,
     /// The robot's motion and the timing of a trial.
     pub timeline: TimelineParams,
+    /// The rig's imperfections: robot repeatability, calibration errors, patch position.
+    pub rig: RigParams,
 }
 
 /// The hemispherical tip and its internal pins.
@@ -94,6 +96,13 @@ pub struct ContactParams {
     /// Per-trial relative spread of the skin's stiffness-like gains (normal, spread, shear): real
     /// trials are never quite identical.
     pub trial_variation: f64,
+    /// Share of the skin's response that follows the commanded pose slowly, with time constant
+    /// `creep_tau_s` (the rest follows with `skin_tau_s`): silicone creeps on under a held
+    /// indentation or tilt, and its loading and unloading paths differ (hysteresis). A
+    /// two-term Prony series, the usual model of a viscoelastic solid.
+    pub creep_fraction: f64,
+    /// Time constant of the slow (creep) share of the skin's response.
+    pub creep_tau_s: f64,
     /// Where the plane starts before the indentation, as a negative depth (a gap).
     pub approach_gap_mm: f64,
     /// Where the plane stays in the no-contact protocol and recording (far out of reach).
@@ -111,6 +120,8 @@ impl Default for ContactParams {
             shear_mm_per_deg: 1.2,
             shear_grip_mm: 0.3,
             trial_variation: 0.03,
+            creep_fraction: 0.02,
+            creep_tau_s: 1.0,
             approach_gap_mm: 0.5,
             no_contact_gap_mm: 10.0,
         }
@@ -257,6 +268,14 @@ pub struct ImuParams {
     pub gyro_scale_error: f64,
     /// Standard deviation of the gyroscope's white noise per sample, deg/s.
     pub gyro_noise_deg_s: f64,
+    /// The gyroscope bias's random walk (rate random walk), deg/s per square root of a second:
+    /// the bias measured before onset drifts away during the trial.
+    pub gyro_bias_walk_deg_s_per_sqrt_s: f64,
+    /// Standard deviation of the per-trial offset between the IMU's timestamps and the events'
+    /// clock, microseconds (positive: IMU stamps late).
+    pub clock_offset_sd_us: f64,
+    /// Standard deviation of each IMU timestamp's jitter, microseconds.
+    pub clock_jitter_us: f64,
     /// Gyroscope resolution (one LSB), deg/s: 1000 dps full scale over 16 bits.
     pub gyro_lsb_deg_s: f64,
     /// Standard deviation of the per-trial accelerometer bias per axis, g.
@@ -280,6 +299,9 @@ impl Default for ImuParams {
             gyro_bias_deg_s: 0.3,
             gyro_scale_error: 0.01,
             gyro_noise_deg_s: 0.05,
+            gyro_bias_walk_deg_s_per_sqrt_s: 0.005,
+            clock_offset_sd_us: 300.0,
+            clock_jitter_us: 20.0,
             gyro_lsb_deg_s: 1000.0 / 32768.0,
             accel_bias_g: 0.005,
             accel_noise_g: 0.002,
@@ -327,6 +349,46 @@ impl Default for TimelineParams {
             total_deg: 20.0,
             no_contact_s: 2.0,
             truth_rate_hz: 1000.0,
+        }
+    }
+}
+
+/// The rig's imperfections, drawn per trial ([`crate::rig::TrialErrors`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RigParams {
+    /// Standard deviation of the tilt the robot reaches against the one commanded (each stop
+    /// and the final tilt), degrees.
+    pub angle_sd_deg: f64,
+    /// Standard deviation of the plane's height against the commanded indentation, millimetres.
+    pub plane_height_sd_mm: f64,
+    /// Standard deviation of the robot's rotation centre from the dome's centre along the axis
+    /// (a tool-centre-point calibration error), millimetres.
+    pub rolling_centre_sd_mm: f64,
+    /// Standard deviation of the contact patch's position on the dome per axis, millimetres
+    /// along the surface.
+    pub patch_offset_sd_mm: f64,
+}
+
+impl Default for RigParams {
+    fn default() -> Self {
+        Self {
+            angle_sd_deg: 0.035,
+            plane_height_sd_mm: 0.03,
+            rolling_centre_sd_mm: 0.5,
+            patch_offset_sd_mm: 0.02,
+        }
+    }
+}
+
+impl RigParams {
+    /// A rig that does exactly what it is told (every error zero).
+    pub fn perfect() -> Self {
+        Self {
+            angle_sd_deg: 0.0,
+            plane_height_sd_mm: 0.0,
+            rolling_centre_sd_mm: 0.0,
+            patch_offset_sd_mm: 0.0,
         }
     }
 }

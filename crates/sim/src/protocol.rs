@@ -356,6 +356,19 @@ impl Motion {
     /// The commanded motion of `spec` (`gap_mm`: how far the plane starts from the tip; without
     /// contact the plane stays at that gap).
     pub fn new(spec: &TrialSpec, timeline: &TimelineParams, gap_mm: f64) -> Self {
+        Self::reaching(spec, timeline, gap_mm, [0.0, 0.0])
+    }
+
+    /// The motion the robot makes for `spec`: the commanded one, but reaching the stop and the
+    /// final tilt `errors_deg` (stop, final) away from the commanded angles (the robot's
+    /// repeatability, [`crate::rig::TrialErrors`]).
+    pub fn reaching(
+        spec: &TrialSpec,
+        timeline: &TimelineParams,
+        gap_mm: f64,
+        errors_deg: [f64; 2],
+    ) -> Self {
+        let total = timeline.total_deg + errors_deg[1];
         let start = timeline.indent_s + timeline.settle_s;
         let accel = timeline.accel_deg_s2.max(1e-6);
         let v = spec.speed_deg_s.max(1e-6);
@@ -370,9 +383,9 @@ impl Motion {
         let mut stop = (None, None);
         let mut targets = Vec::new();
         if let Some(s) = spec.stop_deg {
-            targets.push(s.clamp(0.0, timeline.total_deg));
+            targets.push((s.clamp(0.0, timeline.total_deg) + errors_deg[0]).clamp(0.0, total));
         }
-        targets.push(timeline.total_deg);
+        targets.push(total);
         for (k, target) in targets.iter().enumerate() {
             let dist = target - theta;
             if dist > 0.0 {

@@ -7,6 +7,12 @@
 //! [`crate::sensor`]), so a stop makes the skin relax over a few time constants, a burst of
 //! "elastic recoil" events that dies out, and then the sensor is quiet.
 //!
+//! A share `creep_fraction` of the skin's response follows with the much slower `creep_tau_s`
+//! instead (silicone's creep and hysteresis): after a stop the skin keeps settling for a second
+//! or so, at a trickle of events. The rig's per-trial errors ([`crate::rig`]) move the angles the
+//! robot reaches, the indentation and where the patch sits; the manifest keeps the commanded
+//! values and the ground truth follows the robot's actual motion, as on a real rig.
+//!
 //! Steps are adaptive: each is as long as possible (up to `max_step_s`) such that no pin's image
 //! moves more than `max_px_per_step` pixels.
 
@@ -21,6 +27,7 @@ use crate::dvs::{Dvs, PixelArray, gaussian};
 use crate::imu::simulate_imu;
 use crate::params::SimParams;
 use crate::protocol::{Motion, TrialSpec};
+use crate::rig::TrialErrors;
 use crate::sensor::{Dome, Gains, PinImage, SkinPose};
 
 /// One ground-truth sample: the commanded pose.
@@ -82,6 +89,14 @@ impl TrialRecording {
     }
 }
 
+/// Random stream `k` of the trial with `seed`: each kind of draw has its own stream, so one
+/// kind's parameters do not move another's draws.
+fn trial_stream(seed: u64, k: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(k);
+    rng
+}
+
 /// The simulator: one sensor (tip, camera with its fixed pattern, IMU mounting) that records
 /// trials.
 pub struct Simulator {
@@ -131,8 +146,19 @@ impl Simulator {
         } else {
             self.params.contact.no_contact_gap_mm
         };
-        let motion = Motion::new(spec, &self.params.timeline, gap);
-        self.run(spec, &motion)
+        let errors = self.errors(spec);
+        let reached = [errors.stop_deg, errors.total_deg];
+        let motion = Motion::reaching(spec, &self.params.timeline, gap, reached);
+        self.run(spec, &motion, &errors)
+    }
+
+    /// The rig's errors in trial `spec` (none without contact: the robot does not move then).
+    pub fn errors(&self, spec: &TrialSpec) -> TrialErrors {
+        if !spec.contact {
+            return TrialErrors::default();
+        }
+        let seed = rand::Rng::next_u64(&mut trial_stream(spec.seed, 4));
+        TrialErrors::draw(&self.params.rig, self.params.sensor.tip_radius_mm, seed)
     }
 
     /// The `no_contact.aedat4` recording: the sensor at rest out of contact, noise only.
@@ -154,7 +180,7 @@ impl Simulator {
             seed,
         };
         let motion = Motion::rest(duration_s, self.params.contact.no_contact_gap_mm);
-        self.run(&spec, &motion)
+        self.run(&spec, &motion, &TrialErrors::default())
     }
 
     /// The camera's linear brightness image (row-major, full sensor) with the skin at `pose`:
@@ -165,12 +191,8 @@ impl Simulator {
         Dvs::new(&self.array, &self.params.dvs, &self.params.camera, &pins, 0).brightness_image()
     }
 
-    fn run(&self, spec: &TrialSpec, motion: &Motion) -> TrialRecording {
-        let stream = |k: u64| {
-            let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-            rng.set_stream(k);
-            rng
-        };
+    fn run(&self, spec: &TrialSpec, motion: &Motion, errors: &TrialErrors) -> TrialRecording {
+        let stream = |k: u64| trial_stream(spec.seed, k);
         let mut variation = stream(1);
         let v = self.params.contact.trial_variation;
         let mut gain = || (1.0 + v * gaussian(&mut variation)).max(0.1);
@@ -179,13 +201,20 @@ impl Simulator {
             spread: gain(),
             shear: gain(),
         };
-        let events = self.events(spec, motion, &gains, rand::Rng::next_u64(&mut stream(2)));
+        let events = self.events(
+            spec,
+            motion,
+            &gains,
+            errors,
+            rand::Rng::next_u64(&mut stream(2)),
+        );
         let imu = simulate_imu(
             &self.params.imu,
             &self.calibration,
             motion,
             spec.direction_deg,
             rand::Rng::next_u64(&mut stream(3)),
+            rand::Rng::next_u64(&mut stream(5)),
         );
         let us = |t: f64| (t * 1e6).round() as i64;
         let duration_us = us(motion.end_s);
@@ -220,42 +249,63 @@ impl Simulator {
         }
     }
 
-    fn events(&self, spec: &TrialSpec, motion: &Motion, gains: &Gains, seed: u64) -> Vec<Event> {
+    fn events(
+        &self,
+        spec: &TrialSpec,
+        motion: &Motion,
+        gains: &Gains,
+        errors: &TrialErrors,
+        seed: u64,
+    ) -> Vec<Event> {
         let p = &self.params;
         let tau = p.contact.skin_tau_s.max(1e-6);
+        let creep_tau = p.contact.creep_tau_s.max(1e-6);
+        let creep = p.contact.creep_fraction.clamp(0.0, 1.0);
         let (max_px, min_dt, max_dt) = (
             p.dvs.max_px_per_step.max(1e-3) as f32,
             p.dvs.min_step_s.max(1e-7),
             p.dvs.max_step_s.max(p.dvs.min_step_s.max(1e-7)),
         );
-        let pose = |theta_s: f64, depth_s: f64, t: f64| SkinPose {
-            theta_deg: theta_s,
-            phi_deg: spec.direction_deg,
-            depth_mm: depth_s,
-            lag_deg: motion.theta(t) - theta_s,
+        // The skin's pose from its fast and slow (creep) states, each `[tilt, depth]`; the rig's
+        // errors move the indentation with the tilt and the patch on the dome.
+        let pose = |fast: [f64; 2], slow: [f64; 2], t: f64| {
+            let mix = |k: usize| (1.0 - creep) * fast[k] + creep * slow[k];
+            let theta_s = mix(0);
+            let (theta_deg, phi_deg) = errors.patch_tilt(theta_s, spec.direction_deg);
+            SkinPose {
+                theta_deg,
+                phi_deg,
+                depth_mm: mix(1) + errors.depth_offset_mm(theta_s),
+                lag_deg: motion.theta(t) - theta_s,
+            }
         };
-        // The skin's lagged state: exact first-order response to a linearly changing input.
-        let follow = |x0: f64, c0: f64, c1: f64, dt: f64| {
+        // A lagged state: exact first-order response (time constant `tau`) to a linearly
+        // changing input.
+        let follow = |tau: f64, x0: f64, c0: f64, c1: f64, dt: f64| {
             let b = (c1 - c0) / dt;
             c1 - b * tau + (x0 - c0 + b * tau) * (-dt / tau).exp()
         };
-        let (mut theta_s, mut depth_s) = (motion.theta(0.0), motion.depth(0.0));
+        let mut fast = [motion.theta(0.0), motion.depth(0.0)];
+        let mut slow = fast;
         let mut pins = Vec::new();
-        self.dome
-            .pins(&pose(theta_s, depth_s, 0.0), gains, &mut pins);
+        self.dome.pins(&pose(fast, slow, 0.0), gains, &mut pins);
         let mut dvs = Dvs::new(&self.array, &p.dvs, &p.camera, &pins, seed);
         let mut next: Vec<PinImage> = Vec::new();
         let mut events = Vec::new();
         let (mut t, mut dt) = (0.0, min_dt);
         while t < motion.end_s {
-            let (mut t1, mut th1, mut de1, mut disp);
+            let (mut t1, mut fast1, mut slow1, mut disp);
             let mut tries = 0;
             loop {
                 t1 = (t + dt).min(motion.end_s);
                 let h = t1 - t;
-                th1 = follow(theta_s, motion.theta(t), motion.theta(t1), h);
-                de1 = follow(depth_s, motion.depth(t), motion.depth(t1), h);
-                self.dome.pins(&pose(th1, de1, t1), gains, &mut next);
+                let (c0, c1) = (
+                    [motion.theta(t), motion.depth(t)],
+                    [motion.theta(t1), motion.depth(t1)],
+                );
+                fast1 = std::array::from_fn(|k| follow(tau, fast[k], c0[k], c1[k], h));
+                slow1 = std::array::from_fn(|k| follow(creep_tau, slow[k], c0[k], c1[k], h));
+                self.dome.pins(&pose(fast1, slow1, t1), gains, &mut next);
                 disp = pins
                     .iter()
                     .zip(&next)
@@ -270,7 +320,7 @@ impl Simulator {
             dvs.step(t1, &next, &mut events);
             std::mem::swap(&mut pins, &mut next);
             let used = t1 - t;
-            (t, theta_s, depth_s) = (t1, th1, de1);
+            (t, fast, slow) = (t1, fast1, slow1);
             // Next step: as long as the current pin speed allows, growing at most twofold.
             let ideal = if disp > 0.0 {
                 used * f64::from(max_px / disp)
@@ -328,17 +378,85 @@ mod tests {
         );
     }
 
+    /// Events in the last 100 ms before the tilt starts.
+    fn settle_events(r: &TrialRecording) -> usize {
+        r.events
+            .iter()
+            .filter(|e| e.t >= r.motion_start_us - 100_000 && e.t < r.motion_start_us)
+            .count()
+    }
+
     #[test]
     fn quiet_before_contact_busy_during_motion() {
         let r = quiet_sim().simulate(&spec(10.0, 2.0));
         let rate = motion_rate(&r);
         assert!(rate > 20_000.0, "{rate}");
-        // The last 100 ms of the settle period: the skin has settled, nothing moves.
-        let settle = r
-            .events
-            .iter()
-            .filter(|e| e.t >= r.motion_start_us - 100_000 && e.t < r.motion_start_us)
-            .count();
-        assert!(settle < 50, "{settle}");
+        // The skin's fast response has settled by then: what moves is the creep, a trickle.
+        let settle = settle_events(&r) as f64 / 0.1;
+        assert!(
+            settle < 0.05 * rate,
+            "{settle} events/s at rest, {rate} moving"
+        );
+        // Without creep nothing moves at all.
+        let mut params = quiet_sim().params().clone();
+        params.contact.creep_fraction = 0.0;
+        let r = Simulator::new(params, 1).simulate(&spec(10.0, 2.0));
+        assert!(settle_events(&r) < 50, "{}", settle_events(&r));
+    }
+
+    #[test]
+    fn the_skin_creeps_on_after_a_stop() {
+        let mut s = plan(Protocol::Exp2, Scale::Tiny, 1, &Default::default()).remove(0);
+        s.speed_deg_s = 10.0;
+        let creeping = quiet_sim();
+        let mut params = creeping.params().clone();
+        params.contact.creep_fraction = 0.0;
+        let elastic = Simulator::new(params, 1);
+        // Events in the second half of the stop, after the fast recoil has died out.
+        let late_stop = |r: &TrialRecording| {
+            let (a, b) = r.stop_us.expect("a stop");
+            r.events
+                .iter()
+                .filter(|e| e.t >= (a + b) / 2 && e.t < b)
+                .count()
+        };
+        let (with, without) = (
+            late_stop(&creeping.simulate(&s)),
+            late_stop(&elastic.simulate(&s)),
+        );
+        assert!(
+            with > 2 * without + 20,
+            "{with} events with creep, {without} without"
+        );
+    }
+
+    #[test]
+    fn the_robot_reaches_its_targets_within_its_repeatability() {
+        let sim = Simulator::new(SimParams::default(), 1);
+        let s = plan(Protocol::Exp2, Scale::Tiny, 1, &Default::default()).remove(0);
+        let r = sim.simulate(&s);
+        let commanded = s.stop_deg.expect("a stop");
+        let (a, b) = r.stop_us.expect("a stop");
+        let at = |t: i64| {
+            r.truth
+                .iter()
+                .find(|x| x.t_us >= t)
+                .expect("inside")
+                .theta_deg
+        };
+        let stop_error = at((a + b) / 2) - commanded;
+        let final_error = r.truth.last().unwrap().theta_deg - sim.params().timeline.total_deg;
+        let sd = sim.params().rig.angle_sd_deg;
+        assert!(
+            stop_error != 0.0 && stop_error.abs() < 5.0 * sd,
+            "{stop_error}"
+        );
+        assert!(
+            final_error != 0.0 && final_error.abs() < 5.0 * sd,
+            "{final_error}"
+        );
+        // The manifest keeps the commands.
+        let meta = r.meta("t.aedat4", None, sim.params().timeline.total_deg);
+        assert_eq!(meta.stop_deg, Some(commanded));
     }
 }

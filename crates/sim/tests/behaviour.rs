@@ -98,7 +98,8 @@ fn a_stop_shows_recoil_then_quiet() {
     let late = rate(&r.events, s1 - 200_000, s1);
     assert!(recoil > 0.05 * moving, "recoil {recoil} vs motion {moving}");
     assert!(late < 0.1 * recoil, "late {late} vs recoil {recoil}");
-    assert!(late < 0.01 * moving, "late {late} vs motion {moving}");
+    // What is left late in the stop is the skin's creep: a trickle.
+    assert!(late < 0.05 * moving, "late {late} vs motion {moving}");
     // The rate decays through the stop.
     let quarters: Vec<f64> = (0..4)
         .map(|q| rate(&r.events, s0 + q * 125_000, s0 + (q + 1) * 125_000))

@@ -58,9 +58,17 @@ fn the_session_holds_the_dataset_s_trials_with_triggers_and_a_log_on_the_robot_s
     let manifest = simulate_dataset(&dataset, &dataset_dir, |_| {}).unwrap();
     let session = read_recording(session_dir.join("session.aedat4")).unwrap();
 
-    // One IMU at one rate across the session, and events in order.
-    assert!(session.imu.windows(2).all(|w| w[1].t - w[0].t == 1250));
-    assert_eq!(session.imu[0].t, config.start_us);
+    // One IMU at one rate across the session (its stamps jitter by 20 us and shift by each
+    // stretch's clock offset, a few hundred us), and events in order.
+    let steps: Vec<i64> = session.imu.windows(2).map(|w| w[1].t - w[0].t).collect();
+    assert!(steps.iter().all(|&d| d > 0 && (d - 1250).abs() < 5_000));
+    let on_rate = steps.iter().filter(|&&d| (d - 1250).abs() <= 200).count();
+    assert!(
+        on_rate * 100 >= steps.len() * 99,
+        "{on_rate} of {}",
+        steps.len()
+    );
+    assert!((session.imu[0].t - config.start_us).abs() < 5_000);
     assert!(session.events.windows(2).all(|w| w[0].t <= w[1].t));
     // A trigger at every onset.
     let onsets: Vec<i64> = record.trials.iter().map(|t| t.motion_start_us).collect();
