@@ -732,7 +732,7 @@ pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
                 }
             })
             .x_desc("sampling interval")
-            .y_desc("end-to-end time (us)")
+            .y_desc("processing time per estimate (us)")
             .y_label_formatter(&tick)
             .label_style((FAMILY, 16))
             .axis_desc_style((FAMILY, 18))

@@ -57,7 +57,7 @@ pub const FIGURES: [(&str, &str); 7] = [
     ),
     (
         "latency.png",
-        "End-to-end time per step (events in to MLP output) at each sampling interval: box 25-75 %, black bar median, triangle P99, whiskers min-max; dashed the interval, solid the paper's 10 ms bound.",
+        "Processing time per estimate (events in to estimate out, as `evtac online` reports it) at each sampling interval: box 25-75 %, black bar median, triangle P99, whiskers min-max; dashed the interval, solid the paper's 10 ms bound.",
     ),
     (
         "noise.png",
@@ -333,19 +333,26 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     figure(&mut md, figures, 3);
     figure(&mut md, figures, 4);
 
-    let _ = writeln!(md, "## Latency (end-to-end per step, microseconds)\n");
+    let _ = writeln!(
+        md,
+        "## Latency (processing time per estimate, microseconds)\n"
+    );
     if r.latency.is_empty() {
         let _ = writeln!(md, "Not measured.\n");
     } else {
         let _ = writeln!(
             md,
             "Sequential, one thread, on this machine's CPU (the paper: an Intel Core Ultra 7 165H \
-             plus an RTX 2080 Ti for inference), from a step's new events to the MLP's output, \
-             through the estimator `evtac online` runs; the work known before they arrive (the \
-             dynamic window dropping what leaves it by the step) is done before timing starts, \
-             as `evtac online` does between estimates. \
-             Paper: every representation under 10 ms at every interval; static and dynamic \
-             under the interval, combined over it for a few samples at 1 and 2 ms.\n"
+             plus an RTX 2080 Ti for inference), through the estimator `evtac online` runs. Each \
+             figure is the time `evtac online` reports as an estimate's processing time: \
+             everything the estimator does from the step's events in to the estimate out \
+             (cropping, the representation update, advancing to the step's time, pooling, the \
+             MLP, and the work it does ahead of the estimate between estimates, such as the \
+             dynamic window dropping what leaves it), with nothing done before the timer starts. \
+             Events come at recorded pace (one chunk per step holding that interval's events), \
+             so no step waits in a queue; transmission from the sensor is excluded, as in the \
+             paper. Paper: every representation under 10 ms at every interval; static and \
+             dynamic under the interval, combined over it for a few samples at 1 and 2 ms.\n"
         );
         let _ = writeln!(
             md,

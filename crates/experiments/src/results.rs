@@ -203,7 +203,8 @@ pub struct LatencyCell {
     pub interval_ms: u32,
     /// Number of measured samples.
     pub samples: usize,
-    /// Median end-to-end time in microseconds.
+    /// Median processing time per estimate in microseconds (events in to estimate out, see
+    /// [`crate::latency`]).
     pub median_us: f64,
     /// 99th percentile in microseconds.
     pub p99_us: f64,
