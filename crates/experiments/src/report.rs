@@ -69,7 +69,7 @@ pub const FIGURES: [(&str, &str); 9] = [
     ),
     (
         "sensor.png",
-        "The sensor: what the camera inside the tip sees at rest and in contact (the same test trial), the centered 240x240 crop outlined.",
+        "The sensor: what the camera inside the tip sees at rest and in contact (in contact: the test trial of the next figure, at its sample's tilt), the centered 240x240 crop outlined.",
     ),
 ];
 
