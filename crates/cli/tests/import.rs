@@ -164,6 +164,11 @@ fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
         text.contains("Calibration: calibration.json. No-contact mask: no_contact.aedat4."),
         "{text}"
     );
+    // A recorded dataset has no camera frames: the sensor figure shows event counts, and says so.
+    assert!(
+        text.contains("(figures/sensor.png)") && text.contains("these are event-count images"),
+        "{text}"
+    );
     let again = dir.path().join("again");
     args[5] = again.to_str().unwrap();
     args.extend(["--clock-offset-us", "5"]);

@@ -1,6 +1,6 @@
 //! Tests of `evtac online`.
 
-use crate::common::{evtac, run_ok};
+use crate::common::{evtac, run_ok, simulate_tiny};
 use evtac_learn::{ModelBundle, Representation};
 use evtac_repr::ReprConfig;
 use std::io::Write;
@@ -208,4 +208,62 @@ fn ctrl_c_ends_a_live_run_with_its_summary() {
         "{total}: {stderr}"
     );
     drop(stdin);
+}
+
+/// Issue 19: a recording replayed as fast as possible is read far ahead of the estimator, so
+/// its "latency" is mostly queueing (a P99 of milliseconds against about a hundred microseconds
+/// at `--realtime`). Its summary must lead with the processing time per estimate and say that
+/// latency needs `--realtime`; a paced replay still reports latency.
+#[test]
+fn a_replay_as_fast_as_possible_reports_processing_time_not_latency() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let ds = dir.path().join("ds");
+    simulate_tiny("exp1", 3, &ds, 1);
+    let manifest = evtac_events::manifest::Manifest::read(&ds).unwrap();
+    let trial = ds.join(&manifest.trials[0].file);
+    let (m, t) = (model.to_str().unwrap(), trial.to_str().unwrap());
+    let out = dir.path().join("estimates.csv");
+    let o = out.to_str().unwrap();
+    let run = run_ok(&["online", "--model", m, "--input", t, "--output", o]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let lines: Vec<&str> = stderr.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("estimates: "))
+        .unwrap_or_else(|| panic!("no summary in:\n{stderr}"));
+    assert!(
+        lines[at + 1].starts_with("processing time per estimate: median "),
+        "the processing time is not the headline:\n{stderr}"
+    );
+    assert!(
+        lines[at + 2].starts_with("latency: not measured") && lines[at + 2].contains("--realtime"),
+        "no note that latency needs --realtime:\n{stderr}"
+    );
+    assert!(!stderr.contains("late (latency"), "{stderr}");
+    let estimates = std::fs::read_to_string(&out).unwrap().lines().count() - 1;
+    assert!(estimates > 100, "{estimates} estimates:\n{stderr}");
+
+    // At recorded pace the latency is reported (a quarter second of the trial is enough).
+    let paced = run_ok(&[
+        "online",
+        "--model",
+        m,
+        "--input",
+        t,
+        "--output",
+        o,
+        "--realtime",
+        "--max-duration-s",
+        "0.25",
+    ]);
+    let stderr = String::from_utf8_lossy(&paced.stderr);
+    assert!(stderr.contains("\nlatency: median "), "{stderr}");
+    assert!(stderr.contains("late (latency > interval)"), "{stderr}");
+    assert!(
+        stderr.contains("processing time per estimate: median "),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("not measured"), "{stderr}");
 }

@@ -54,6 +54,38 @@ pub fn tiny_args(out: &Path) -> Vec<String> {
         .to_vec()
 }
 
+/// A decoded 8-bit RGB figure.
+struct Rgb(Vec<u8>);
+
+impl Rgb {
+    fn decode(bytes: &[u8]) -> Rgb {
+        let mut reader = png::Decoder::new(bytes).read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(
+            (info.color_type, info.bit_depth),
+            (png::ColorType::Rgb, png::BitDepth::Eight)
+        );
+        buf.truncate(info.buffer_size());
+        Rgb(buf)
+    }
+
+    fn pixels(&self) -> impl Iterator<Item = [u8; 3]> + '_ {
+        self.0.chunks_exact(3).map(|p| [p[0], p[1], p[2]])
+    }
+
+    /// The share of pixels for which `f` holds.
+    fn share(&self, f: impl Fn([u8; 3]) -> bool) -> f64 {
+        self.pixels().filter(|&p| f(p)).count() as f64 / (self.0.len() / 3).max(1) as f64
+    }
+
+    fn distinct(&self) -> usize {
+        self.pixels()
+            .collect::<std::collections::HashSet<_>>()
+            .len()
+    }
+}
+
 /// `results.json` of a finished run.
 fn results(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
@@ -70,15 +102,55 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         report.contains("0.160 ± 0.004"),
         "the paper's numbers are quoted"
     );
+    // Every figure drawn, named in the report, and not blank; nothing else in figures/.
+    assert!(
+        FIGURES.len() >= 8,
+        "the report has {} figures",
+        FIGURES.len()
+    );
     for (fig, _) in FIGURES {
         let bytes = std::fs::read(out.join("figures").join(fig)).unwrap();
         assert!(bytes.starts_with(b"\x89PNG"), "{fig} is not a PNG");
         assert!(bytes.len() > 5_000, "{fig} is nearly empty");
+        let image = Rgb::decode(&bytes);
+        assert!(
+            image.share(|p| p != [255, 255, 255]) > 0.02,
+            "{fig} is blank"
+        );
+        assert!(
+            image.distinct() >= 16,
+            "{fig} has {} colors",
+            image.distinct()
+        );
         assert!(
             report.contains(&format!("(figures/{fig})")),
             "{fig} not referenced"
         );
     }
+    for entry in std::fs::read_dir(out.join("figures")).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(
+            report.contains(&format!("(figures/{name})")),
+            "figures/{name} is not named in report.md"
+        );
+    }
+    // Fig. 2: the window's events in colour (ON red or OFF blue), and frames with set pixels.
+    let repr = Rgb::decode(&std::fs::read(out.join("figures/representations.png")).unwrap());
+    assert!(
+        repr.share(|p| p == [255, 60, 60] || p == [70, 140, 255]) > 0.001,
+        "representations.png shows no events"
+    );
+    assert!(repr.share(|p| p == [255, 255, 255]) > 0.001);
+    // The simulated sensor: a camera image has many grey levels, not two.
+    let sensor = Rgb::decode(&std::fs::read(out.join("figures/sensor.png")).unwrap());
+    let greys = sensor.pixels().filter(|p| p[0] == p[1] && p[1] == p[2]);
+    let levels: std::collections::HashSet<u8> = greys.map(|p| p[0]).collect();
+    assert!(
+        levels.len() > 64,
+        "sensor.png has {} grey levels",
+        levels.len()
+    );
+    assert!(report.contains("Simulated: the simulator's camera brightness"));
     // Every value the paper leaves open, as this run used it: simulated with the defaults.
     assert!(report.contains(&format!("## {CHOICES_TITLE}")));
     let sim = SimParams::default();

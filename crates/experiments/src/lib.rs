@@ -18,7 +18,8 @@
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`noise`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
-//!   experiments; [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm
+//!   experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and [`sensor_view`] (the
+//!   sensor at rest and in contact) the data of two illustrative figures; [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm
 //!   cluster); [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the
 //!   PNG figures; [`choices`] lists the values evtac chose where the paper states none.
 //!
@@ -57,9 +58,11 @@ pub mod pipeline;
 pub mod plan;
 pub mod plots;
 pub mod report;
+pub mod repr_example;
 pub mod results;
 pub mod robot_log;
 pub mod sampling;
+pub mod sensor_view;
 pub mod slurm;
 pub mod splits;
 pub mod stage;

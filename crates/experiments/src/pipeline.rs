@@ -15,7 +15,10 @@ use crate::splits::Split;
 use crate::stage::Stage;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
-use crate::{choices, examples, exp1, exp2, exp3, label_check, latency, noise, report};
+use crate::{
+    choices, examples, exp1, exp2, exp3, label_check, latency, noise, report, repr_example,
+    sensor_view,
+};
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -242,9 +245,21 @@ pub fn reproduce(
         stages.done("experiment 3");
     }
     let overlays = examples::overlays(&cache1, reprs[0].1, reprs[1].1)?;
+    // The paper's Fig. 2 and the sensor's camera view, both on the first test trial.
+    let test = ds1.trials(splits1.get(Split::Test))?;
+    let (repr_example, sensor) = match test.first() {
+        Some(meta) => {
+            let example = repr_example::example(&cache1, meta, &reprs)?;
+            // The tilt at the example's sample (commanded: constant speed from onset).
+            let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
+                (meta.speed_deg_s * e.t_ms / 1000.0).min(meta.total_deg)
+            });
+            (example, Some(sensor_view::view(&ds1, meta, theta)?))
+        }
+        None => (None, None),
+    };
 
     // Latency: the first model of each representation on the Experiment 1 test trials, alone.
-    let test = ds1.trials(splits1.get(Split::Test))?;
     let test = &test[..test.len().min(plan.latency_trials)];
     progress.stage(
         Stage::Latency,
@@ -285,6 +300,8 @@ pub fn reproduce(
         ),
         labels,
         overlays,
+        repr_example,
+        sensor,
     };
     results.run.stage_seconds = stages.list.clone();
     report::write(out, &results)?;

@@ -1,9 +1,18 @@
-//! The report's figures as PNG, drawn with plotters.
+//! The report's figures as PNG, drawn with plotters: the charts here, the image figures in
+//! submodules ([`representations()`], the paper's Fig. 2 for one sample, and [`sensor()`], the
+//! sensor's camera view; the private `images` draws their pixels).
 //!
 //! Text is rendered with DejaVu Sans, embedded in the binary (`assets/fonts/DejaVuSans.ttf`, from
 //! Debian's `fonts-dejavu-core`; Bitstream Vera license with public-domain DejaVu changes, see
 //! `assets/fonts/LICENSE-DejaVu.txt`), so figures look the same on every machine and need no
 //! system fonts.
+
+mod images;
+mod representations;
+mod sensor;
+
+pub use representations::representations;
+pub use sensor::sensor;
 
 use crate::results::{ExampleTrial, Exp2Cell, Exp3Point, LatencyCell, NoisePoint, Overlay, Tuning};
 use plotters::coord::Shift;
@@ -732,7 +741,7 @@ pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
                 }
             })
             .x_desc("sampling interval")
-            .y_desc("end-to-end time (us)")
+            .y_desc("processing time per estimate (us)")
             .y_label_formatter(&tick)
             .label_style((FAMILY, 16))
             .axis_desc_style((FAMILY, 18))

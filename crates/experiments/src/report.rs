@@ -4,7 +4,7 @@
 use crate::exp2::SETTINGS;
 use crate::io::IoError;
 use crate::plots;
-use crate::results::{Exp3Point, MaeStats, NoisePoint, Results};
+use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, SensorKind};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -34,7 +34,7 @@ pub enum Error {
 }
 
 /// The figures of a report: file name (under `figures/`) and one-line caption.
-pub const FIGURES: [(&str, &str); 7] = [
+pub const FIGURES: [(&str, &str); 9] = [
     (
         "tuning.png",
         "Validation MAE of the static (decay tau, threshold) and dynamic (window, threshold) settings, one parameter varied with the other fixed; the chosen setting in red.",
@@ -57,13 +57,40 @@ pub const FIGURES: [(&str, &str); 7] = [
     ),
     (
         "latency.png",
-        "End-to-end time per step (events in to MLP output) at each sampling interval: box 25-75 %, black bar median, triangle P99, whiskers min-max; dashed the interval, solid the paper's 10 ms bound.",
+        "Processing time per estimate (events in to estimate out, as `evtac online` reports it) at each sampling interval: box 25-75 %, black bar median, triangle P99, whiskers min-max; dashed the interval, solid the paper's 10 ms bound.",
     ),
     (
         "noise.png",
         "Experiment 1 at other background noise: test MAE per representation against the factor on the simulator's leak, shot and hot-pixel noise (mean ± std over seeds; 1 is Experiment 1).",
     ),
+    (
+        "representations.png",
+        "The paper's Fig. 2 for one Experiment 1 test sample (the middle motion sample of the first test trial): the events of the last dynamic window (ON red, OFF blue, both magenta), the static, dynamic and combined binary frames (240x240, tuned settings, no-contact mask applied), and below each frame its 30x30 pooled features, the models' input (black 0, white 1).",
+    ),
+    (
+        "sensor.png",
+        "The sensor: what the camera inside the tip sees at rest and in contact (in contact: the test trial of the next figure, at its sample's tilt), the centered 240x240 crop outlined.",
+    ),
 ];
+
+/// The caption of `sensor.png` for what it shows: the simulator's camera images, or event counts
+/// of a recorded dataset (which has no frames to show).
+fn sensor_caption(kind: SensorKind) -> String {
+    match kind {
+        SensorKind::Simulated => format!(
+            "{} Simulated: the simulator's camera brightness (gamma 0.5) of the pins out of \
+             contact and pressed in at the trial's depth and the sample's tilt.",
+            FIGURES[8].1
+        ),
+        SensorKind::EventCounts => {
+            "The sensor as recorded: a real dataset has no camera frames, so \
+             these are event-count images (events per pixel, log scale) of the no-contact \
+             recording (when the dataset was opened with its mask) and of the first test trial's \
+             motion phase, the centered 240x240 crop outlined."
+                .to_string()
+        }
+    }
+}
 
 fn cell(s: &crate::results::MeanStd) -> String {
     if s.n == 0 { "-".into() } else { s.display() }
@@ -219,6 +246,13 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     let _ = writeln!(md, "| total | {total:.1} |\n");
 
     md.push_str(&crate::label_check::section(r.labels.as_ref()));
+
+    if figures.contains(&FIGURES[7].0) || figures.contains(&FIGURES[8].0) {
+        let _ = writeln!(md, "## The sensor and the representations\n");
+        figure(&mut md, figures, 8, r.sensor.as_ref().map(|v| v.kind));
+        figure(&mut md, figures, 7, None);
+    }
+
     let _ = writeln!(md, "## Experiment 1: hyperparameter search\n");
     for t in &r.tuning {
         let (unit, paper_choice) = if t.repr == "static" {
@@ -250,7 +284,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         }
         let _ = writeln!(md);
     }
-    figure(&mut md, figures, 0);
+    figure(&mut md, figures, 0, None);
 
     let _ = writeln!(md, "## Experiment 1: representations (test MAE, degrees)\n");
     let _ = writeln!(
@@ -311,8 +345,8 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
              phases.\n",
             PAPER_EXP2_STATIC.0, PAPER_EXP2_STATIC.1
         );
-        figure(&mut md, figures, 1);
-        figure(&mut md, figures, 2);
+        figure(&mut md, figures, 1, None);
+        figure(&mut md, figures, 2, None);
     }
 
     let _ = writeln!(
@@ -331,22 +365,29 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
             let _ = writeln!(md);
         }
     }
-    figure(&mut md, figures, 3);
-    figure(&mut md, figures, 4);
+    figure(&mut md, figures, 3, None);
+    figure(&mut md, figures, 4, None);
 
-    let _ = writeln!(md, "## Latency (end-to-end per step, microseconds)\n");
+    let _ = writeln!(
+        md,
+        "## Latency (processing time per estimate, microseconds)\n"
+    );
     if r.latency.is_empty() {
         let _ = writeln!(md, "Not measured.\n");
     } else {
         let _ = writeln!(
             md,
             "Sequential, one thread, on this machine's CPU (the paper: an Intel Core Ultra 7 165H \
-             plus an RTX 2080 Ti for inference), from a step's new events to the MLP's output, \
-             through the estimator `evtac online` runs; the work known before they arrive (the \
-             dynamic window dropping what leaves it by the step) is done before timing starts, \
-             as `evtac online` does between estimates. \
-             Paper: every representation under 10 ms at every interval; static and dynamic \
-             under the interval, combined over it for a few samples at 1 and 2 ms.\n"
+             plus an RTX 2080 Ti for inference), through the estimator `evtac online` runs. Each \
+             figure is the time `evtac online` reports as an estimate's processing time: \
+             everything the estimator does from the step's events in to the estimate out \
+             (cropping, the representation update, advancing to the step's time, pooling, the \
+             MLP, and the work it does ahead of the estimate between estimates, such as the \
+             dynamic window dropping what leaves it), with nothing done before the timer starts. \
+             Events come at recorded pace (one chunk per step holding that interval's events), \
+             so no step waits in a queue; transmission from the sensor is excluded, as in the \
+             paper. Paper: every representation under 10 ms at every interval; static and \
+             dynamic under the interval, combined over it for a few samples at 1 and 2 ms.\n"
         );
         let _ = writeln!(
             md,
@@ -367,7 +408,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
             );
         }
         let _ = writeln!(md);
-        figure(&mut md, figures, 5);
+        figure(&mut md, figures, 5, None);
     }
     choices_section(&mut md, &r.choices);
     md
@@ -484,7 +525,7 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
         );
     }
     let _ = writeln!(md, "\n{}\n", noise_verdict(&gaps));
-    figure(md, figures, 6);
+    figure(md, figures, 6, None);
 }
 
 /// The title of the section listing the values evtac chose where the paper states none.
@@ -515,8 +556,11 @@ fn choices_section(md: &mut String, choices: &[crate::choices::Choice]) {
     let _ = writeln!(md);
 }
 
-fn figure(md: &mut String, present: &[&str], i: usize) {
+/// Figure `i` of [`FIGURES`] with its caption, if it was drawn; the sensor figure's caption
+/// says what it shows (`sensor`).
+fn figure(md: &mut String, present: &[&str], i: usize, sensor: Option<SensorKind>) {
     let (file, caption) = FIGURES[i];
+    let caption = sensor.map_or_else(|| caption.to_string(), sensor_caption);
     if present.contains(&file) {
         let _ = writeln!(md, "![{caption}](figures/{file})\n\n*{caption}*\n");
     }
@@ -558,6 +602,12 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
     }
     if !r.noise.is_empty() {
         draw(FIGURES[6].0, &|p| plots::noise(p, &r.noise))?;
+    }
+    if let Some(ex) = &r.repr_example {
+        draw(FIGURES[7].0, &|p| plots::representations(p, ex))?;
+    }
+    if let Some(view) = &r.sensor {
+        draw(FIGURES[8].0, &|p| plots::sensor(p, view))?;
     }
     let json_path = out.join("results.json");
     let json = serde_json::to_string_pretty(r).map_err(IoError::at(&json_path))?;

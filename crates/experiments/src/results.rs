@@ -203,7 +203,8 @@ pub struct LatencyCell {
     pub interval_ms: u32,
     /// Number of measured samples.
     pub samples: usize,
-    /// Median end-to-end time in microseconds.
+    /// Median processing time per estimate in microseconds (events in to estimate out, see
+    /// [`crate::latency`]).
     pub median_us: f64,
     /// 99th percentile in microseconds.
     pub p99_us: f64,
@@ -270,6 +271,68 @@ pub struct Overlay {
     pub second: Vec<u8>,
 }
 
+/// The paper's Fig. 2 for one test sample (see [`crate::repr_example`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ReprExample {
+    /// Trial name.
+    pub trial: String,
+    /// The sample's time from motion onset, in ms.
+    pub t_ms: f64,
+    /// The dynamic window the event counts cover, `(t - window, t]`, in ms.
+    pub window_ms: f64,
+    /// Crop width in pixels.
+    pub width: usize,
+    /// Crop height in pixels.
+    pub height: usize,
+    /// ON events per pixel in the window (row-major).
+    pub on: Vec<u32>,
+    /// OFF events per pixel in the window.
+    pub off: Vec<u32>,
+    /// Static, dynamic and combined: frame and pooled features.
+    pub panels: Vec<ReprPanel>,
+}
+
+/// One representation of [`ReprExample`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ReprPanel {
+    /// `Static`, `Dynamic` or `Combined`.
+    pub name: String,
+    /// The binary frame (0/1, `width x height`, row-major).
+    pub frame: Vec<u8>,
+    /// The pooled features (`width / 8 x height / 8`, row-major, each the fraction of set
+    /// pixels in its 8x8 cell).
+    pub features: Vec<f32>,
+}
+
+/// What the sensor figure's images are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SensorKind {
+    /// The simulator's camera brightness (gamma 0.5).
+    Simulated,
+    /// Event counts per pixel of recordings (log-scaled): a real dataset has no frames.
+    EventCounts,
+}
+
+/// The sensor figure's data (see [`crate::sensor_view`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorView {
+    /// What the images are.
+    pub kind: SensorKind,
+    /// The full sensor's size.
+    pub resolution: evtac_events::Resolution,
+    /// The images, in order (at rest first).
+    pub panels: Vec<SensorPanel>,
+}
+
+/// One image of [`SensorView`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct SensorPanel {
+    /// Panel title.
+    pub title: String,
+    /// Display intensity per pixel in 0..=1 (row-major, full sensor).
+    pub values: Vec<f32>,
+}
+
 /// Everything a reproduction measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Results {
@@ -302,6 +365,12 @@ pub struct Results {
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,
+    /// The paper's Fig. 2 for one Experiment 1 test sample; not written to JSON.
+    #[serde(skip)]
+    pub repr_example: Option<ReprExample>,
+    /// The sensor at rest and in contact; not written to JSON.
+    #[serde(skip)]
+    pub sensor: Option<SensorView>,
 }
 
 #[cfg(test)]

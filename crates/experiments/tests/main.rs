@@ -2,6 +2,7 @@
 
 mod cache;
 mod check;
+mod figures;
 mod import;
 mod inputs;
 mod resume;

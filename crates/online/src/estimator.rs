@@ -10,6 +10,15 @@
 //! representation's, see `FeatureExtractor::deferring_accumulation`) takes them. Nothing on
 //! this path allocates once the buffers have grown to the largest chunk seen.
 //!
+//! Two times come with every estimate. Its *latency* runs from the arrival of the chunk that
+//! made it final to the end of the forward pass, so it includes any wait in a queue before the
+//! estimator. Its *processing time* is the estimator's own work for it, and nothing else: every
+//! moment spent in [`Estimator::process`] (and [`Estimator::finish`]) is charged to the next
+//! estimate to come out, apart from handing estimates over (`emit`). That is the chunks'
+//! cropping and representation updates since the previous estimate, the work done ahead of it
+//! once the previous estimate was out, advancing to its time and the MLP. It is what a replay
+//! as fast as possible can report, where the reader runs ahead and queueing is not latency.
+//!
 //! The MLP runs as a [`StreamingPredictor`]: its first layer is updated from the pooled cells
 //! that changed since the previous estimate (a few dozen of 900 per millisecond), with the
 //! same results as a full forward pass. Reading the whole first layer (0.9 MB) for every
@@ -53,6 +62,10 @@ pub struct Estimate {
     /// From the arrival of the chunk that made `t_us` final to the end of the forward pass (see
     /// `docs/online.md`).
     pub latency: Duration,
+    /// The estimator's own work for this estimate: its time in [`Estimator::process`] since the
+    /// previous estimate was handed over, up to the end of the forward pass (see the module
+    /// docs). Never includes waiting.
+    pub processing: Duration,
 }
 
 /// Counters kept by the estimator.
@@ -81,6 +94,9 @@ pub struct Estimator {
     floor: i64,
     counters: Counters,
     stats: LatencyStats,
+    processing: LatencyStats,
+    /// Work done since the previous estimate was handed over, in calls that have returned.
+    carried: Duration,
 }
 
 impl std::fmt::Debug for Estimator {
@@ -132,6 +148,8 @@ impl Estimator {
             floor: i64::MIN,
             counters: Counters::default(),
             stats: LatencyStats::new(interval),
+            processing: LatencyStats::new(interval),
+            carried: Duration::ZERO,
         })
     }
 
@@ -152,6 +170,12 @@ impl Estimator {
         &self.stats
     }
 
+    /// Processing-time statistics so far (see [`Estimate::processing`]); *late* counts
+    /// estimates whose processing alone took longer than the interval.
+    pub fn processing_stats(&self) -> &LatencyStats {
+        &self.processing
+    }
+
     /// Event counters so far.
     pub fn counters(&self) -> Counters {
         self.counters
@@ -167,6 +191,7 @@ impl Estimator {
         arrival: Instant,
         emit: &mut impl FnMut(&Estimate),
     ) -> Result<(), Error> {
+        let mut started = Instant::now();
         // Cropped without a branch per event (whether an event falls in the crop is as good as
         // random to the branch predictor): every accepted event is written at `kept`, which
         // only moves on for those inside. The buffer keeps its largest length, so no chunk
@@ -212,13 +237,15 @@ impl Estimator {
         // may still follow in the next chunk.
         let proven = latest.map_or(i64::MIN, |t| t.saturating_sub(1));
         let horizon = horizon.map_or(proven, |h| h.max(proven));
-        self.estimate_until(horizon, arrival, emit)?;
+        self.estimate_until(horizon, arrival, &mut started, emit)?;
         if let Some(next) = self.schedule.next() {
             // Ahead of the next estimate, after this chunk's estimates are out: apply the
             // queued events that belong to it and let the windows drop what leaves them by
             // then (known now: the window reaches back past every event yet to come).
             self.extractor.prepare(next)?;
         }
+        // The rest of this call is work for the next estimate.
+        self.carried += started.elapsed();
         Ok(())
     }
 
@@ -228,23 +255,32 @@ impl Estimator {
         arrival: Instant,
         emit: &mut impl FnMut(&Estimate),
     ) -> Result<(), Error> {
+        let mut started = Instant::now();
         match self.counters.span_us {
-            Some((_, last)) => self.estimate_until(last, arrival, emit),
+            Some((_, last)) => self.estimate_until(last, arrival, &mut started, emit),
             None => Ok(()),
         }
     }
 
+    /// Makes every estimate due by `horizon`. `started` is when the estimator's current stretch
+    /// of work began: each estimate's processing time is the work carried over from earlier
+    /// calls plus the time since then, and the next stretch starts once it is handed over.
     fn estimate_until(
         &mut self,
         horizon: i64,
         arrival: Instant,
+        started: &mut Instant,
         emit: &mut impl FnMut(&Estimate),
     ) -> Result<(), Error> {
         while let Some(t) = self.schedule.pop_due(horizon) {
             self.extractor.advance_to(t)?;
             let [pitch_deg, roll_deg] = self.predictor.predict(self.extractor.features(0));
-            let latency = arrival.elapsed();
+            let done = Instant::now();
+            let latency = done.saturating_duration_since(arrival);
+            let processing =
+                std::mem::take(&mut self.carried) + done.saturating_duration_since(*started);
             self.stats.record(latency);
+            self.processing.record(processing);
             // Later events must not reach back before an estimate already made.
             self.floor = self.floor.max(t.saturating_add(1));
             emit(&Estimate {
@@ -252,7 +288,10 @@ impl Estimator {
                 pitch_deg,
                 roll_deg,
                 latency,
+                processing,
             });
+            // Handing the estimate over is not the estimator's work.
+            *started = Instant::now();
         }
         Ok(())
     }

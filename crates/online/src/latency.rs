@@ -1,5 +1,12 @@
-//! Latency accounting: an allocation-free histogram of per-estimate latencies, and the summary
-//! printed when a run ends.
+//! Latency accounting: an allocation-free histogram of per-estimate latencies (and of processing
+//! times), and the summary printed when a run ends.
+//!
+//! Latency is only what it says when the events come at their recorded or live pace. A
+//! recording replayed as fast as possible is read far ahead of the estimator, so its chunks
+//! wait in the queue and that wait counts into latency (a P99 of milliseconds where a
+//! `--realtime` replay of the same file shows about a hundred microseconds). Such a run's
+//! summary ([`Summary::paced`] false) leads with the processing time per estimate instead, and
+//! says that latency needs a paced replay.
 
 use hdrhistogram::Histogram;
 use std::time::Duration;
@@ -88,6 +95,16 @@ pub struct Summary {
     pub max: Duration,
     /// Estimates whose latency exceeded the interval.
     pub late: u64,
+    /// Median processing time per estimate (the estimator's own work, no waiting: see
+    /// `Estimate::processing`).
+    pub processing_median: Duration,
+    /// 99th-percentile processing time.
+    pub processing_p99: Duration,
+    /// Largest processing time.
+    pub processing_max: Duration,
+    /// Whether the events came at their recorded or live pace, so that latency means what it
+    /// would live (set by the caller, who knows the source; `true` unless told otherwise).
+    pub paced: bool,
     /// The interval between estimates.
     pub interval: Duration,
     /// Events received from the source (on the whole sensor).
@@ -108,14 +125,19 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// Fills the latency fields from `stats`; counters start at zero.
-    pub fn from_stats(stats: &LatencyStats) -> Self {
+    /// Fills the latency fields from `stats` and the processing-time fields from `processing`;
+    /// counters start at zero, and the run counts as paced.
+    pub fn from_stats(stats: &LatencyStats, processing: &LatencyStats) -> Self {
         Self {
             estimates: stats.count(),
             median: stats.quantile(0.5),
             p99: stats.quantile(0.99),
             max: stats.max(),
             late: stats.late(),
+            processing_median: processing.quantile(0.5),
+            processing_p99: processing.quantile(0.99),
+            processing_max: processing.max(),
+            paced: true,
             interval: stats.interval,
             events: 0,
             events_in_roi: 0,
@@ -137,18 +159,35 @@ impl std::fmt::Display for Summary {
             self.estimates,
             us(self.interval)
         )?;
-        writeln!(
-            f,
-            "latency: median {:.1} us, P99 {:.1} us, max {:.1} us",
-            us(self.median),
-            us(self.p99),
-            us(self.max)
-        )?;
-        writeln!(
-            f,
-            "late (latency > interval): {} of {}",
-            self.late, self.estimates
-        )?;
+        let processing = format!(
+            "processing time per estimate: median {:.1} us, P99 {:.1} us, max {:.1} us",
+            us(self.processing_median),
+            us(self.processing_p99),
+            us(self.processing_max)
+        );
+        if self.paced {
+            writeln!(
+                f,
+                "latency: median {:.1} us, P99 {:.1} us, max {:.1} us",
+                us(self.median),
+                us(self.p99),
+                us(self.max)
+            )?;
+            writeln!(
+                f,
+                "late (latency > interval): {} of {}",
+                self.late, self.estimates
+            )?;
+            writeln!(f, "{processing}")?;
+        } else {
+            writeln!(f, "{processing}")?;
+            writeln!(
+                f,
+                "latency: not measured: the recording was replayed as fast as possible, so its \
+                 events waited in the queue behind a reader running ahead, and that wait is not \
+                 latency; end-to-end latency needs a replay at recorded pace (--realtime)"
+            )?;
+        }
         writeln!(
             f,
             "events: {} received, {} in the region of interest, {} dropped, {} out of order",
@@ -195,19 +234,42 @@ mod tests {
     fn summary_prints_every_figure() {
         let mut s = LatencyStats::new(Duration::from_millis(1));
         s.record(Duration::from_micros(40));
-        let mut summary = Summary::from_stats(&s);
+        let mut p = LatencyStats::new(Duration::from_millis(1));
+        p.record(Duration::from_micros(12));
+        let mut summary = Summary::from_stats(&s, &p);
         summary.events = 10;
         summary.events_dropped = 0;
         let text = summary.to_string();
         for needle in [
             "estimates: 1",
-            "median 40",
+            "latency: median 40",
             "P99 40",
             "late",
+            "processing time per estimate: median 12",
             "10 received",
             "0 dropped",
         ] {
             assert!(text.contains(needle), "{needle:?} missing from:\n{text}");
         }
+    }
+
+    #[test]
+    fn an_unpaced_summary_leads_with_processing_time_and_names_no_latency() {
+        let mut s = LatencyStats::new(Duration::from_millis(1));
+        s.record(Duration::from_micros(6500));
+        let mut p = LatencyStats::new(Duration::from_millis(1));
+        p.record(Duration::from_micros(30));
+        let mut summary = Summary::from_stats(&s, &p);
+        summary.paced = false;
+        let text = summary.to_string();
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(
+            lines[1].starts_with("processing time per estimate: median 30"),
+            "{text}"
+        );
+        assert!(lines[2].contains("--realtime"), "{text}");
+        // The queueing-inflated figure is not printed as latency.
+        assert!(!text.contains("6500"), "{text}");
+        assert!(!text.contains("late (latency"), "{text}");
     }
 }

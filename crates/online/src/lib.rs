@@ -3,18 +3,22 @@
 //! A robot needs the contact angle while it moves. This crate runs a trained model (an
 //! [`evtac_learn::Model`]: weights, representation settings, no-contact mask) on an event
 //! stream and emits `(pitch, roll)` at a fixed interval of event time, stamping each estimate
-//! with its processing latency.
+//! with its latency and its processing time.
 //!
 //! - [`input`]: where events come from: a recording replayed as fast as possible or at
 //!   recorded pace ([`input::Paced`]), a live DV network stream with reconnection and backoff,
 //!   standard input, or memory.
-//! - [`Estimator`]: the single-threaded core (crop, representation, MLP, latency stamp).
+//! - [`Estimator`]: the single-threaded core (crop, representation, MLP, latency and
+//!   processing-time stamps).
 //! - [`pipeline::run`]: ingestion and estimation on two threads with a bounded queue between.
-//! - [`Summary`]: estimates, median/P99/max latency, late estimates, dropped events.
+//! - [`Summary`]: estimates, median/P99/max latency and processing time, late estimates,
+//!   dropped events.
 //!
 //! The exact definition of latency is in `docs/online.md`; in short, it runs from the moment the
 //! ingestion thread received the chunk that made an estimate's time final to the end of that
-//! estimate's forward pass.
+//! estimate's forward pass. The processing time is the estimator's own work for an estimate,
+//! without any wait: what a replay as fast as possible can report, its latency being mostly
+//! queueing behind a reader that runs ahead.
 //!
 //! ```no_run
 //! use evtac_online::input::{self, OpenOptions, SourceSpec};

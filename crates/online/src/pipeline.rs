@@ -235,7 +235,7 @@ pub fn run_until<S: EventSource + 'static>(
     };
     let counters = estimator.counters();
     let dropped = ingested.dropped.load(Ordering::Relaxed);
-    let mut summary = Summary::from_stats(estimator.stats());
+    let mut summary = Summary::from_stats(estimator.stats(), estimator.processing_stats());
     summary.events = counters.events + dropped;
     summary.events_in_roi = counters.events_in_roi;
     summary.events_dropped = dropped;

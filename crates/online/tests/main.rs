@@ -2,5 +2,6 @@
 
 mod live;
 mod pipeline;
+mod processing;
 mod replay;
 mod support;

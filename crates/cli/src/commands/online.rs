@@ -1,12 +1,16 @@
 //! `evtac online`: a trained model on a live or replayed event stream, one estimate per
 //! interval of event time, with latency figures.
+//!
+//! A recording replayed as fast as possible is read far ahead of the estimator, so its latency
+//! would be mostly time spent queueing; its summary reports the processing time per estimate
+//! instead and says that latency needs `--realtime`.
 
 use anyhow::Context;
 use evtac_events::Resolution;
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
-use evtac_online::{Backoff, Estimator};
+use evtac_online::{Backoff, Estimator, Summary};
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -103,6 +107,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let interval_us = interval_us as i64;
     let spec: SourceSpec = args.input.parse()?;
+    // A file without --realtime is the one source that runs ahead of the estimator; live
+    // streams (network, standard input) come at their own pace.
+    let paced = args.realtime || !matches!(spec, SourceSpec::File(_));
     let model = Model::load(&args.model)?;
     let options = OpenOptions {
         realtime: args.realtime,
@@ -179,14 +186,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     let flushed = out.flush();
     drop(out);
+    let with_pace = |mut summary: Summary| {
+        summary.paced = paced;
+        summary
+    };
     let summary = match result {
-        Ok(summary) => summary,
+        Ok(summary) => with_pace(summary),
         Err(pipeline::Error::Input { source, summary }) => {
-            eprintln!("{summary}");
+            eprintln!("{}", with_pace(*summary));
             return Err(source).with_context(|| format!("reading {spec}"));
         }
         Err(pipeline::Error::Estimator { source, summary }) => {
-            eprintln!("{summary}");
+            eprintln!("{}", with_pace(*summary));
             return Err(source).context("estimating");
         }
         Err(e) => return Err(e.into()),
