@@ -8,6 +8,8 @@
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
 //! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
 //!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]).
+//! - [`sensor_stats`]: what a recording says about its sensor (noise at rest, hot pixels, the
+//!   IMU's noise and bias), as simulator parameters (`evtac stats`).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -58,6 +60,7 @@ pub mod report;
 pub mod results;
 pub mod robot_log;
 pub mod sampling;
+pub mod sensor_stats;
 pub mod slurm;
 pub mod splits;
 pub mod stage;
