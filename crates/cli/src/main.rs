@@ -40,7 +40,8 @@ enum Command {
     /// Measure a recording's sensor noise at rest (background, hot pixels, IMU noise and bias),
     /// optionally as simulator parameters for `evtac simulate --params`.
     Stats(commands::stats::Args),
-    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log).
+    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log,
+    /// or without a log, per motion found in the gyroscope).
     Import(commands::import::Args),
     /// Validate a dataset before training: manifest, files, time spans, IMU rate, calibration,
     /// no-contact recording, Experiment 3 groups (exit status 1 when anything is wrong).

@@ -91,7 +91,8 @@ fn imports_a_session_and_refuses_bad_logs() {
 }
 
 /// `evtac simulate --session` writes what `evtac import --sync trigger` and `--sync imu` read,
-/// without an offset (giving one too is refused), and the imported dataset reproduces.
+/// without an offset (giving one too is refused), and what an import without the log cuts by
+/// the gyroscope; the imported dataset reproduces.
 #[test]
 fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
     let dir = tempfile::tempdir().unwrap();
@@ -147,6 +148,38 @@ fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
     let err = String::from_utf8(run_ok(&imu_args).stderr).unwrap();
     assert!(err.contains("clock offset from the IMU: "), "{err}");
     run_ok(&["check", by_imu.to_str().unwrap()]);
+    // No log at all: the motions are found in the gyroscope and listed for review.
+    let log_free = dir.path().join("log-free");
+    let mut free_args = vec![
+        "import",
+        file.to_str().unwrap(),
+        "--out",
+        log_free.to_str().unwrap(),
+        "--no-contact",
+        no_contact.to_str().unwrap(),
+        "--calibration",
+        calibration.to_str().unwrap(),
+    ];
+    let o = evtac().args(&free_args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--depth-mm is needed"),
+        "{err}"
+    );
+    free_args.extend(["--depth-mm", "1.5"]);
+    let stdout = String::from_utf8(run_ok(&free_args).stdout).unwrap();
+    assert!(
+        stdout.starts_with("16 motions found in the gyroscope of "),
+        "{stdout}"
+    );
+    assert!(stdout.contains("imported 16 trials ("), "{stdout}");
+    let review = std::fs::read_to_string(log_free.join("motions.csv")).unwrap();
+    assert_eq!(review.lines().count(), 17, "{review}");
+    assert!(
+        review.lines().nth(1).unwrap().starts_with("m0000,"),
+        "{review}"
+    );
+    run_ok(&["check", log_free.to_str().unwrap()]);
     // The imported Experiment 1 dataset goes through the whole protocol (the end-to-end
     // path: simulate a session, import, check, label, reproduce).
     let report = dir.path().join("out");

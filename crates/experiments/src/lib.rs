@@ -52,6 +52,7 @@ pub mod inputs;
 pub mod io;
 pub mod jobs;
 pub mod latency;
+pub mod motions;
 pub mod noise;
 pub mod pipeline;
 pub mod plan;

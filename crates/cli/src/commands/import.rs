@@ -1,6 +1,7 @@
-//! `evtac import`: a recording session and the robot's log of its motions in, a dataset folder
-//! out (one AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when
-//! given), written into a temporary folder and renamed at the end. The work is
+//! `evtac import`: a recording session and the robot's log of its motions in (or without a log,
+//! the motions found in its gyroscope: `evtac_experiments::motions`), a dataset folder out (one
+//! AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when given),
+//! written into a temporary folder and renamed at the end. The work is
 //! `evtac_experiments::import`'s.
 
 use anyhow::Context;
@@ -9,7 +10,9 @@ use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_experiments::import::{
     DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, import_session,
 };
+use evtac_experiments::imu_sync::read_imu;
 use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
+use evtac_experiments::motions;
 use evtac_experiments::robot_log::RobotLog;
 use evtac_experiments::sync::{Sync, synchronise};
 use std::path::PathBuf;
@@ -33,9 +36,39 @@ pub struct Args {
     pub session: PathBuf,
     /// The robot's log: a CSV with the manifest's columns except file and truth, one row per
     /// motion (trial, direction_deg, speed_deg_s, depth_mm, total_deg, motion_start_us,
-    /// motion_end_us; optionally stop_start_us, stop_end_us, stop_deg, group).
+    /// motion_end_us; optionally stop_start_us, stop_end_us, stop_deg, group). Without it the
+    /// motions are found in the gyroscope (needs --calibration and --depth-mm) and listed for
+    /// review in DIR/motions.csv.
     #[arg(long, value_name = "LOG.csv")]
-    pub log: PathBuf,
+    pub log: Option<PathBuf>,
+    /// Without --log: the indentation depth written for every motion, mm (the gyroscope cannot
+    /// see it).
+    #[arg(long, value_name = "MM", conflicts_with = "log")]
+    pub depth_mm: Option<f64>,
+    /// Without --log: directions are rounded to multiples of this, degrees (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG",
+        conflicts_with = "log"
+    )]
+    pub direction_step_deg: f64,
+    /// Without --log: speeds are rounded to multiples of this, deg/s (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG_S",
+        conflicts_with = "log"
+    )]
+    pub speed_step_deg_s: f64,
+    /// Without --log: total tilts are rounded to multiples of this, degrees (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG",
+        conflicts_with = "log"
+    )]
+    pub total_step_deg: f64,
     /// The dataset folder to write (must not exist).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -75,6 +108,57 @@ pub struct Args {
     pub calibration: Option<PathBuf>,
 }
 
+/// Where a log-free import lists what it found, in the dataset folder.
+const REVIEW_FILE: &str = "motions.csv";
+
+/// The motions in the session's gyroscope, printed as a table.
+fn found_motions(args: &Args) -> anyhow::Result<Vec<motions::FoundMotion>> {
+    let calibration_path = args.calibration.as_ref().context(
+        "without --log, --calibration is needed: the tilt's direction is read in the sensor frame",
+    )?;
+    let depth_mm = args.depth_mm.context(
+        "without --log, --depth-mm is needed: the gyroscope cannot see the indentation depth",
+    )?;
+    let calibration = evtac_labels::read_calibration_file(calibration_path)?;
+    let imu = read_imu(&args.session)?;
+    let config = motions::FindConfig {
+        direction_step_deg: args.direction_step_deg,
+        speed_step_deg_s: args.speed_step_deg_s,
+        total_step_deg: args.total_step_deg,
+        ..motions::FindConfig::new(depth_mm)
+    };
+    let found = motions::find_motions(&imu, &calibration, &config);
+    anyhow::ensure!(
+        !found.is_empty(),
+        "{}: no motion found in its {} IMU samples (a tilt of at least {} deg/s for {} ms, \
+         with gravity turning)",
+        args.session.display(),
+        imu.len(),
+        config.threshold_deg_s,
+        config.min_motion_us / 1000
+    );
+    println!(
+        "{} motions found in the gyroscope of {}:",
+        found.len(),
+        args.session.display()
+    );
+    println!("trial  onset_us              duration_s  direction  speed  total  review");
+    for m in &found {
+        let t = &m.meta;
+        println!(
+            "{}  {:<20}  {:>10.3}  {:>9}  {:>5}  {:>5}  {}",
+            t.trial,
+            t.motion_start_us,
+            (t.motion_end_us - t.motion_start_us) as f64 * 1e-6,
+            t.direction_deg,
+            t.speed_deg_s,
+            t.total_deg,
+            motions::review_note(m)
+        );
+    }
+    Ok(found)
+}
+
 fn parse_range(s: &str) -> Result<(i64, i64), String> {
     let bad = || format!("`{s}` is not a range A..B of microseconds with A < B");
     let (a, b) = s.split_once("..").ok_or_else(bad)?;
@@ -96,7 +180,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         SyncMode::Trigger => Sync::Trigger(args.trigger_kind),
         SyncMode::Imu => Sync::Imu,
     };
-    let synced = synchronise(&args.session, RobotLog::read(&args.log, 0)?, sync)?;
+    let (log, found) = match &args.log {
+        Some(path) => (RobotLog::read(path, 0)?, None),
+        None => {
+            anyhow::ensure!(
+                args.sync == SyncMode::Offset && args.clock_offset_us == 0,
+                "--sync and --clock-offset-us put a log on the recording's clock: without --log \
+                 the motions are found on it"
+            );
+            let found = found_motions(&args)?;
+            (motions::as_log(&args.session, &found), Some(found))
+        }
+    };
+    let synced = synchronise(&args.session, log, sync)?;
     if let (SyncMode::Trigger, Some([lo, median, hi])) = (args.sync, synced.offset_range()) {
         eprintln!(
             "clock offsets from the triggers: median {median} us, {lo} .. {hi} us over {} rows",
@@ -143,6 +239,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         args.session.display(),
         summary.out.display()
     );
+    if let Some(found) = &found {
+        let review = summary.out.join(REVIEW_FILE);
+        std::fs::write(&review, motions::review_csv(found))
+            .with_context(|| review.display().to_string())?;
+        println!("the motions as found, for review: {}", review.display());
+    }
     if config.calibration.is_none() {
         println!(
             "no calibration given: add {}, or pass --{IDENTITY_CALIBRATION_FLAG} to the commands \
