@@ -230,8 +230,8 @@ impl Dataset {
         self.dir.join(LABELS_DIR).join(format!("{trial}.key.json"))
     }
 
-    /// A short name for [`Self::labels_key`] (the first 12 hex digits of its SHA-256), for
-    /// caches that hold labels.
+    /// A short name for what labels depend on (the first 12 hex digits of the SHA-256 of the
+    /// calibration and the label settings), for caches that hold labels.
     pub fn labels_id(&self) -> String {
         let digest = Sha256::digest(self.labels_key().as_bytes());
         digest[..6].iter().map(|b| format!("{b:02x}")).collect()

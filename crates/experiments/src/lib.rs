@@ -7,7 +7,9 @@
 //!   calibration and mask come from its files or were opted out of.
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`).
 //! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
-//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]).
+//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]), or by the motions found
+//!   in its gyroscope ([`motions`]); several sessions, or a folder of per-trial files
+//!   ([`trial_folder`]), into one dataset.
 //! - [`sensor_stats`]: what a recording says about its sensor (noise at rest, hot pixels, the
 //!   IMU's noise and bias), as simulator parameters (`evtac stats`).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
@@ -67,4 +69,5 @@ pub mod splits;
 pub mod stage;
 pub mod sync;
 pub mod training;
+pub mod trial_folder;
 pub mod tuning;

@@ -312,11 +312,17 @@ pub fn find_motions(
             None => k = past(imu[k].t, k),
         }
     }
+    number_from(&mut found, 0);
+    found
+}
+
+/// Names the motions `m<first>`, `m<first + 1>`, ... (four digits at least): one session's of
+/// several numbered on from the sessions before.
+pub fn number_from(found: &mut [FoundMotion], first: usize) {
     for (i, m) in found.iter_mut().enumerate() {
-        m.meta.trial = format!("m{i:04}");
+        m.meta.trial = format!("m{:04}", first + i);
         m.meta.file = trial_file(&m.meta.trial).into();
     }
-    found
 }
 
 /// The mean rate less `bias` over the first [`FindConfig::min_motion_us`] after the rate left
@@ -454,18 +460,35 @@ pub fn as_log(session: &Path, found: &[FoundMotion]) -> RobotLog {
     }
 }
 
-/// The review file `motions.csv`: each motion's row as written, beside what the gyroscope and
-/// accelerometer measured before rounding, and a note where a value wants a look.
-pub fn review_csv(found: &[FoundMotion]) -> String {
+/// Names the motions found in one file of a folder of trials after it: the file's stem for its
+/// only motion, `<stem>-m0000`, `<stem>-m0001`, ... for more.
+pub fn name_after(found: &mut [FoundMotion], stem: &str) {
+    let only = found.len() == 1;
+    for (i, m) in found.iter_mut().enumerate() {
+        m.meta.trial = if only {
+            stem.to_string()
+        } else {
+            format!("{stem}-m{i:04}")
+        };
+        m.meta.file = trial_file(&m.meta.trial).into();
+    }
+}
+
+/// The review file `motions.csv`: each motion's row as written and the recording it was found
+/// in, beside what the gyroscope and accelerometer measured before rounding, and a note where a
+/// value wants a look.
+pub fn review_csv(found: &[(PathBuf, FoundMotion)]) -> String {
     let mut out = String::from(
-        "trial,motion_start_us,motion_end_us,direction_deg,direction_gyro_deg,speed_deg_s,\
-         speed_gyro_deg_s,total_deg,total_gyro_deg,total_gravity_deg,off_axis,pauses,review\n",
+        "trial,session,motion_start_us,motion_end_us,direction_deg,direction_gyro_deg,\
+         speed_deg_s,speed_gyro_deg_s,total_deg,total_gyro_deg,total_gravity_deg,off_axis,\
+         pauses,review\n",
     );
-    for m in found {
+    for (session, m) in found {
         let t = &m.meta;
         out += &format!(
-            "{},{},{},{},{:.3},{},{:.3},{},{:.3},{:.3},{:.3},{},{}\n",
+            "{},{},{},{},{},{:.3},{},{:.3},{},{:.3},{:.3},{:.3},{},{}\n",
             t.trial,
+            session.display(),
             t.motion_start_us,
             t.motion_end_us,
             t.direction_deg,
