@@ -37,7 +37,11 @@ enum Command {
     /// Simulate NeuroTac trials of one of the paper's experiments (with evtac's sensor model and
     /// timing) into a dataset folder.
     Simulate(commands::simulate::Args),
-    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log).
+    /// Measure a recording's sensor noise at rest (background, hot pixels, IMU noise and bias),
+    /// optionally as simulator parameters for `evtac simulate --params`.
+    Stats(commands::stats::Args),
+    /// Cut a recording session into a dataset folder (one AEDAT4 per motion of the robot's log,
+    /// or without a log, per motion found in the gyroscope).
     Import(commands::import::Args),
     /// Validate a dataset before training: manifest, files, time spans, IMU rate, calibration,
     /// no-contact recording, Experiment 3 groups (exit status 1 when anything is wrong).
@@ -68,6 +72,7 @@ fn main() {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
+        Command::Stats(args) => commands::stats::run(args),
         Command::Import(args) => commands::import::run(args),
         Command::Check(args) => commands::check::run(args),
         Command::Labels(args) => commands::labels::run(args),

@@ -23,9 +23,25 @@ pub fn run_ok(args: &[&str]) -> Output {
 
 /// Simulates the first `limit` trials of `protocol` at the tiny scale with `seed` into `out`.
 pub fn simulate_tiny(protocol: &str, seed: u64, out: &std::path::Path, limit: usize) {
-    let (seed, limit) = (seed.to_string(), limit.to_string());
+    simulate(protocol, seed, out, Some(limit), false);
+}
+
+/// Simulates a session of the first `limit` trials (all without) of `protocol` at the tiny
+/// scale with `seed` into `out`.
+pub fn simulate_session_tiny(
+    protocol: &str,
+    seed: u64,
+    out: &std::path::Path,
+    limit: Option<usize>,
+) {
+    simulate(protocol, seed, out, limit, true);
+}
+
+fn simulate(protocol: &str, seed: u64, out: &std::path::Path, limit: Option<usize>, session: bool) {
+    let seed = seed.to_string();
+    let limit = limit.map(|l| l.to_string());
     let out = out.to_str().expect("utf-8 path");
-    run_ok(&[
+    let mut args = vec![
         "simulate",
         "--protocol",
         protocol,
@@ -35,7 +51,12 @@ pub fn simulate_tiny(protocol: &str, seed: u64, out: &std::path::Path, limit: us
         &seed,
         "--out",
         out,
-        "--limit",
-        &limit,
-    ]);
+    ];
+    if let Some(limit) = &limit {
+        args.extend(["--limit", limit]);
+    }
+    if session {
+        args.push("--session");
+    }
+    run_ok(&args);
 }

@@ -2,7 +2,7 @@
 //! passes, bad logs failing with the log's line and column, writing nothing, and a simulated
 //! session imported by each sync mode and reproduced.
 
-use crate::common::{evtac, run_ok, simulate_tiny};
+use crate::common::{evtac, run_ok, simulate_session_tiny, simulate_tiny};
 use evtac_events::manifest::Manifest;
 use evtac_events::read_recording;
 
@@ -91,24 +91,13 @@ fn imports_a_session_and_refuses_bad_logs() {
 }
 
 /// `evtac simulate --session` writes what `evtac import --sync trigger` and `--sync imu` read,
-/// without an offset (giving one too is refused), and the imported dataset reproduces.
+/// without an offset (giving one too is refused), and what an import without the log cuts by
+/// the gyroscope; the imported dataset reproduces.
 #[test]
 fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
     let dir = tempfile::tempdir().unwrap();
     let session = dir.path().join("session");
-    let s = session.to_str().unwrap();
-    run_ok(&[
-        "simulate",
-        "--session",
-        "--protocol",
-        "exp1",
-        "--scale",
-        "tiny",
-        "--seed",
-        "4",
-        "--out",
-        s,
-    ]);
+    simulate_session_tiny("exp1", 4, &session, None);
     let data = dir.path().join("data");
     let out = data.join("exp1");
     let (file, log, no_contact, calibration) = (
@@ -147,6 +136,38 @@ fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
     let err = String::from_utf8(run_ok(&imu_args).stderr).unwrap();
     assert!(err.contains("clock offset from the IMU: "), "{err}");
     run_ok(&["check", by_imu.to_str().unwrap()]);
+    // No log at all: the motions are found in the gyroscope and listed for review.
+    let log_free = dir.path().join("log-free");
+    let mut free_args = vec![
+        "import",
+        file.to_str().unwrap(),
+        "--out",
+        log_free.to_str().unwrap(),
+        "--no-contact",
+        no_contact.to_str().unwrap(),
+        "--calibration",
+        calibration.to_str().unwrap(),
+    ];
+    let o = evtac().args(&free_args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--depth-mm is needed"),
+        "{err}"
+    );
+    free_args.extend(["--depth-mm", "1.5"]);
+    let stdout = String::from_utf8(run_ok(&free_args).stdout).unwrap();
+    assert!(
+        stdout.starts_with("16 motions found in the gyroscope of "),
+        "{stdout}"
+    );
+    assert!(stdout.contains("imported 16 trials ("), "{stdout}");
+    let review = std::fs::read_to_string(log_free.join("motions.csv")).unwrap();
+    assert_eq!(review.lines().count(), 17, "{review}");
+    assert!(
+        review.lines().nth(1).unwrap().starts_with("m0000,"),
+        "{review}"
+    );
+    run_ok(&["check", log_free.to_str().unwrap()]);
     // The imported Experiment 1 dataset goes through the whole protocol (the end-to-end
     // path: simulate a session, import, check, label, reproduce).
     let report = dir.path().join("out");
@@ -179,4 +200,142 @@ fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
         err.contains("--clock-offset-us is for --sync offset"),
         "{err}"
     );
+}
+
+/// Several sessions into one dataset (each with its log, or their motions found in the
+/// gyroscope), and a folder of per-trial files (cut by a log on each file's clock, or each
+/// file's motion found).
+#[test]
+fn several_sessions_and_a_folder_of_trials_import_into_one_dataset() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    for (name, seed) in [("a", 1), ("b", 2)] {
+        simulate_session_tiny("exp1", seed, &dir.path().join(name), Some(2));
+    }
+    let (a, b) = (p("a/session.aedat4"), p("b/session.aedat4"));
+    let calibration = p("a/calibration.json");
+    // Both sessions name their trials t0000, t0001: refused, naming both logs' lines.
+    let (log_a, log_b) = (p("a/robot_log.csv"), p("b/robot_log.csv"));
+    let out = p("both");
+    let mut args = vec![
+        "import",
+        &a,
+        &b,
+        "--log",
+        &log_a,
+        "--log",
+        &log_b,
+        "--sync",
+        "trigger",
+        "--out",
+        &out,
+        "--calibration",
+        &calibration,
+    ];
+    let o = evtac().args(&args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("robot_log.csv:2: column `trial`: `t0000` is also "),
+        "{err}"
+    );
+    let renamed = p("b/renamed.csv");
+    let text = std::fs::read_to_string(&log_b).unwrap();
+    std::fs::write(&renamed, text.replace("\nt00", "\nu00")).unwrap();
+    args[6] = &renamed;
+    run_ok(&args);
+    let names: Vec<String> = Manifest::read(dir.path().join("both"))
+        .unwrap()
+        .trials
+        .into_iter()
+        .map(|t| t.trial)
+        .collect();
+    assert_eq!(names, ["t0000", "t0001", "u0000", "u0001"]);
+    run_ok(&["check", &out, "--no-mask"]);
+    // One log for two sessions is ambiguous.
+    let o = evtac()
+        .args(["import", &a, &b, "--log", &log_a, "--out", &p("one-log")])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&o.stderr).contains("2 sessions and 1 logs"));
+
+    // Without logs: the motions of both, numbered on.
+    let free = p("free");
+    let stdout = String::from_utf8(
+        run_ok(&[
+            "import",
+            &a,
+            &b,
+            "--out",
+            &free,
+            "--calibration",
+            &calibration,
+            "--depth-mm",
+            "2",
+        ])
+        .stdout,
+    )
+    .unwrap();
+    assert!(stdout.contains("imported 4 trials ("), "{stdout}");
+    let review = std::fs::read_to_string(dir.path().join("free/motions.csv")).unwrap();
+    let rows: Vec<&str> = review.lines().skip(1).collect();
+    assert!(
+        rows[2].starts_with("m0002,") && rows[2].contains("b/session.aedat4"),
+        "{review}"
+    );
+
+    // A folder of per-trial files (a simulated dataset): by a log on each file's clock, the
+    // trials come out as they went in; without a log, each file's motion is found and named
+    // after it, and the no-contact recording is passed over.
+    let trials = dir.path().join("trials");
+    simulate_tiny("exp1", 5, &trials, 2);
+    let manifest = Manifest::read(&trials).unwrap();
+    let log = p("trials.csv");
+    std::fs::write(&log, manifest.to_log_csv().unwrap()).unwrap();
+    let (folder, by_log, cal) = (p("trials"), p("by-log"), p("trials/calibration.json"));
+    run_ok(&[
+        "import",
+        &folder,
+        "--log",
+        &log,
+        "--out",
+        &by_log,
+        "--calibration",
+        &cal,
+    ]);
+    for t in &manifest.trials {
+        let (x, y) = (
+            read_recording(trials.join(&t.file)).unwrap(),
+            read_recording(dir.path().join("by-log").join(&t.file)).unwrap(),
+        );
+        assert!(
+            x.events == y.events && x.imu == y.imu,
+            "{} changed",
+            t.trial
+        );
+    }
+    let found = p("found");
+    let stdout = String::from_utf8(
+        run_ok(&[
+            "import",
+            &folder,
+            "--out",
+            &found,
+            "--calibration",
+            &cal,
+            "--depth-mm",
+            "2",
+        ])
+        .stdout,
+    )
+    .unwrap();
+    assert!(stdout.contains("no_contact.aedat4: no motion in its gyroscope, passed over"));
+    let imported = Manifest::read(dir.path().join("found")).unwrap().trials;
+    let names: Vec<&str> = imported.iter().map(|t| t.trial.as_str()).collect();
+    assert_eq!(names, ["t0000", "t0001"]);
+    for (i, t) in imported.iter().zip(&manifest.trials) {
+        assert!(
+            (i.motion_start_us - t.motion_start_us).abs() <= 20_000,
+            "{i:?}"
+        );
+    }
 }

@@ -15,5 +15,6 @@ mod represent;
 mod reproduce;
 mod simulate;
 mod slurm;
+mod stats;
 mod train;
 mod tune;

@@ -5,7 +5,8 @@
 //! Layout (one folder per sampling scheme, one per config and mask inside it):
 //!
 //! ```text
-//! cache/m50-s0/samples/<trial>.csv                 t_us,phase,pitch_deg,roll_deg (labels at samples)
+//! cache/m50-s0/samples-<labels id>/<trial>.csv     t_us,phase,pitch_deg,roll_deg (labels at samples,
+//!                                                  per calibration and label settings)
 //! cache/m50-s0/<cache_key>-<mask id>/config.json   the config and mask identity (for people)
 //! cache/m50-s0/<cache_key>-<mask id>/<trial>.npy   N x 900 float32, one row per sample
 //! ```
@@ -176,9 +177,12 @@ impl<'a> FeatureCache<'a> {
         )))
     }
 
+    /// The labels at `trial`'s samples: keyed by what the labels were computed with (the
+    /// calibration and label settings, [`Dataset::labels_id`]), so that opening the dataset
+    /// with another calibration never reuses them.
     fn samples_path(&self, trial: &str, sampling: Sampling) -> PathBuf {
         self.sampling_dir(sampling)
-            .join("samples")
+            .join(format!("samples-{}", self.ds.labels_id()))
             .join(format!("{trial}.csv"))
     }
 

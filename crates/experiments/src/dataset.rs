@@ -225,23 +225,53 @@ impl Dataset {
         self.dir.join(LABELS_DIR).join(format!("{trial}.csv"))
     }
 
-    /// The labels of `meta`: `labels/<trial>.csv`, computed from the trial's IMU (and written)
-    /// when missing.
+    /// The file beside `labels/<trial>.csv` that says what the labels were computed with.
+    pub fn labels_key_path(&self, trial: &str) -> PathBuf {
+        self.dir.join(LABELS_DIR).join(format!("{trial}.key.json"))
+    }
+
+    /// A short name for what labels depend on (the first 12 hex digits of the SHA-256 of the
+    /// calibration and the label settings), for caches that hold labels.
+    pub fn labels_id(&self) -> String {
+        let digest = Sha256::digest(self.labels_key().as_bytes());
+        digest[..6].iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    /// What labels depend on besides the trial: the calibration this dataset was opened with
+    /// (the file's, or the identity when opted out) and the label settings.
+    fn labels_key(&self) -> String {
+        serde_json::json!({
+            "calibration": self.calibration,
+            "config": LabelConfig::default(),
+        })
+        .to_string()
+    }
+
+    /// The labels of `meta`: `labels/<trial>.csv` when `labels/<trial>.key.json` says it was
+    /// computed with this calibration and these settings; otherwise computed from the trial's
+    /// IMU and written, with its key (labels from another calibration, or from `evtac labels`
+    /// without a key, are never taken for these).
     pub fn labels(&self, meta: &TrialMeta) -> Result<LabelSeries, Error> {
         let path = self.labels_path(&meta.trial);
+        let key_path = self.labels_key_path(&meta.trial);
+        let key = self.labels_key();
         let lab = |message: String| Error::Labels {
             trial: meta.trial.clone(),
             message,
         };
-        if !path.is_file() {
+        let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key) && path.is_file();
+        if !cached {
             let labels = self.compute_labels(meta)?;
-            let tmp = crate::jobs::tmp_path(&path);
             std::fs::create_dir_all(self.dir.join(LABELS_DIR)).map_err(io_err(&path))?;
+            // The labels first, then their key: a crash between the two leaves labels without
+            // their key, which are computed again.
+            let tmp = crate::jobs::tmp_path(&path);
             labels
                 .labels
                 .write_csv(&tmp)
                 .map_err(|e| lab(e.to_string()))?;
             std::fs::rename(&tmp, &path).map_err(io_err(&path))?;
+            crate::jobs::write_atomic(&key_path, key.as_bytes()).map_err(io_err(&key_path))?;
             return Ok(labels.labels);
         }
         LabelSeries::read_csv(&path).map_err(|e| lab(e.to_string()))

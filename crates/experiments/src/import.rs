@@ -4,6 +4,8 @@
 //! when that is later, so that the labels' stationary segment never holds another motion) to
 //! [`ImportConfig::post_us`] after its end (inclusive), on the session's clock; the manifest; the
 //! no-contact recording (a file, or a time range of the session) and the calibration when given.
+//! Several recordings, each with its own log ([`Part`]: sessions of one protocol, or a folder
+//! of per-trial files), make one dataset with [`import_parts`].
 //!
 //! Each trial is cut with a time-range read, through the AEDAT4 data table when the session has
 //! one (only the packets in the range are decoded), and streamed chunk by chunk, so memory stays
@@ -17,7 +19,7 @@ use crate::inputs::{Inputs, MaskSource};
 use crate::io::IoError;
 use crate::robot_log::RobotLog;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
-use evtac_events::manifest::Manifest;
+use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{EventWriter, RangeIndex};
 use evtac_labels::CalibrationSource;
 use std::path::{Path, PathBuf};
@@ -90,6 +92,15 @@ pub struct ImportSummary {
     pub index: Option<RangeIndex>,
 }
 
+/// One recording and the log of the motions to cut from it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// The recording (a session, or one trial's file).
+    pub session: PathBuf,
+    /// Its motions, on its clock.
+    pub log: RobotLog,
+}
+
 /// Imports `session` cut by `log` into the new folder `out`; `on_trial` is called after each
 /// trial is written.
 pub fn import_session(
@@ -99,6 +110,39 @@ pub fn import_session(
     config: &ImportConfig,
     on_trial: &(dyn Fn() + Sync),
 ) -> Result<ImportSummary, ImportError> {
+    let part = Part {
+        session: session.to_path_buf(),
+        log: log.clone(),
+    };
+    import_parts(std::slice::from_ref(&part), out, config, on_trial)
+}
+
+/// Imports every part (several sessions, or a folder of per-trial files, each cut by its own
+/// log) into the one new folder `out`, trials in the parts' order; a no-contact range is of the
+/// first part's recording. Trial names must differ across the parts.
+pub fn import_parts(
+    parts: &[Part],
+    out: &Path,
+    config: &ImportConfig,
+    on_trial: &(dyn Fn() + Sync),
+) -> Result<ImportSummary, ImportError> {
+    let mut seen = std::collections::HashMap::new();
+    let mut repeated = Vec::new();
+    for part in parts {
+        for (line, t) in &part.log.rows {
+            let here = format!("{}:{line}", part.log.path.display());
+            if let Some(first) = seen.insert(t.trial.clone(), here.clone()) {
+                repeated.push(format!(
+                    "{here}: column `trial`: `{}` is also {first} (trial names name the files: \
+                     each must be unique across the logs)",
+                    t.trial
+                ));
+            }
+        }
+    }
+    if !repeated.is_empty() {
+        return Err(ImportError::Problems(repeated));
+    }
     if out.exists() {
         return Err(ImportError::Exists(out.to_path_buf()));
     }
@@ -110,7 +154,7 @@ pub fn import_session(
         std::fs::remove_dir_all(&tmp).map_err(IoError::at(&tmp))?;
     }
     std::fs::create_dir_all(&tmp).map_err(IoError::at(&tmp))?;
-    let result = write_all(session, log, &tmp, config, on_trial).and_then(|mut summary| {
+    let result = write_all(parts, &tmp, config, on_trial).and_then(|mut summary| {
         std::fs::rename(&tmp, out).map_err(IoError::at(out))?;
         summary.out = out.to_path_buf();
         Ok(summary)
@@ -155,62 +199,75 @@ fn copy_range(
 }
 
 fn write_all(
-    session: &Path,
-    log: &RobotLog,
+    parts: &[Part],
     dir: &Path,
     config: &ImportConfig,
     on_trial: &(dyn Fn() + Sync),
 ) -> Result<ImportSummary, ImportError> {
     let mut summary = ImportSummary {
         out: dir.to_path_buf(),
-        trials: log.rows.len(),
+        trials: parts.iter().map(|p| p.log.rows.len()).sum(),
         events: 0,
         index: None,
     };
     let mut outside = Vec::new();
-    for ((line, t), previous_end) in log.rows.iter().zip(log.previous_ends()) {
-        let from = t.motion_start_us.saturating_sub(config.pre_us);
-        let from = previous_end.map_or(from, |end| from.max(end));
-        // Up to and including `post_us` after the end.
-        let to = t
-            .motion_end_us
-            .saturating_add(config.post_us)
-            .saturating_add(1);
-        let copied = copy_range(session, Some((from, to)), &dir.join(&t.file))?;
-        if copied.events == 0 && copied.imu == 0 {
-            outside.push(format!(
-                "{}:{line}: column `motion_start_us` (trial `{}`): {} holds nothing from {from} \
-                 to {to} us: the motion lies outside the recording (check the times and \
-                 --clock-offset-us)",
-                log.path.display(),
-                t.trial,
-                session.display()
-            ));
+    for Part { session, log } in parts {
+        for ((line, t), previous_end) in log.rows.iter().zip(log.previous_ends()) {
+            let from = t.motion_start_us.saturating_sub(config.pre_us);
+            let from = previous_end.map_or(from, |end| from.max(end));
+            // Up to and including `post_us` after the end.
+            let to = t
+                .motion_end_us
+                .saturating_add(config.post_us)
+                .saturating_add(1);
+            let copied = copy_range(session, Some((from, to)), &dir.join(&t.file))?;
+            if copied.events == 0 && copied.imu == 0 {
+                outside.push(format!(
+                    "{}:{line}: column `motion_start_us` (trial `{}`): {} holds nothing from \
+                     {from} to {to} us: the motion lies outside the recording (check the times \
+                     and --clock-offset-us)",
+                    log.path.display(),
+                    t.trial,
+                    session.display()
+                ));
+            }
+            summary.events += copied.events;
+            summary.index = summary.index.or(copied.index);
+            on_trial();
         }
-        summary.events += copied.events;
-        summary.index = summary.index.or(copied.index);
-        on_trial();
     }
     if !outside.is_empty() {
         return Err(ImportError::Problems(outside));
     }
     let no_contact = dir.join(NO_CONTACT_FILE);
-    match &config.no_contact {
-        Some(NoContact::File(path)) => {
+    match (&config.no_contact, parts.first()) {
+        (Some(NoContact::File(path)), _) => {
             copy_range(path, None, &no_contact)?;
         }
-        Some(NoContact::Range(from, to)) => {
-            copy_range(session, Some((*from, *to)), &no_contact)?;
+        (Some(NoContact::Range(from, to)), Some(first)) => {
+            copy_range(&first.session, Some((*from, *to)), &no_contact)?;
         }
-        None => {}
+        _ => {}
     }
     if let Some(path) = &config.calibration {
         let dest = dir.join(CALIBRATION_FILE);
         std::fs::copy(path, &dest).map_err(IoError::at(path))?;
         evtac_labels::read_calibration(dir).map_err(ImportError::Calibration)?;
     }
+    // The manifest's rows in the parts' order, each with where it came from.
+    let rows: Vec<Source> = parts
+        .iter()
+        .flat_map(|p| {
+            p.log.rows.iter().map(move |(line, t)| Source {
+                log: &p.log.path,
+                line: *line,
+                session: &p.session,
+                trial: t,
+            })
+        })
+        .collect();
     let manifest = Manifest {
-        trials: log.rows.iter().map(|(_, t)| t.clone()).collect(),
+        trials: rows.iter().map(|r| r.trial.clone()).collect(),
     };
     manifest.write(dir)?;
     // What was not given is not checked here: `evtac check` and the commands that read the
@@ -233,29 +290,38 @@ fn write_all(
             report
                 .problems
                 .iter()
-                .map(|p| in_log_terms(p, log, session, dir))
+                .map(|p| in_log_terms(p, &rows, dir))
                 .collect(),
         ));
     }
     Ok(summary)
 }
 
+/// Where a manifest row came from: its log's line and the recording it was cut from.
+struct Source<'a> {
+    log: &'a Path,
+    line: usize,
+    session: &'a Path,
+    trial: &'a TrialMeta,
+}
+
 /// A problem of the imported dataset in the terms of the import's inputs: a trial's problem
-/// names the log's line (the manifest keeps the log's order), a file written from the session
-/// names the session.
-fn in_log_terms(p: &Problem, log: &RobotLog, session: &Path, dir: &Path) -> String {
+/// names its log's line (the manifest keeps the logs' order), a file written from a session
+/// names the file.
+fn in_log_terms(p: &Problem, rows: &[Source], dir: &Path) -> String {
     let field = p.field.as_deref().unwrap_or("-");
-    // Manifest line n (after the header on line 1) is the log's row n - 2.
+    // Manifest line n (after the header on line 1) is row n - 2.
     let row = p
         .line
         .and_then(|l| l.checked_sub(2))
-        .and_then(|i| log.rows.get(i));
+        .and_then(|i| rows.get(i));
     match row {
-        Some((line, t)) => format!(
-            "{}:{line}: column `{field}` (trial `{}`, cut from {}): {} ({})",
-            log.path.display(),
-            t.trial,
-            session.display(),
+        Some(r) => format!(
+            "{}:{}: column `{field}` (trial `{}`, cut from {}): {} ({})",
+            r.log.display(),
+            r.line,
+            r.trial.trial,
+            r.session.display(),
             p.problem,
             p.fix
         ),

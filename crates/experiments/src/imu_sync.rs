@@ -160,16 +160,23 @@ fn search(f: &dyn Fn(i64) -> f64, lo: i64, hi: i64, step: i64) -> i64 {
     best
 }
 
+/// Every IMU sample of the recording at `path`, in time order, one per timestamp (a sample
+/// repeated across packets counted once).
+pub fn read_imu(path: &Path) -> Result<Vec<evtac_events::ImuSample>, evtac_events::Error> {
+    let mut reader = evtac_events::open(path)?;
+    let mut samples = Vec::new();
+    while let Some(chunk) = reader.next_chunk()? {
+        samples.extend_from_slice(chunk.imu);
+    }
+    samples.sort_by_key(|s| s.t);
+    samples.dedup_by_key(|s| s.t);
+    Ok(samples)
+}
+
 /// Finds the offset of `log` (on the robot's clock) that best aligns its commanded rate with the
 /// gyroscope of `session`.
 pub fn imu_offset(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyncError> {
-    let mut reader = evtac_events::open(session)?;
-    let mut samples_3d = Vec::new();
-    while let Some(chunk) = reader.next_chunk()? {
-        samples_3d.extend_from_slice(chunk.imu);
-    }
-    samples_3d.sort_by_key(|s| s.t);
-    samples_3d.dedup_by_key(|s| s.t);
+    let samples_3d = read_imu(session)?;
     let samples: Vec<(i64, f64)> = samples_3d
         .iter()
         .map(|s| (s.t, magnitude(s.gyroscope.map(f64::from), [0.0; 3])))

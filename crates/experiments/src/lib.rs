@@ -8,7 +8,11 @@
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`);
 //!   [`label_check`]: its labels against the commanded stop angles and the ground truth.
 //! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
-//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]).
+//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]), or by the motions found
+//!   in its gyroscope ([`motions`]); several sessions, or a folder of per-trial files
+//!   ([`trial_folder`]), into one dataset.
+//! - [`sensor_stats`]: what a recording says about its sensor (noise at rest, hot pixels, the
+//!   IMU's noise and bias), as simulator parameters (`evtac stats`).
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -53,6 +57,7 @@ pub mod io;
 pub mod jobs;
 pub mod label_check;
 pub mod latency;
+pub mod motions;
 pub mod noise;
 pub mod pipeline;
 pub mod plan;
@@ -62,10 +67,12 @@ pub mod repr_example;
 pub mod results;
 pub mod robot_log;
 pub mod sampling;
+pub mod sensor_stats;
 pub mod sensor_view;
 pub mod slurm;
 pub mod splits;
 pub mod stage;
 pub mod sync;
 pub mod training;
+pub mod trial_folder;
 pub mod tuning;

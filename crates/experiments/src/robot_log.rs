@@ -104,15 +104,31 @@ pub struct RobotLog {
 impl RobotLog {
     /// Reads the log at `path`, shifting its times by `clock_offset_us`.
     pub fn read(path: &Path, clock_offset_us: i64) -> Result<Self, LogError> {
-        let text = std::fs::read_to_string(path).map_err(|source| LogError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&text, path, clock_offset_us)
+        Self::parse(&read_text(path)?, path, clock_offset_us)
+    }
+
+    /// Reads the log at `path` of a folder of per-trial files, shifting its times by
+    /// `clock_offset_us`: each row is on its own trial file's clock, so rows of different
+    /// trials may overlap (the rows of one file are checked with [`Self::check_overlaps`] once
+    /// split by file).
+    pub fn read_per_trial(path: &Path, clock_offset_us: i64) -> Result<Self, LogError> {
+        Self::parse_rows(&read_text(path)?, path, clock_offset_us)
     }
 
     /// Parses log text (`path` names it in errors), shifting its times by `clock_offset_us`.
     pub fn parse(text: &str, path: &Path, clock_offset_us: i64) -> Result<Self, LogError> {
+        let log = Self::parse_rows(text, path, clock_offset_us)?;
+        log.check_overlaps()?;
+        Ok(log)
+    }
+
+    /// Motions one after another, else the first overlap as an error naming both lines.
+    pub fn check_overlaps(&self) -> Result<(), LogError> {
+        check_overlaps(&self.path, &self.rows)
+    }
+
+    /// [`Self::parse`] but for the overlaps.
+    fn parse_rows(text: &str, path: &Path, clock_offset_us: i64) -> Result<Self, LogError> {
         let mut lines = text.lines();
         let header: Vec<&str> = lines
             .next()
@@ -198,7 +214,6 @@ impl RobotLog {
                 ));
             }
         }
-        check_overlaps(path, &rows)?;
         Ok(RobotLog {
             path: path.to_path_buf(),
             rows,
@@ -229,6 +244,14 @@ impl RobotLog {
         }
         out
     }
+}
+
+/// The log file's text.
+fn read_text(path: &Path) -> Result<String, LogError> {
+    std::fs::read_to_string(path).map_err(|source| LogError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 fn row_error(path: &Path, line: usize, column: &str, reason: String) -> LogError {

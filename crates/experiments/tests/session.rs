@@ -1,15 +1,18 @@
 //! A simulated session (`evtac simulate --session`) imported back into a dataset, its log put
-//! on the recording's clock by each sync mode: its labels match the simulator's truth as
-//! closely as the per-trial simulated dataset's do.
+//! on the recording's clock by each sync mode, or its motions found in the gyroscope without
+//! the log: its labels match the simulator's truth as closely as the per-trial simulated
+//! dataset's do.
 
 use evtac_events::Trigger;
-use evtac_events::manifest::Manifest;
+use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_experiments::check::check;
 use evtac_experiments::import::{ImportConfig, NoContact, import_session};
+use evtac_experiments::imu_sync::read_imu;
 use evtac_experiments::inputs::Inputs;
+use evtac_experiments::motions::{FindConfig, as_log, find_motions};
 use evtac_experiments::robot_log::RobotLog;
 use evtac_experiments::sync::{Sync, SyncError, synchronise};
-use evtac_labels::dataset::{label_trial, read_calibration};
+use evtac_labels::dataset::{label_trial, read_calibration, read_calibration_file};
 use evtac_labels::{LabelConfig, LabelSeries, TruthError};
 use evtac_sim::{
     Protocol, Scale, SessionConfig, SessionRecord, simulate_dataset, simulate_session,
@@ -205,4 +208,60 @@ fn a_session_synchronised_by_its_imu_recovers_the_offset_within_a_millisecond() 
     };
     let imported = label_errors(&out, &session, &truths);
     assert_as_close(&imported, &per_trial_errors(dir.path()));
+}
+
+#[test]
+fn a_session_imported_without_its_log_finds_every_motion_and_labels_as_well_as_per_trial_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = simulate(dir.path());
+    let session = dir.path().join("session");
+    let imu = read_imu(&session.join("session.aedat4")).unwrap();
+    let calibration = read_calibration_file(&session.join("calibration.json")).unwrap();
+    let found = find_motions(&imu, &calibration, &FindConfig::new(1.5));
+    assert_eq!(
+        found.len(),
+        record.trials.len(),
+        "every motion, nothing else"
+    );
+    let mut onset_errors_ms = Vec::new();
+    for (m, truth) in found.iter().zip(&record.trials) {
+        let t = &m.meta;
+        let error_us = t.motion_start_us - truth.motion_start_us;
+        onset_errors_ms.push(error_us as f64 * 1e-3);
+        assert!(
+            error_us.abs() <= 20_000,
+            "{}: onset off by {error_us} us",
+            truth.trial
+        );
+        // Rounded to whole degrees and deg/s, the gyroscope's values are the commanded ones.
+        assert_eq!(
+            (t.direction_deg, t.speed_deg_s, t.total_deg),
+            (truth.direction_deg, truth.speed_deg_s, truth.total_deg),
+            "{}: {m:?}",
+            truth.trial
+        );
+        // Experiment 2's stop is a pause inside the motion, not a motion of its own.
+        assert_eq!(m.pauses, 1, "{}", truth.trial);
+    }
+    let log = as_log(&session.join("session.aedat4"), &found);
+    let out = import(dir.path(), &log, "imported");
+    // The motions are named in the order found, which is the truth's.
+    let truths = Manifest {
+        trials: record
+            .trials
+            .iter()
+            .zip(&found)
+            .map(|(truth, m)| TrialMeta {
+                trial: m.meta.trial.clone(),
+                ..truth.clone()
+            })
+            .collect(),
+    };
+    let imported = label_errors(&out, &session, &truths);
+    let per_trial = per_trial_errors(dir.path());
+    eprintln!(
+        "log-free: onset errors {onset_errors_ms:?} ms; labels vs truth, RMS deg: imported \
+         {imported:?}, per-trial {per_trial:?}"
+    );
+    assert_as_close(&imported, &per_trial);
 }

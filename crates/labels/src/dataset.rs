@@ -52,7 +52,13 @@ pub fn dataset_calibration(
 
 /// Reads `<dataset_dir>/calibration.json`; a missing file is [`Error::MissingCalibration`].
 pub fn read_calibration(dataset_dir: impl AsRef<Path>) -> Result<Calibration, Error> {
-    let path = dataset_dir.as_ref().join(CALIBRATION_FILE);
+    read_calibration_file(&dataset_dir.as_ref().join(CALIBRATION_FILE))
+}
+
+/// Reads and checks the calibration file at `path` (a `calibration.json` anywhere, e.g. the
+/// one `evtac import --calibration` is given).
+pub fn read_calibration_file(path: &Path) -> Result<Calibration, Error> {
+    let path = path.to_path_buf();
     let bad = |message: String| Error::Calibration {
         path: path.clone(),
         message,

@@ -52,7 +52,7 @@ pub mod validation;
 
 pub use dataset::{
     CalibrationSource, DatasetLabels, TrialReport, dataset_calibration, label_dataset, label_trial,
-    read_calibration,
+    read_calibration, read_calibration_file,
 };
 pub use error::{Error, TrialError};
 pub use scale::ScaleMethod;

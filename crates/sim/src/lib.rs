@@ -19,6 +19,7 @@ pub mod dataset;
 pub mod dvs;
 pub mod imu;
 pub mod params;
+pub mod params_file;
 pub mod protocol;
 pub mod rig;
 pub mod sensor;
@@ -27,6 +28,7 @@ pub mod trial;
 
 pub use dataset::{DatasetConfig, DatasetError, simulate_dataset};
 pub use params::SimParams;
+pub use params_file::{ParamsError, read_params};
 pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan};
 pub use sensor::SkinPose;
 pub use session::{SessionConfig, SessionRecord, simulate_session};

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// All simulator parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct SimParams {
     /// The tip and its pins.
     pub sensor: SensorParams,
@@ -28,7 +28,7 @@ pub struct SimParams {
 
 /// The hemispherical tip and its internal pins.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct SensorParams {
     /// Outer radius of the tip's hemisphere (the NeuroTac's 20 mm).
     pub tip_radius_mm: f64,
@@ -69,7 +69,7 @@ impl SensorParams {
 
 /// The contact with a rigid flat plane, and the skin's dynamics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct ContactParams {
     /// How much of the skin's penetration into the plane moves a pin tip along the plane normal
     /// (the rest is taken up by the silicone's compression).
@@ -130,7 +130,7 @@ impl Default for ContactParams {
 
 /// The camera inside the tip and the scene's brightness.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct CameraParams {
     /// Sensor width in pixels (DVXplorer: 640).
     pub width: u16,
@@ -170,7 +170,7 @@ impl Default for CameraParams {
 
 /// The DVS pixel model, with the names and meaning of v2e's (Hu, Liu and Delbruck, 2021) options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct DvsParams {
     /// Nominal ON threshold in log intensity.
     pub pos_thres: f64,
@@ -258,7 +258,7 @@ impl DvsParams {
 
 /// The IMU: gyroscope and accelerometer with the usual error terms.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct ImuParams {
     /// Sample rate (the DVXplorer's default 800 Hz).
     pub rate_hz: f64,
@@ -314,7 +314,7 @@ impl Default for ImuParams {
 
 /// The timing of a trial and the robot's motion profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct TimelineParams {
     /// Time from the start of the recording to full indentation (a smooth cosine ramp from the
     /// approach gap to the trial's depth).
@@ -355,7 +355,7 @@ impl Default for TimelineParams {
 
 /// The rig's imperfections, drawn per trial ([`crate::rig::TrialErrors`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct RigParams {
     /// Standard deviation of the tilt the robot reaches against the one commanded (each stop
     /// and the final tilt), degrees.

@@ -1,18 +1,23 @@
-//! `evtac import`: a recording session and the robot's log of its motions in, a dataset folder
-//! out (one AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when
-//! given), written into a temporary folder and renamed at the end. The work is
+//! `evtac import`: a recording session and the robot's log of its motions in (or without a log,
+//! the motions found in its gyroscope: `evtac_experiments::motions`), a dataset folder out (one
+//! AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when given),
+//! written into a temporary folder and renamed at the end. The work is
 //! `evtac_experiments::import`'s.
 
 use anyhow::Context;
 use evtac_events::Trigger;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_experiments::import::{
-    DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, import_session,
+    DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, Part, import_parts,
 };
+use evtac_experiments::imu_sync::read_imu;
 use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
+use evtac_experiments::motions::{self, FoundMotion};
 use evtac_experiments::robot_log::RobotLog;
 use evtac_experiments::sync::{Sync, synchronise};
-use std::path::PathBuf;
+use evtac_experiments::trial_folder::{split_by_file, trial_files};
+use evtac_labels::geometry::Calibration;
+use std::path::{Path, PathBuf};
 
 /// How `evtac import` puts the log on the recording's clock.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -29,13 +34,47 @@ pub enum SyncMode {
 /// Arguments of `evtac import`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The session recording (AEDAT4 with a data table is read fastest; any format evtac reads).
-    pub session: PathBuf,
+    /// The session recordings (AEDAT4 with a data table is read fastest; any format evtac
+    /// reads), or folders of per-trial files (their .aedat4/.aedat files, a log's rows cut from
+    /// the file named after their trial): all go into one dataset.
+    #[arg(required = true, num_args = 1.., value_name = "SESSION")]
+    pub sessions: Vec<PathBuf>,
     /// The robot's log: a CSV with the manifest's columns except file and truth, one row per
     /// motion (trial, direction_deg, speed_deg_s, depth_mm, total_deg, motion_start_us,
-    /// motion_end_us; optionally stop_start_us, stop_end_us, stop_deg, group).
+    /// motion_end_us; optionally stop_start_us, stop_end_us, stop_deg, group). Without it the
+    /// motions are found in the gyroscope (needs --calibration and --depth-mm) and listed for
+    /// review in DIR/motions.csv. With several sessions, one --log per session, in the same
+    /// order.
     #[arg(long, value_name = "LOG.csv")]
-    pub log: PathBuf,
+    pub log: Vec<PathBuf>,
+    /// Without --log: the indentation depth written for every motion, mm (the gyroscope cannot
+    /// see it).
+    #[arg(long, value_name = "MM", conflicts_with = "log")]
+    pub depth_mm: Option<f64>,
+    /// Without --log: directions are rounded to multiples of this, degrees (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG",
+        conflicts_with = "log"
+    )]
+    pub direction_step_deg: f64,
+    /// Without --log: speeds are rounded to multiples of this, deg/s (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG_S",
+        conflicts_with = "log"
+    )]
+    pub speed_step_deg_s: f64,
+    /// Without --log: total tilts are rounded to multiples of this, degrees (0: not rounded).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG",
+        conflicts_with = "log"
+    )]
+    pub total_step_deg: f64,
     /// The dataset folder to write (must not exist).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -75,6 +114,166 @@ pub struct Args {
     pub calibration: Option<PathBuf>,
 }
 
+/// Where a log-free import lists what it found, in the dataset folder.
+const REVIEW_FILE: &str = "motions.csv";
+
+/// What a log-free import needs: the calibration, and how motions are found and rounded.
+fn find_config(args: &Args) -> anyhow::Result<(Calibration, motions::FindConfig)> {
+    let calibration_path = args.calibration.as_ref().context(
+        "without --log, --calibration is needed: the tilt's direction is read in the sensor frame",
+    )?;
+    let depth_mm = args.depth_mm.context(
+        "without --log, --depth-mm is needed: the gyroscope cannot see the indentation depth",
+    )?;
+    let calibration = evtac_labels::read_calibration_file(calibration_path)?;
+    let config = motions::FindConfig {
+        direction_step_deg: args.direction_step_deg,
+        speed_step_deg_s: args.speed_step_deg_s,
+        total_step_deg: args.total_step_deg,
+        ..motions::FindConfig::new(depth_mm)
+    };
+    Ok((calibration, config))
+}
+
+/// The motions in the gyroscope of `file`.
+fn found_motions(
+    file: &Path,
+    (calibration, config): &(Calibration, motions::FindConfig),
+) -> anyhow::Result<Vec<FoundMotion>> {
+    let imu = read_imu(file)?;
+    Ok(motions::find_motions(&imu, calibration, config))
+}
+
+/// The motions found in `file`, as a table.
+fn print_found(file: &Path, found: &[FoundMotion]) {
+    println!(
+        "{} motions found in the gyroscope of {}:",
+        found.len(),
+        file.display()
+    );
+    println!("trial  onset_us              duration_s  direction  speed  total  review");
+    for m in found {
+        let t = &m.meta;
+        println!(
+            "{}  {:<20}  {:>10.3}  {:>9}  {:>5}  {:>5}  {}",
+            t.trial,
+            t.motion_start_us,
+            (t.motion_end_us - t.motion_start_us) as f64 * 1e-6,
+            t.direction_deg,
+            t.speed_deg_s,
+            t.total_deg,
+            motions::review_note(m)
+        );
+    }
+}
+
+/// Motions found in the gyroscope, each with the recording it was found in.
+type Found = Vec<(PathBuf, FoundMotion)>;
+
+/// The recordings and logs to import: each session with its log (put on its clock by --sync),
+/// each folder split by its log's trials, or without logs the motions found in every file
+/// (returned for review too).
+fn parts(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found)> {
+    let mut parts = Vec::new();
+    let mut found_all = Vec::new();
+    if args.log.is_empty() {
+        anyhow::ensure!(
+            args.sync == SyncMode::Offset && args.clock_offset_us == 0,
+            "--sync and --clock-offset-us put a log on the recording's clock: without --log \
+             the motions are found on it"
+        );
+        let config = find_config(args)?;
+        // A session's motions are numbered on across the sessions (m0000, m0001, ...); a
+        // folder's files are trials, each named after its file, and a file without a motion
+        // (the no-contact recording) is passed over.
+        let mut numbered = 0;
+        for session in &args.sessions {
+            let in_folder = session.is_dir();
+            let files = if in_folder {
+                trial_files(session)?
+            } else {
+                vec![session.clone()]
+            };
+            for file in files {
+                let mut found = found_motions(&file, &config)?;
+                if found.is_empty() && in_folder {
+                    println!(
+                        "{}: no motion in its gyroscope, passed over",
+                        file.display()
+                    );
+                    continue;
+                }
+                anyhow::ensure!(
+                    !found.is_empty(),
+                    "{}: no motion found in its gyroscope (a tilt of at least {} deg/s for {} \
+                     ms, with gravity turning)",
+                    file.display(),
+                    config.1.threshold_deg_s,
+                    config.1.min_motion_us / 1000
+                );
+                if in_folder {
+                    let stem = file.file_stem().unwrap_or_default().to_string_lossy();
+                    motions::name_after(&mut found, &stem);
+                } else {
+                    motions::number_from(&mut found, numbered);
+                    numbered += found.len();
+                }
+                print_found(&file, &found);
+                parts.push(Part {
+                    session: file.clone(),
+                    log: motions::as_log(&file, &found),
+                });
+                found_all.extend(found.into_iter().map(|m| (file.clone(), m)));
+            }
+        }
+        return Ok((parts, found_all));
+    }
+    anyhow::ensure!(
+        args.log.len() == args.sessions.len(),
+        "{} sessions and {} logs: give one --log per session, in the same order (or none, to \
+         find the motions in the gyroscope)",
+        args.sessions.len(),
+        args.log.len()
+    );
+    for (session, log) in args.sessions.iter().zip(&args.log) {
+        if session.is_dir() {
+            anyhow::ensure!(
+                args.sync == SyncMode::Offset,
+                "{}: a folder of trials is cut on each file's clock: --sync {} is for a session",
+                session.display(),
+                clap::ValueEnum::to_possible_value(&args.sync)
+                    .map_or_else(String::new, |v| v.get_name().to_string())
+            );
+            let log = RobotLog::read_per_trial(log, args.clock_offset_us)?;
+            parts.extend(split_by_file(&log, &trial_files(session)?)?);
+            continue;
+        }
+        let synced = synchronise(session, RobotLog::read(log, 0)?, sync)?;
+        if let (SyncMode::Trigger, Some([lo, median, hi])) = (args.sync, synced.offset_range()) {
+            eprintln!(
+                "{}: clock offsets from the triggers: median {median} us, {lo} .. {hi} us over \
+                 {} rows",
+                session.display(),
+                synced.offsets.len()
+            );
+        }
+        if let (Some(residual), Some([_, offset, _])) =
+            (synced.residual_deg_s, synced.offset_range())
+        {
+            eprintln!(
+                "{}: clock offset from the IMU: {offset} us (gyroscope rate vs the commanded \
+                 rate: {residual:.3} deg/s RMS)",
+                session.display()
+            );
+        }
+        parts.push(Part {
+            session: session.clone(),
+            log: synced.log,
+        });
+    }
+    Ok((parts, found_all))
+}
+
 fn parse_range(s: &str) -> Result<(i64, i64), String> {
     let bad = || format!("`{s}` is not a range A..B of microseconds with A < B");
     let (a, b) = s.split_once("..").ok_or_else(bad)?;
@@ -96,20 +295,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         SyncMode::Trigger => Sync::Trigger(args.trigger_kind),
         SyncMode::Imu => Sync::Imu,
     };
-    let synced = synchronise(&args.session, RobotLog::read(&args.log, 0)?, sync)?;
-    if let (SyncMode::Trigger, Some([lo, median, hi])) = (args.sync, synced.offset_range()) {
-        eprintln!(
-            "clock offsets from the triggers: median {median} us, {lo} .. {hi} us over {} rows",
-            synced.offsets.len()
-        );
-    }
-    if let (Some(residual), Some([_, offset, _])) = (synced.residual_deg_s, synced.offset_range()) {
-        eprintln!(
-            "clock offset from the IMU: {offset} us (gyroscope rate vs the commanded rate: \
-             {residual:.3} deg/s RMS)"
-        );
-    }
-    let log = synced.log;
+    let (parts, found) = parts(&args, sync)?;
     let config = ImportConfig {
         pre_us: i64::try_from(args.pre_ms)
             .ok()
@@ -126,23 +312,32 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
         calibration: args.calibration.clone(),
     };
-    let bar = crate::progress::bar(log.rows.len() as u64, "trials");
-    let summary = import_session(&args.session, &log, &args.out, &config, &|| bar.inc(1))
-        .with_context(|| format!("importing {}", args.session.display()))?;
+    let trials = parts.iter().map(|p| p.log.rows.len()).sum::<usize>();
+    let sources = args
+        .sessions
+        .iter()
+        .map(|s| s.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let bar = crate::progress::bar(trials as u64, "trials");
+    let summary = import_parts(&parts, &args.out, &config, &|| bar.inc(1))
+        .with_context(|| format!("importing {sources}"))?;
     bar.finish_and_clear();
     if let Some(reason) = summary.index.as_ref().and_then(|i| i.fallback()) {
-        eprintln!(
-            "note: {} was read from its start for every trial: {reason}",
-            args.session.display()
-        );
+        eprintln!("note: the recordings were read from their start for every trial: {reason}");
     }
     println!(
-        "imported {} trials ({} events) from {} into {}",
+        "imported {} trials ({} events) from {sources} into {}",
         summary.trials,
         summary.events,
-        args.session.display(),
         summary.out.display()
     );
+    if !found.is_empty() {
+        let review = summary.out.join(REVIEW_FILE);
+        std::fs::write(&review, motions::review_csv(&found))
+            .with_context(|| review.display().to_string())?;
+        println!("the motions as found, for review: {}", review.display());
+    }
     if config.calibration.is_none() {
         println!(
             "no calibration given: add {}, or pass --{IDENTITY_CALIBRATION_FLAG} to the commands \

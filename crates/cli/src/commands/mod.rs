@@ -12,5 +12,6 @@ pub mod predict;
 pub mod represent;
 pub mod reproduce;
 pub mod simulate;
+pub mod stats;
 pub mod train;
 pub mod tune;

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use evtac_sim::{
-    DatasetConfig, Protocol, Scale, SessionConfig, SimParams, simulate_dataset, simulate_session,
+    DatasetConfig, Protocol, Scale, SessionConfig, SimParams, read_params, simulate_dataset,
+    simulate_session,
 };
 
 /// Arguments of `evtac simulate`.
@@ -27,8 +28,9 @@ pub struct Args {
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
-    /// Simulator parameters as JSON (e.g. an edited `simulator.json`'s `params`); missing
-    /// fields take their defaults.
+    /// Simulator parameters as JSON (e.g. an edited `simulator.json`'s `params`, or what
+    /// `evtac stats --sim-params` measured on a recording); missing fields take their defaults,
+    /// a misspelt field or a value the model cannot use is an error naming the field.
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Simulate only the first N trials of the protocol.
@@ -49,12 +51,7 @@ pub struct Args {
 /// Runs `evtac simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let params = match &args.params {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading {}", path.display()))?;
-            serde_json::from_str::<SimParams>(&text)
-                .with_context(|| format!("parsing simulator parameters {}", path.display()))?
-        }
+        Some(path) => read_params(path).context("--params")?,
         None => SimParams::default(),
     };
     let config = DatasetConfig {
