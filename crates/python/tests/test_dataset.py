@@ -2,6 +2,8 @@
 
 import csv
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -148,3 +150,13 @@ def test_dataset_feature_errors(datasets, tmp_path):
         evtac.dataset_features(ds, evtac.Representation(roi=(160, 160)))
     with pytest.raises(OSError):
         evtac.dataset_features(tmp_path / "none")
+
+
+def test_torch_is_loaded_only_when_evtac_torch_is_used(torch):
+    code = (
+        "import sys, evtac\n"
+        "assert 'torch' not in sys.modules\n"
+        "assert evtac.torch.FeatureDataset.__module__ == 'evtac.torch'\n"
+        "assert 'torch' in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

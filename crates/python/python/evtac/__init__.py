@@ -459,3 +459,13 @@ def dataset_features(
         None if trials is None else list(trials), motion_points, stop_points,
     )
     return DatasetFeatures(features, labels, trial, t_us, stop, tuple(names))
+
+
+def __getattr__(name: str) -> Any:
+    """``evtac.torch`` after a plain ``import evtac``: imported on first use, so that torch is
+    loaded only by code that uses it (an ``ImportError`` naming torch when it is missing)."""
+    if name == "torch":
+        import importlib
+
+        return importlib.import_module(".torch", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
