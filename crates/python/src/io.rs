@@ -40,7 +40,8 @@ pub struct Recording {
     /// file does not state it (CSV, NPY) and none was given.
     #[pyo3(get)]
     resolution: Option<(u16, u16)>,
-    /// The file's format: `AEDAT4`, `EVT2`, `EVT3`, `CSV` or `NPY`.
+    /// The file's format: `AEDAT4`, `AEDAT3.1`, `AEDAT2`, `EVT2`, `EVT21`, `EVT3`, `CSV` or
+    /// `NPY`.
     #[pyo3(get)]
     format: &'static str,
     /// The camera that recorded it, when the file says.

@@ -61,6 +61,16 @@ def cli():
 
 
 @pytest.fixture(scope="session")
+def torch():
+    """The torch module (`.ci/python-env` installs a CPU-only torch into .venv)."""
+    try:
+        import torch
+    except ImportError:
+        _missing("torch (`bash .ci/python-env` installs it)")
+    return torch
+
+
+@pytest.fixture(scope="session")
 def aedat(real):
     """The DVXplorer 320x240 recording with IMU."""
     return real("dvxplorer_320x240_imu.aedat4")

@@ -2,6 +2,8 @@
 
 import csv
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -91,16 +93,53 @@ def test_dataset_features_are_the_representations(datasets):
     assert again.features.tobytes() == data.features[data.trial == 1].tobytes()
 
 
-def test_torch_feature_dataset(datasets):
-    torch = pytest.importorskip("torch")
+def test_torch_feature_dataset_serves_the_representations_features(torch, datasets):
+    """Every item is the representation's features at the sample's time in the trial's own
+    recording, and the trial's labels interpolated there: computed here without the dataset
+    cache, so a wrong row, trial, order or dtype fails."""
     import evtac.torch
 
     _, ds = datasets
-    data = evtac.torch.FeatureDataset(ds, evtac.Representation("dynamic"))
-    x, y = data[3]
-    assert len(data) == 120 and x.shape == (900,) and y.shape == (2,)
-    assert x.dtype == torch.float32
-    assert torch.equal(x, torch.from_numpy(evtac.dataset_features(ds, evtac.Representation("dynamic")).features[3]))
+    rep = evtac.Representation("combined", tau_ms=700, window_ms=300)
+    data = evtac.torch.FeatureDataset(ds, rep)
+    assert isinstance(data, torch.utils.data.Dataset)
+    meta = data.data
+    assert len(data) == len(meta.t_us) == 120
+    with open(ds / "trials.csv") as f:
+        files = {r["trial"]: r["file"] for r in csv.DictReader(f)}
+    no_contact = ds / "no_contact.aedat4"
+    want_x, want_y = [], []
+    for i, name in enumerate(meta.trials):
+        rows = meta.trial == i
+        t = meta.t_us[rows]
+        rec = evtac.read(ds / files[name])
+        own = evtac.Representation("combined", sensor=rec.resolution, tau_ms=700, window_ms=300,
+                                   mask=no_contact if no_contact.exists() else None)
+        want_x.append(own.features(rec.events, t))
+        lab = evtac.label_trial(ds, name)
+        angles = [np.interp(t, lab["t_us"], lab[k]) for k in ("pitch_deg", "roll_deg")]
+        want_y.append(np.stack(angles, axis=1).astype(np.float32))
+    want_x, want_y = np.concatenate(want_x), np.concatenate(want_y)
+    assert np.count_nonzero(want_x) > 0
+    for i in range(len(data)):
+        x, y = data[i]
+        assert x.dtype == torch.float32 and x.shape == (900,)
+        assert y.dtype == torch.float32 and y.shape == (2,)
+        assert x.numpy().tobytes() == want_x[i].tobytes(), i
+        assert y.numpy().tobytes() == want_y[i].tobytes(), i
+    # Batched through a DataLoader, as a training script reads it.
+    loader = torch.utils.data.DataLoader(data, batch_size=32, shuffle=False)
+    xs, ys = zip(*loader)
+    assert [len(b) for b in xs] == [32, 32, 32, 24]
+    assert torch.cat(xs).numpy().tobytes() == want_x.tobytes()
+    assert torch.cat(ys).numpy().tobytes() == want_y.tobytes()
+    # One trial, and another sampling: the same rows as evtac.dataset_features gives.
+    one = evtac.torch.FeatureDataset(ds, rep, trials=[meta.trials[1]], motion_points=20,
+                                     stop_points=5)
+    ref = evtac.dataset_features(ds, rep, trials=[meta.trials[1]], motion_points=20,
+                                 stop_points=5)
+    assert len(one) == 25
+    assert torch.stack([one[i][0] for i in range(25)]).numpy().tobytes() == ref.features.tobytes()
 
 
 def test_dataset_feature_errors(datasets, tmp_path):
@@ -111,3 +150,13 @@ def test_dataset_feature_errors(datasets, tmp_path):
         evtac.dataset_features(ds, evtac.Representation(roi=(160, 160)))
     with pytest.raises(OSError):
         evtac.dataset_features(tmp_path / "none")
+
+
+def test_torch_is_loaded_only_when_evtac_torch_is_used(torch):
+    code = (
+        "import sys, evtac\n"
+        "assert 'torch' not in sys.modules\n"
+        "assert evtac.torch.FeatureDataset.__module__ == 'evtac.torch'\n"
+        "assert 'torch' in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

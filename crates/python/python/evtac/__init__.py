@@ -139,7 +139,8 @@ def _size(value: Any, what: str) -> Optional[Size]:
 
 
 def read(path: PathLike, roi: Optional[Size] = None, resolution: Optional[Size] = None) -> Recording:
-    """Reads a whole event file (AEDAT4, EVT 2.0/3.0 raw, CSV or NPY).
+    """Reads a whole event file: AEDAT 4.0, 3.1 or 2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY (the
+    formats ``evtac convert`` reads).
 
     ``roi=(w, h)`` keeps the centered ``w x h`` region (coordinates shifted into it; the
     recording's resolution is then the region's). ``resolution=(w, h)`` declares the sensor size
@@ -458,3 +459,13 @@ def dataset_features(
         None if trials is None else list(trials), motion_points, stop_points,
     )
     return DatasetFeatures(features, labels, trial, t_us, stop, tuple(names))
+
+
+def __getattr__(name: str) -> Any:
+    """``evtac.torch`` after a plain ``import evtac``: imported on first use, so that torch is
+    loaded only by code that uses it (an ``ImportError`` naming torch when it is missing)."""
+    if name == "torch":
+        import importlib
+
+        return importlib.import_module(".torch", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -5,10 +5,25 @@ Events, IMU samples and estimates cross as packed records viewed as ``uint8`` (s
 """
 
 import os
-from typing import Iterator, Optional, Tuple, Union
+from typing import Iterator, Optional, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "__version__",
+    "read",
+    "write",
+    "simulate",
+    "labels",
+    "label_trial",
+    "dataset_features",
+    "Recording",
+    "Reader",
+    "Representation",
+    "Model",
+    "Estimator",
+]
 
 __version__: str
 
@@ -16,6 +31,7 @@ _Path = Union[str, os.PathLike[str]]
 _Size = Tuple[int, int]
 _Bytes = npt.NDArray[np.uint8]
 
+@final
 class Recording:
     """A recording or one chunk of it."""
 
@@ -26,19 +42,20 @@ class Recording:
     format: str
     source: Optional[str]
 
+@final
 class Reader:
     """A large event file read chunk by chunk."""
 
     format: str
     source: Optional[str]
     resolution: Optional[_Size]
-    def __init__(
-        self,
+    def __new__(
+        cls,
         path: _Path,
         roi: Optional[_Size] = None,
         resolution: Optional[_Size] = None,
         chunk_events: int = 65536,
-    ) -> None: ...
+    ) -> Reader: ...
     def __iter__(self) -> Iterator[Recording]: ...
     def __next__(self) -> Recording: ...
 
@@ -53,6 +70,7 @@ def write(
     source: Optional[str] = None,
 ) -> None: ...
 
+@final
 class Representation:
     kind: str
     config_json: str
@@ -62,15 +80,15 @@ class Representation:
     mask: Optional[npt.NDArray[np.uint8]]
     feature_len: int
     time_us: Optional[int]
-    def __init__(
-        self,
+    def __new__(
+        cls,
         kind: str,
         settings: str,
         sensor: Optional[_Size] = None,
         roi: Optional[_Size] = None,
         mask: Optional[npt.NDArray[np.uint8]] = None,
         mask_events: Optional[_Bytes] = None,
-    ) -> None: ...
+    ) -> Representation: ...
     def features(self, events: _Bytes, times: npt.NDArray[np.int64]) -> npt.NDArray[np.float32]: ...
     def frames(self, events: _Bytes, times: npt.NDArray[np.int64]) -> npt.NDArray[np.uint8]: ...
     def potentials(
@@ -81,6 +99,7 @@ class Representation:
     def frame(self) -> npt.NDArray[np.uint8]: ...
     def reset(self) -> None: ...
 
+@final
 class Model:
     config_json: str
     dir: str
@@ -92,9 +111,10 @@ class Model:
     def predict(self, features: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]: ...
     def representation(self, sensor: Optional[_Size] = None) -> Representation: ...
 
+@final
 class Estimator:
     counters: Tuple[int, int, int]
-    def __init__(self, model: Model, sensor: _Size, interval_us: int) -> None: ...
+    def __new__(cls, model: Model, sensor: _Size, interval_us: int) -> Estimator: ...
     def push(self, events: _Bytes, horizon_us: Optional[int] = None) -> np.ndarray: ...
     def finish(self) -> np.ndarray: ...
 
