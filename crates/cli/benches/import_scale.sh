@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `evtac import` on sessions of growing length: wall time, throughput and peak memory (RSS).
 #
-# The import cuts each trial with a time-range read through the AEDAT4 data table and streams it
-# chunk by chunk, so its memory should not grow with the session: this script checks that by
+# The import cuts every trial in one pass over the session, chunk by chunk, so its memory should
+# not grow with the session (it still does, by the data table checked at the end of each full
+# read: docs/performance.md): this script checks that by
 # importing simulated sessions of 16 trials (tiny, about 1.7 minutes) and 125 trials (small,
 # about 16 minutes) by their triggers and without a log, and prints one table row per run. The
 # figures in docs/performance.md come from it.

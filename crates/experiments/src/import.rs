@@ -7,9 +7,9 @@
 //! Several recordings, each with its own log ([`Part`]: sessions of one protocol, or a folder
 //! of per-trial files), make one dataset with [`import_parts`].
 //!
-//! Each trial is cut with a time-range read, through the AEDAT4 data table when the session has
-//! one (only the packets in the range are decoded), and streamed chunk by chunk, so memory stays
-//! bounded however long the session. Everything is written into a temporary folder beside the
+//! A session's trials are cut in one sequential pass over it, each chunk streamed into the
+//! trials it overlaps (a trial whose data trails by more than a second is cut again by a
+//! time-range read), so no index is loaded per trial and every packet is read once. Everything is written into a temporary folder beside the
 //! output, checked with [`crate::check`] (a motion outside the recording, a session without IMU,
 //! a lead-in too short for the labels are errors naming the log's line), and renamed at the end:
 //! a failed import leaves nothing behind.
@@ -166,7 +166,8 @@ pub fn import_parts(
     result
 }
 
-/// What [`copy_range`] wrote.
+/// What [`copy_range`] or [`cut_session`] wrote into one file.
+#[derive(Debug, Default)]
 struct Copied {
     events: u64,
     imu: u64,
@@ -198,6 +199,125 @@ fn copy_range(
     Ok(Copied { events, imu, index })
 }
 
+/// One file cut from a session: its elements with `from <= t < to`.
+struct Cut {
+    from: i64,
+    to: i64,
+    dest: PathBuf,
+}
+
+/// How long a cut's file stays open after the latest time read (in any stream) passes its end,
+/// us: a recorder writes each stream's packets as they fill, so one stream (IMU, triggers)
+/// trails another by about a packet's span (10 ms in DV). An element that trails by more is
+/// not lost: its cut is written again by a range read.
+const KEEP_OPEN_US: i64 = 1_000_000;
+
+/// The part of `elements` (sorted by time) with `from <= t < to`.
+fn within<T>(elements: &[T], t: impl Fn(&T) -> i64, from: i64, to: i64) -> &[T] {
+    let start = elements.partition_point(|e| t(e) < from);
+    let end = start + elements[start..].partition_point(|e| t(e) < to);
+    &elements[start..end]
+}
+
+/// Cuts every range of `cuts` out of `source` in one pass over the file, each chunk written into
+/// the cuts it overlaps: memory holds a chunk and the few cuts open at a time (those within
+/// [`KEEP_OPEN_US`] of the reading position), never an index or the session, and every packet
+/// is read once however many trials there are. Writes exactly what [`copy_range`] of each
+/// range writes (the same elements, in the same order): a cut that receives an element after
+/// it was closed is rewritten with [`copy_range`]. `on_cut(k)` is called as `cuts[k]` is done.
+fn cut_session(
+    source: &Path,
+    cuts: &[Cut],
+    on_cut: &dyn Fn(usize),
+) -> Result<Vec<Copied>, ImportError> {
+    let mut copied: Vec<Copied> = cuts.iter().map(|_| Copied::default()).collect();
+    if cuts.is_empty() {
+        return Ok(copied);
+    }
+    let mut order: Vec<usize> = (0..cuts.len()).collect();
+    order.sort_by_key(|&k| (cuts[k].from, k));
+    let mut reader = evtac_events::open(source)?;
+    let (resolution, name) = (reader.resolution(), reader.source().map(str::to_owned));
+    let create = |k: usize| EventWriter::create(&cuts[k].dest, resolution, name.as_deref());
+    // Cuts open for writing (in `order`), the next one to open, the closed ones, and the latest
+    // end among the closed ones (a chunk starting after it cannot touch them).
+    let mut open: Vec<(usize, EventWriter)> = Vec::new();
+    let mut next = 0;
+    let mut closed: Vec<usize> = Vec::new();
+    let mut closed_to = i64::MIN;
+    let mut redo = vec![false; cuts.len()];
+    let mut latest = i64::MIN;
+    while let Some(chunk) = reader.next_chunk()? {
+        let firsts = [
+            chunk.events.first().map(|e| e.t),
+            chunk.imu.first().map(|s| s.t),
+            chunk.triggers.first().map(|t| t.t),
+        ];
+        let lasts = [
+            chunk.events.last().map(|e| e.t),
+            chunk.imu.last().map(|s| s.t),
+            chunk.triggers.last().map(|t| t.t),
+        ];
+        let (Some(lo), Some(hi)) = (
+            firsts.into_iter().flatten().min(),
+            lasts.into_iter().flatten().max(),
+        ) else {
+            continue;
+        };
+        while let Some(&k) = order.get(next).filter(|&&k| cuts[k].from <= hi) {
+            open.push((k, create(k)?));
+            next += 1;
+        }
+        for (k, writer) in &mut open {
+            let Cut { from, to, .. } = cuts[*k];
+            let events = within(chunk.events, |e| e.t, from, to);
+            let imu = within(chunk.imu, |s| s.t, from, to);
+            writer.write_events(events)?;
+            writer.write_imu(imu)?;
+            writer.write_triggers(within(chunk.triggers, |t| t.t, from, to))?;
+            copied[*k].events += events.len() as u64;
+            copied[*k].imu += imu.len() as u64;
+        }
+        if lo < closed_to {
+            for &k in &closed {
+                let Cut { from, to, .. } = cuts[k];
+                if !within(chunk.events, |e| e.t, from, to).is_empty()
+                    || !within(chunk.imu, |s| s.t, from, to).is_empty()
+                    || !within(chunk.triggers, |t| t.t, from, to).is_empty()
+                {
+                    redo[k] = true;
+                }
+            }
+        }
+        latest = latest.max(hi);
+        let mut i = 0;
+        while i < open.len() {
+            let k = open[i].0;
+            if cuts[k].to.saturating_add(KEEP_OPEN_US) <= latest {
+                open.remove(i).1.finish()?;
+                closed.push(k);
+                closed_to = closed_to.max(cuts[k].to);
+                on_cut(k);
+            } else {
+                i += 1;
+            }
+        }
+    }
+    for (k, writer) in open {
+        writer.finish()?;
+        on_cut(k);
+    }
+    // Ranges the recording never reached: empty files, as a range read writes them.
+    for &k in &order[next..] {
+        create(k)?.finish()?;
+        on_cut(k);
+    }
+    for (k, cut) in cuts.iter().enumerate().filter(|(k, _)| redo[*k]) {
+        copied[k] = copy_range(source, Some((cut.from, cut.to)), &cut.dest)?;
+    }
+    Ok(copied)
+}
+
 fn write_all(
     parts: &[Part],
     dir: &Path,
@@ -210,44 +330,64 @@ fn write_all(
         events: 0,
         index: None,
     };
+    let no_contact = dir.join(NO_CONTACT_FILE);
     let mut outside = Vec::new();
-    for Part { session, log } in parts {
-        for ((line, t), previous_end) in log.rows.iter().zip(log.previous_ends()) {
-            let from = t.motion_start_us.saturating_sub(config.pre_us);
-            let from = previous_end.map_or(from, |end| from.max(end));
-            // Up to and including `post_us` after the end.
-            let to = t
-                .motion_end_us
-                .saturating_add(config.post_us)
-                .saturating_add(1);
-            let copied = copy_range(session, Some((from, to)), &dir.join(&t.file))?;
+    for (p, Part { session, log }) in parts.iter().enumerate() {
+        let mut cuts: Vec<Cut> = log
+            .rows
+            .iter()
+            .zip(log.previous_ends())
+            .map(|((_, t), previous_end)| {
+                let from = t.motion_start_us.saturating_sub(config.pre_us);
+                let from = previous_end.map_or(from, |end| from.max(end));
+                // Up to and including `post_us` after the end.
+                let to = t
+                    .motion_end_us
+                    .saturating_add(config.post_us)
+                    .saturating_add(1);
+                Cut {
+                    from,
+                    to,
+                    dest: dir.join(&t.file),
+                }
+            })
+            .collect();
+        // The no-contact range of the first session is cut in the same pass.
+        if let (0, Some(NoContact::Range(from, to))) = (p, &config.no_contact) {
+            cuts.push(Cut {
+                from: *from,
+                to: *to,
+                dest: no_contact.clone(),
+            });
+        }
+        let rows = log.rows.len();
+        let copied = cut_session(session, &cuts, &|k| {
+            if k < rows {
+                on_trial();
+            }
+        })?;
+        for (((line, t), cut), copied) in log.rows.iter().zip(&cuts).zip(&copied) {
             if copied.events == 0 && copied.imu == 0 {
                 outside.push(format!(
                     "{}:{line}: column `motion_start_us` (trial `{}`): {} holds nothing from \
-                     {from} to {to} us: the motion lies outside the recording (check the times \
+                     {} to {} us: the motion lies outside the recording (check the times \
                      and --clock-offset-us)",
                     log.path.display(),
                     t.trial,
-                    session.display()
+                    session.display(),
+                    cut.from,
+                    cut.to
                 ));
             }
             summary.events += copied.events;
-            summary.index = summary.index.or(copied.index);
-            on_trial();
+            summary.index = summary.index.take().or(copied.index.clone());
         }
     }
     if !outside.is_empty() {
         return Err(ImportError::Problems(outside));
     }
-    let no_contact = dir.join(NO_CONTACT_FILE);
-    match (&config.no_contact, parts.first()) {
-        (Some(NoContact::File(path)), _) => {
-            copy_range(path, None, &no_contact)?;
-        }
-        (Some(NoContact::Range(from, to)), Some(first)) => {
-            copy_range(&first.session, Some((*from, *to)), &no_contact)?;
-        }
-        _ => {}
+    if let Some(NoContact::File(path)) = &config.no_contact {
+        copy_range(path, None, &no_contact)?;
     }
     if let Some(path) = &config.calibration {
         let dest = dir.join(CALIBRATION_FILE);
@@ -331,5 +471,96 @@ fn in_log_terms(p: &Problem, rows: &[Source], dir: &Path) -> String {
             p.problem,
             p.fix
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use evtac_events::{Event, ImuSample, Resolution, Trigger};
+
+    /// Writes a 3 s session: events every 100 us, IMU every 1250 us, a trigger every 0.5 s;
+    /// with `trailing`, all the IMU and triggers after all the events (streams trailing by up
+    /// to 3 s), else interleaved every 10 ms as a recorder writes them.
+    fn session(path: &Path, trailing: bool) {
+        let events: Vec<Event> = (0..30_000)
+            .map(|i| Event {
+                t: i * 100,
+                x: (i % 64) as u16,
+                y: (i % 48) as u16,
+                polarity: i % 3 == 0,
+            })
+            .collect();
+        let imu: Vec<ImuSample> = (0..2_400)
+            .map(|i| ImuSample {
+                t: i * 1250 + 7,
+                accelerometer: [0.0, 0.0, 1.0],
+                gyroscope: [i as f32, 0.0, 0.0],
+                temperature: 30.0,
+            })
+            .collect();
+        let triggers: Vec<Trigger> = (0..6)
+            .map(|i| Trigger {
+                t: i * 500_000 + 3,
+                kind: 1,
+            })
+            .collect();
+        let mut w = EventWriter::create(path, Some(Resolution::new(64, 48)), Some("cam")).unwrap();
+        if trailing {
+            w.write_events(&events).unwrap();
+            w.write_imu(&imu).unwrap();
+            w.write_triggers(&triggers).unwrap();
+        } else {
+            for slice in 0..300 {
+                let (a, b) = (slice * 10_000, (slice + 1) * 10_000);
+                w.write_events(within(&events, |e| e.t, a, b)).unwrap();
+                w.write_imu(within(&imu, |s| s.t, a, b)).unwrap();
+                w.write_triggers(within(&triggers, |t| t.t, a, b)).unwrap();
+            }
+        }
+        w.finish().unwrap();
+    }
+
+    #[test]
+    fn one_pass_cuts_equal_range_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        for trailing in [false, true] {
+            let source = dir.path().join(format!("session-{trailing}.aedat4"));
+            session(&source, trailing);
+            // Overlapping, nested, out of order, empty and beyond the end.
+            let ranges = [
+                (400_000, 1_300_000),
+                (0, 250_001),
+                (1_200_000, 1_250_000),
+                (1_000_000, 2_999_901),
+                (5_000_000, 6_000_000),
+                (2_000_000, 2_000_001),
+            ];
+            let cuts: Vec<Cut> = ranges
+                .iter()
+                .enumerate()
+                .map(|(k, &(from, to))| Cut {
+                    from,
+                    to,
+                    dest: dir.path().join(format!("cut-{trailing}-{k}.aedat4")),
+                })
+                .collect();
+            let copied = cut_session(&source, &cuts, &|_| {}).unwrap();
+            for (cut, copied) in cuts.iter().zip(&copied) {
+                let expected = dir.path().join("expected.aedat4");
+                let by_range = copy_range(&source, Some((cut.from, cut.to)), &expected).unwrap();
+                assert_eq!(
+                    (copied.events, copied.imu),
+                    (by_range.events, by_range.imu),
+                    "{}",
+                    cut.dest.display()
+                );
+                assert!(
+                    std::fs::read(&cut.dest).unwrap() == std::fs::read(&expected).unwrap(),
+                    "{} differs from the range read",
+                    cut.dest.display()
+                );
+            }
+        }
     }
 }

@@ -641,10 +641,18 @@ impl Verifiable for FileDataTable<'_> {
 }
 
 /// Verifies a size-prefixed `FileDataTable` buffer and returns its root.
+///
+/// The verifier's default limit of a million tables would reject the table of a recording of
+/// more than a million packets (about 80 minutes of DV's events and IMU at 10 ms a packet): a
+/// table takes at least 4 bytes, so the buffer's own size bounds the count instead.
 pub fn size_prefixed_root_as_file_data_table(
     buf: &[u8],
 ) -> Result<FileDataTable<'_>, InvalidFlatbuffer> {
-    flatbuffers::size_prefixed_root::<FileDataTable>(buf)
+    let opts = flatbuffers::VerifierOptions {
+        max_tables: (buf.len() / 4).max(1_000_000),
+        ..Default::default()
+    };
+    flatbuffers::size_prefixed_root_with_opts::<FileDataTable>(&opts, buf)
 }
 
 /// Builds a finished, size-prefixed `FileDataTable` buffer into `fbb`.
