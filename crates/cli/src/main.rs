@@ -50,6 +50,9 @@ enum Command {
     Labels(commands::labels::Args),
     /// Build static, dynamic or combined frames, potentials or pooled features at sample times.
     Represent(commands::represent::Args),
+    /// Render what the sensor and the network see (events, binary frames, pooled features) as
+    /// an animated GIF or a PNG contact sheet.
+    Render(commands::render::Args),
     /// Train the MLP regressor on a dataset's training split.
     Train(commands::train::Args),
     /// Evaluate a trained model on a dataset split (MAE overall, pitch, roll; per phase).
@@ -77,6 +80,7 @@ fn main() {
         Command::Check(args) => commands::check::run(args),
         Command::Labels(args) => commands::labels::run(args),
         Command::Represent(args) => commands::represent::run(args),
+        Command::Render(args) => commands::render::run(args),
         Command::Train(args) => commands::train::run(args),
         Command::Evaluate(args) => commands::evaluate::run(args),
         Command::Predict(args) => commands::predict::run(args),

@@ -11,6 +11,7 @@ mod labels;
 mod legacy_formats;
 mod online;
 mod predict;
+mod render;
 mod represent;
 mod reproduce;
 mod simulate;

@@ -62,6 +62,7 @@ pub mod noise;
 pub mod pipeline;
 pub mod plan;
 pub mod plots;
+pub mod render;
 pub mod report;
 pub mod repr_example;
 pub mod results;

@@ -7,7 +7,7 @@
 //! `assets/fonts/LICENSE-DejaVu.txt`), so figures look the same on every machine and need no
 //! system fonts.
 
-mod images;
+pub(crate) mod images;
 mod representations;
 mod sensor;
 
@@ -29,7 +29,7 @@ static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 /// at `(size / 2 + top) as i32`, which truncates toward zero, so at odd sizes glyphs above and
 /// below that line round in opposite directions and a decimal point sits a pixel above the
 /// digits' baseline.
-const FAMILY: &str = "sans-serif";
+pub(crate) const FAMILY: &str = "sans-serif";
 
 /// Colors of the three representations, used in every figure.
 const REPR_COLORS: [RGBColor; 3] = [
@@ -67,14 +67,14 @@ pub enum Error {
     },
 }
 
-fn register_font() -> Result<(), Error> {
+pub(crate) fn register_font() -> Result<(), Error> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE
         .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
     if ok { Ok(()) } else { Err(Error::Font) }
 }
 
-fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
+pub(crate) fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Draw {
         path: path.to_path_buf(),
         message: e.to_string(),

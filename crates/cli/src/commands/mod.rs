@@ -9,6 +9,7 @@ pub mod jobs;
 pub mod labels;
 pub mod online;
 pub mod predict;
+pub mod render;
 pub mod represent;
 pub mod reproduce;
 pub mod simulate;

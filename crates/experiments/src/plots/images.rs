@@ -1,11 +1,29 @@
 //! Pixel images on a figure: a row-major image drawn pixel for pixel (or cell for cell, scaled)
 //! with a caller's colour per value, as the image figures (`representations.png`,
-//! `sensor.png`) need and plotters offers no element for without its `image` feature.
+//! `sensor.png`) and `evtac render`'s frames need and plotters offers no element for without its `image` feature.
 
 use super::{Error, draw_err};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+
+/// ON events only in a pixel.
+pub const ON: RGBColor = RGBColor(255, 60, 60);
+/// OFF events only.
+pub const OFF: RGBColor = RGBColor(70, 140, 255);
+/// Both polarities.
+pub const BOTH: RGBColor = RGBColor(235, 90, 235);
+
+/// The colour of an events pixel that saw ON events (`on`) and/or OFF events (`off`): black when
+/// it saw none.
+pub fn polarity_color(on: bool, off: bool) -> RGBColor {
+    match (on, off) {
+        (true, true) => BOTH,
+        (true, false) => ON,
+        (false, true) => OFF,
+        (false, false) => BLACK,
+    }
+}
 
 /// Draws a `width x height` image with its top-left corner at `origin` on `area`, each pixel a
 /// `scale x scale` square coloured by `color(x, y)` (the figure at `path`).

@@ -2,18 +2,11 @@
 //! last dynamic window and the static, dynamic and combined binary frames side by side, each
 //! frame's 30x30 pooled features below it.
 
-use super::images::{draw_image, grey};
+use super::images::{BOTH, OFF, ON, draw_image, grey, polarity_color};
 use super::{Error, FAMILY, canvas, draw_err};
 use crate::results::ReprExample;
 use plotters::prelude::*;
 use std::path::Path;
-
-/// ON events only in a pixel.
-const ON: RGBColor = RGBColor(255, 60, 60);
-/// OFF events only.
-const OFF: RGBColor = RGBColor(70, 140, 255);
-/// Both polarities.
-const BOTH: RGBColor = RGBColor(235, 90, 235);
 
 /// Width of one column (a 240-pixel image and its margins).
 const COLUMN: i32 = 290;
@@ -55,14 +48,10 @@ pub fn representations(path: &Path, ex: &ReprExample) -> Result<(), Error> {
         1,
         |x, y| {
             let i = y * w + x;
-            let on = ex.on.get(i).is_some_and(|&c| c > 0);
-            let off = ex.off.get(i).is_some_and(|&c| c > 0);
-            match (on, off) {
-                (true, true) => BOTH,
-                (true, false) => ON,
-                (false, true) => OFF,
-                (false, false) => BLACK,
-            }
+            polarity_color(
+                ex.on.get(i).is_some_and(|&c| c > 0),
+                ex.off.get(i).is_some_and(|&c| c > 0),
+            )
         },
         path,
     )?;

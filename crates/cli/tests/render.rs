@@ -1,0 +1,117 @@
+//! Tests of `evtac render`: the written GIF and PNG decoded again (the `gif` crate's decoder,
+//! the `png` crate) for frame count, size, and the ON event's pixel lit in its frame only.
+
+use crate::common::{evtac, run_ok};
+use std::fs::File;
+use std::path::Path;
+
+/// Frame size for the default panels (events, static, dynamic, combined): four 240-pixel
+/// columns with 10-pixel margins; a 26-pixel header, a 22-pixel title and a 10-pixel margin.
+const SIZE: (usize, usize) = (10 + 4 * 250, 26 + 22 + 240 + 10);
+/// Where crop pixel (50, 60) of the events panel lands in a frame.
+const ON_PIXEL: (usize, usize) = (10 + 50, 48 + 60);
+/// The events panel's ON colour.
+const ON: [u8; 3] = [255, 60, 60];
+
+/// A 240x240 CSV recording (read as already cropped): one ON event at (50, 60) at 150 ms, and
+/// OFF events at (100, 100) through the range.
+fn write_recording(path: &Path) {
+    let mut text = String::from("t,x,y,p\n");
+    for k in 0..30 {
+        text.push_str(&format!("{},100,100,0\n", k * 10_000));
+    }
+    text.push_str("150000,50,60,1\n");
+    let mut lines: Vec<&str> = text.lines().skip(1).collect();
+    lines.sort_by_key(|l| l.split(',').next().and_then(|t| t.parse::<i64>().ok()));
+    std::fs::write(path, format!("t,x,y,p\n{}\n", lines.join("\n"))).unwrap();
+}
+
+fn render(dir: &Path, out: &str, extra: &[&str]) -> std::path::PathBuf {
+    let input = dir.join("rec.csv");
+    write_recording(&input);
+    let out = dir.join(out);
+    let mut args = vec![
+        "render",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--from-us",
+        "0",
+        "--to-us",
+        "300000",
+        "--fps",
+        "10",
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args);
+    out
+}
+
+#[test]
+fn gif_has_one_frame_per_interval_and_the_on_event_lit_in_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = render(dir.path(), "r.gif", &[]);
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options.read_info(File::open(&out).unwrap()).unwrap();
+    assert_eq!(
+        (usize::from(decoder.width()), usize::from(decoder.height())),
+        SIZE
+    );
+    let mut on_pixel = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!((usize::from(frame.width), usize::from(frame.height)), SIZE);
+        assert_eq!(frame.delay, 10, "10 fps is 10 hundredths of a second");
+        let i = 4 * (ON_PIXEL.1 * SIZE.0 + ON_PIXEL.0);
+        on_pixel.push([frame.buffer[i], frame.buffer[i + 1], frame.buffer[i + 2]]);
+    }
+    // Intervals (0, 100], (100, 200], (200, 300] ms: the ON event at 150 ms is in the second.
+    assert_eq!(on_pixel, vec![[0, 0, 0], ON, [0, 0, 0]]);
+}
+
+#[test]
+fn png_sheet_holds_every_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = render(dir.path(), "r.png", &[]);
+    let decoder = png::Decoder::new(std::io::BufReader::new(File::open(&out).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    // Three frames in a grid about as tall as wide: 1 column (frames are 3.4 times wider than
+    // tall), 3 rows.
+    assert_eq!(
+        (info.width as usize, info.height as usize),
+        (SIZE.0, 3 * SIZE.1)
+    );
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let at = |x: usize, y: usize| {
+        let i = 3 * (y * SIZE.0 + x);
+        [buf[i], buf[i + 1], buf[i + 2]]
+    };
+    assert_eq!(at(ON_PIXEL.0, SIZE.1 + ON_PIXEL.1), ON);
+    assert_eq!(at(ON_PIXEL.0, ON_PIXEL.1), [0, 0, 0]);
+}
+
+#[test]
+fn unknown_panel_and_format_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("rec.csv");
+    write_recording(&input);
+    let out = evtac()
+        .args(["render", input.to_str().unwrap(), "--out"])
+        .arg(dir.path().join("r.gif"))
+        .args(["--panels", "events,colour"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown panel `colour`"), "{err}");
+    let out = evtac()
+        .args(["render", input.to_str().unwrap(), "--out"])
+        .arg(dir.path().join("r.mp3"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("r.mp3: unknown output format"), "{err}");
+}
