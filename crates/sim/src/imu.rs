@@ -37,11 +37,12 @@ pub fn simulate_imu(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut drift_rng = ChaCha8Rng::seed_from_u64(clock_seed);
     let offset_us = params.clock_offset_sd_us * gaussian(&mut drift_rng);
-    let gyro_bias: [f64; 3] = std::array::from_fn(|_| params.gyro_bias_deg_s * gaussian(&mut rng));
+    // Mutable: the bias walks during the trial (below).
+    let mut gyro_bias: [f64; 3] =
+        std::array::from_fn(|_| params.gyro_bias_deg_s * gaussian(&mut rng));
     let gyro_scale: [f64; 3] =
         std::array::from_fn(|_| 1.0 + params.gyro_scale_error * gaussian(&mut rng));
     let accel_bias: [f64; 3] = std::array::from_fn(|_| params.accel_bias_g * gaussian(&mut rng));
-    let mut gyro_bias = gyro_bias;
     let period_us = (1e6 / params.rate_hz.max(1.0)).round().max(1.0) as i64;
     let end_us = (motion.end_s * 1e6).round() as i64;
     let quantise = |v: f64, lsb: f64| {
