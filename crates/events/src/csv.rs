@@ -201,6 +201,15 @@ impl<R: BufRead> CsvReader<R> {
         self.offset
     }
 
+    /// Every remaining event, read chunk by chunk (the whole file for a fresh reader).
+    pub fn read_to_end(mut self) -> Result<Vec<Event>, CsvError> {
+        let mut out = Vec::new();
+        while let Some(chunk) = self.next_chunk()? {
+            out.extend_from_slice(chunk);
+        }
+        Ok(out)
+    }
+
     /// The next chunk of events; `Ok(None)` at the end of the file. Blank lines are skipped.
     pub fn next_chunk(&mut self) -> Result<Option<&[Event]>, CsvError> {
         self.events.clear();
@@ -340,12 +349,7 @@ mod tests {
     use super::*;
 
     fn read_all(bytes: &[u8]) -> Result<Vec<Event>, CsvError> {
-        let mut reader = CsvReader::from_slice(bytes)?;
-        let mut out = Vec::new();
-        while let Some(chunk) = reader.next_chunk()? {
-            out.extend_from_slice(chunk);
-        }
-        Ok(out)
+        CsvReader::from_slice(bytes)?.read_to_end()
     }
 
     #[test]

@@ -293,6 +293,15 @@ impl<R: Read> NpyReader<R> {
         self.data_start + self.done * self.layout.itemsize as u64
     }
 
+    /// Every remaining event, read chunk by chunk (the whole file for a fresh reader).
+    pub fn read_to_end(mut self) -> Result<Vec<Event>, NpyError> {
+        let mut out = Vec::new();
+        while let Some(chunk) = self.next_chunk()? {
+            out.extend_from_slice(chunk);
+        }
+        Ok(out)
+    }
+
     /// The next chunk of events; `Ok(None)` after the last declared record (checking that no
     /// data follows).
     pub fn next_chunk(&mut self) -> Result<Option<&[Event]>, NpyError> {
@@ -447,12 +456,7 @@ mod tests {
     }
 
     fn read_all(bytes: &[u8]) -> Result<Vec<Event>, NpyError> {
-        let mut r = NpyReader::from_slice(bytes)?;
-        let mut out = Vec::new();
-        while let Some(chunk) = r.next_chunk()? {
-            out.extend_from_slice(chunk);
-        }
-        Ok(out)
+        NpyReader::from_slice(bytes)?.read_to_end()
     }
 
     #[test]

@@ -64,19 +64,32 @@ pub fn jobs(
     seed: u64,
     out: &Path,
 ) -> Vec<SeedJob> {
+    let seeds = seeds(seed, plan.seeds);
+    let train = (plan.epochs, Sampling::MOTION, [Phase::Motion].as_slice());
+    seed_jobs(reprs, &seeds, train, |name, s| model_dir(out, name, s))
+}
+
+/// One job per (representation, seed), in that order, each training for `epochs` on `sampling`'s
+/// points of `phases`, in the folder `dir` gives (Experiments 1 and 2 differ only in those).
+pub(crate) fn seed_jobs(
+    reprs: &[(&'static str, ReprConfig)],
+    seeds: &[u64],
+    (epochs, sampling, phases): (usize, Sampling, &[Phase]),
+    dir: impl Fn(&str, u64) -> PathBuf,
+) -> Vec<SeedJob> {
     let mut v = Vec::new();
-    for &(name, config) in reprs {
-        for s in seeds(seed, plan.seeds) {
+    for &(name, repr) in reprs {
+        for &seed in seeds {
             v.push(SeedJob {
                 name,
                 spec: TrainSpec {
-                    repr: config,
-                    seed: s,
-                    epochs: plan.epochs,
-                    sampling: Sampling::MOTION,
-                    phases: vec![Phase::Motion],
+                    repr,
+                    seed,
+                    epochs,
+                    sampling,
+                    phases: phases.to_vec(),
                 },
-                dir: model_dir(out, name, s),
+                dir: dir(name, seed),
             });
         }
     }
@@ -151,12 +164,7 @@ pub fn run_as(
     run: &RunContext<'_>,
     stages: (FeatureSet, Stage),
 ) -> Result<Vec<Exp1Repr>, Error> {
-    let RunContext {
-        plan,
-        seed,
-        models: out,
-        progress,
-    } = *run;
+    let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
     let jobs = jobs(reprs, plan, seed, out);
     features_then_training(
         cache,

@@ -11,7 +11,7 @@ use crate::results::{Exp2Cell, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
-use crate::training::{self, Error, TrainSpec};
+use crate::training::{self, Error};
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -38,26 +38,16 @@ pub fn jobs(
     seed: u64,
     out: &Path,
 ) -> Vec<SeedJob> {
+    let seeds = exp1::seeds(seed, plan.exp2_seeds);
     let mut v = Vec::new();
     for (setting, phases) in [
         (SETTINGS[1].0, vec![Phase::Motion]),
         (SETTINGS[2].0, vec![Phase::Motion, Phase::Stop]),
     ] {
-        for &(name, config) in reprs {
-            for s in exp1::seeds(seed, plan.exp2_seeds) {
-                v.push(SeedJob {
-                    name,
-                    spec: TrainSpec {
-                        repr: config,
-                        seed: s,
-                        epochs: plan.epochs,
-                        sampling: Sampling::WITH_STOP,
-                        phases: phases.clone(),
-                    },
-                    dir: model_dir(out, setting, name, s),
-                });
-            }
-        }
+        let train = (plan.epochs, Sampling::WITH_STOP, phases.as_slice());
+        v.extend(exp1::seed_jobs(reprs, &seeds, train, |name, s| {
+            model_dir(out, setting, name, s)
+        }));
     }
     v
 }
@@ -70,12 +60,7 @@ pub fn run(
     reprs: &[(&'static str, ReprConfig)],
     run: &RunContext<'_>,
 ) -> Result<Vec<Exp2Cell>, Error> {
-    let RunContext {
-        plan,
-        seed,
-        models: out,
-        progress,
-    } = *run;
+    let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
     let jobs = jobs(reprs, plan, seed, out);
     let stages = (FeatureSet::Exp2, Stage::Exp2Training);
     let sampling = Sampling::WITH_STOP;

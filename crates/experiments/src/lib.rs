@@ -6,7 +6,7 @@
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
 //!   calibration and mask come from its files or were opted out of.
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`);
-//!   [`label_check`]: its labels against the commanded stop angles and the ground truth.
+//!   [`LabelCheck`]: its labels against the commanded stop angles and the ground truth.
 //! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
 //!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]), or by the motions found
 //!   in its gyroscope ([`motions`]); several sessions, or a folder of per-trial files
@@ -21,11 +21,15 @@
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
-//! - [`plan`], [`tuning`], [`exp1`], [`noise`], [`exp2`], [`exp3`], [`latency`], [`examples`]: the
-//!   experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and [`sensor_view`] (the
-//!   sensor at rest and in contact) the data of two illustrative figures; [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm
-//!   cluster); [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the
-//!   PNG figures; [`choices`] lists the values evtac chose where the paper states none.
+//! - [`plan`], [`tuning`], [`exp1`], [`latency`] and the crate's own `noise`, `exp2`, `exp3` and
+//!   `examples`: the experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and
+//!   [`sensor_view`] (the sensor at rest and in contact) the data of two illustrative figures;
+//!   [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm cluster);
+//!   [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the PNG
+//!   figures; [`choices`] lists the values evtac chose where the paper states none.
+//!
+//! Modules that only the pipeline calls (`noise`, `exp2`, `exp3`, `examples`, `label_check`,
+//! `io`) are private: their results are in [`results`], their errors in [`pipeline::Error`].
 //!
 //! ```no_run
 //! use evtac_experiments::jobs::Quiet;
@@ -46,19 +50,19 @@ pub mod check;
 pub mod choices;
 pub mod context;
 pub mod dataset;
-pub mod examples;
+mod examples;
 pub mod exp1;
-pub mod exp2;
-pub mod exp3;
+mod exp2;
+mod exp3;
 pub mod import;
 pub mod imu_sync;
 pub mod inputs;
-pub mod io;
+mod io;
 pub mod jobs;
-pub mod label_check;
+mod label_check;
 pub mod latency;
 pub mod motions;
-pub mod noise;
+mod noise;
 pub mod pipeline;
 pub mod plan;
 pub mod plots;
@@ -77,3 +81,6 @@ pub mod sync;
 pub mod training;
 pub mod trial_folder;
 pub mod tuning;
+
+pub use io::IoError;
+pub use label_check::LabelCheck;

@@ -56,10 +56,9 @@ pub struct Plan {
 pub const NOISE_LEVELS: [f64; 3] = [0.0, 1.0, 3.0];
 
 impl Plan {
-    /// The plan of a scale.
+    /// The plan of a scale. `small` and `tiny` take the rest (the cross's centers, the latency
+    /// intervals, the noise levels) from `paper`.
     pub fn for_scale(scale: Scale) -> Plan {
-        let paper_center_static = (1000.0, 2.0);
-        let paper_center_dynamic = (640.0, 0);
         match scale {
             Scale::Paper => Plan {
                 scale,
@@ -68,8 +67,9 @@ impl Plan {
                 dynamic_windows_ms: vec![10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0, 1280.0],
                 dynamic_thresholds: vec![0, 1, 2, 3, 4],
                 full_grid: true,
-                static_center: paper_center_static,
-                dynamic_center: paper_center_dynamic,
+                // The paper's chosen settings (tau 1000 ms, threshold 2; window 640 ms, 0).
+                static_center: (1000.0, 2.0),
+                dynamic_center: (640.0, 0),
                 tuning_epochs: 100,
                 epochs: 100,
                 seeds: 10,
@@ -85,15 +85,12 @@ impl Plan {
                 dynamic_windows_ms: vec![40.0, 160.0, 640.0, 1280.0],
                 dynamic_thresholds: vec![0, 1, 2, 4],
                 full_grid: true,
-                static_center: paper_center_static,
-                dynamic_center: paper_center_dynamic,
                 tuning_epochs: 30,
                 epochs: 60,
                 seeds: 5,
                 exp2_seeds: 3,
                 latency_trials: 20,
-                latency_intervals_ms: vec![1, 2, 5, 10],
-                noise_levels: NOISE_LEVELS.to_vec(),
+                ..Plan::for_scale(Scale::Paper)
             },
             Scale::Tiny => Plan {
                 scale,
@@ -102,15 +99,12 @@ impl Plan {
                 dynamic_windows_ms: vec![80.0, 640.0],
                 dynamic_thresholds: vec![0, 2],
                 full_grid: false,
-                static_center: paper_center_static,
-                dynamic_center: paper_center_dynamic,
                 tuning_epochs: 2,
                 epochs: 3,
                 seeds: 2,
                 exp2_seeds: 2,
                 latency_trials: 2,
-                latency_intervals_ms: vec![1, 2, 5, 10],
-                noise_levels: NOISE_LEVELS.to_vec(),
+                ..Plan::for_scale(Scale::Paper)
             },
         }
     }

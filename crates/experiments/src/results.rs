@@ -361,7 +361,7 @@ pub struct Results {
     /// Experiment 2's labels against the commanded stop angles and the ground truth (absent
     /// without Experiment 2, and from older results).
     #[serde(default)]
-    pub labels: Option<crate::label_check::LabelCheck>,
+    pub labels: Option<crate::LabelCheck>,
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,

@@ -95,12 +95,7 @@ pub fn tune(
     kind: Kind,
     run: &RunContext<'_>,
 ) -> Result<Tuning, Error> {
-    let RunContext {
-        plan,
-        seed,
-        models: out,
-        progress,
-    } = *run;
+    let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
     let points = grid(plan, kind);
     let ds = cache.dataset();
     let trials = ds.trials(&[splits.get(Split::Train), splits.get(Split::Val)].concat())?;

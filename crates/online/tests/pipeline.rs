@@ -64,6 +64,18 @@ fn model(dir: &std::path::Path) -> Model {
     Model::load(dir).unwrap()
 }
 
+/// A synthetic stream of `duration_us` (seeded) for a server that sends it in two halves: the
+/// events, their packets, the index of the second half's first packet, and a listener on a free
+/// local port with that port.
+fn halves(seed: u64, duration_us: i64) -> (Vec<Event>, Stream, usize, TcpListener, u16) {
+    let events: Vec<Event> = Synthetic::new(seed, 300_000.0, 1000, duration_us).collect();
+    let stream = network_stream(&events);
+    let half = stream.packets.len() / 2;
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    (events, stream, half, listener, port)
+}
+
 fn quick_network(attempts: u32, stall_ms: u64) -> NetworkOptions {
     NetworkOptions {
         backoff: Backoff {
@@ -112,11 +124,7 @@ fn run_tcp(
 
 #[test]
 fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
-    let events = Synthetic::new(1, 300_000.0, 1000, 200_000).collect();
-    let stream = network_stream(&events);
-    let half = stream.packets.len() / 2;
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let port = listener.local_addr().unwrap().port();
+    let (events, stream, half, listener, port) = halves(1, 200_000);
     let server = std::thread::spawn(move || {
         // First connection: the first half of the packets, then the server hangs up.
         let (mut c, _) = listener.accept().unwrap();
@@ -149,11 +157,7 @@ fn a_dropped_connection_is_retried_and_nothing_that_arrived_is_lost() {
 
 #[test]
 fn a_stalled_stream_is_reported_and_reopened() {
-    let events = Synthetic::new(2, 300_000.0, 1000, 100_000).collect();
-    let stream = network_stream(&events);
-    let half = stream.packets.len() / 2;
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let port = listener.local_addr().unwrap().port();
+    let (events, stream, half, listener, port) = halves(2, 100_000);
     let server = std::thread::spawn(move || {
         let (mut c, _) = listener.accept().unwrap();
         stream.send(&mut c, &stream.packets[..half]);
@@ -332,11 +336,7 @@ struct ThenSilence {
 }
 
 impl EventSource for ThenSilence {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<input::ChunkInfo>, input::InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, notify: &mut dyn FnMut(Notice)) -> input::Next {
         match self.inner.next_chunk(out, notify)? {
             Some(info) => Ok(Some(info)),
             None => loop {

@@ -35,16 +35,7 @@ pub struct Pool8 {
 impl Pool8 {
     /// An all-zero frame of `resolution`, whose sides must be non-zero multiples of 8.
     pub fn new(resolution: Resolution) -> Result<Self, ReprError> {
-        let (w, h) = (
-            usize::from(resolution.width),
-            usize::from(resolution.height),
-        );
-        if w == 0 || h == 0 || w % CELL != 0 || h % CELL != 0 {
-            return Err(ReprError::FrameNotPoolable {
-                width: resolution.width,
-                height: resolution.height,
-            });
-        }
+        let (w, h) = poolable_sides(resolution)?;
         let cells_x = w / CELL;
         let cell_of = (0..w * h)
             .map(|p| ((p / w / CELL) * cells_x + (p % w) / CELL) as u32)
@@ -122,9 +113,9 @@ impl Pool8 {
     }
 }
 
-/// Straightforward 8x8 mean pooling of a binary (0/non-zero) frame, row-major over cells: the
-/// reference [`Pool8`] is tested against, and a one-shot helper.
-pub fn pool8(resolution: Resolution, frame: &[u8]) -> Result<Vec<f32>, ReprError> {
+/// The frame's sides in pixels, if both are non-zero multiples of [`CELL`] (the one check
+/// [`Pool8`] and [`pool8`] share).
+fn poolable_sides(resolution: Resolution) -> Result<(usize, usize), ReprError> {
     let (w, h) = (
         usize::from(resolution.width),
         usize::from(resolution.height),
@@ -135,6 +126,13 @@ pub fn pool8(resolution: Resolution, frame: &[u8]) -> Result<Vec<f32>, ReprError
             height: resolution.height,
         });
     }
+    Ok((w, h))
+}
+
+/// Straightforward 8x8 mean pooling of a binary (0/non-zero) frame, row-major over cells: the
+/// reference [`Pool8`] is tested against, and a one-shot helper.
+pub fn pool8(resolution: Resolution, frame: &[u8]) -> Result<Vec<f32>, ReprError> {
+    let (w, h) = poolable_sides(resolution)?;
     if frame.len() != w * h {
         return Err(ReprError::BufferLength {
             what: "frame pixels",

@@ -12,7 +12,9 @@ use proptest::prelude::*;
 
 const RES: Resolution = Resolution::new(24, 16);
 
-fn configs() -> Vec<ReprConfig> {
+/// The static and dynamic settings the configs below vary: time constants short enough for the
+/// random streams' microsecond spacing to exercise decay and window exits.
+fn base_configs() -> (StaticConfig, DynamicConfig) {
     let s = StaticConfig {
         tau_ms: 0.2,
         ..StaticConfig::default()
@@ -21,6 +23,11 @@ fn configs() -> Vec<ReprConfig> {
         window_ms: 0.15,
         count_threshold: 0,
     };
+    (s, d)
+}
+
+fn configs() -> Vec<ReprConfig> {
+    let (s, d) = base_configs();
     vec![
         ReprConfig::Static(s),
         ReprConfig::Static(StaticConfig {
@@ -81,14 +88,7 @@ fn configs() -> Vec<ReprConfig> {
 /// Combined configs whose accumulators can take events as they leave the window (see
 /// `FeatureExtractor::deferring_accumulation`), next to some that cannot.
 fn deferrable_configs() -> Vec<ReprConfig> {
-    let s = StaticConfig {
-        tau_ms: 0.2,
-        ..StaticConfig::default()
-    };
-    let d = DynamicConfig {
-        window_ms: 0.15,
-        count_threshold: 0,
-    };
+    let (s, d) = base_configs();
     let short = DynamicConfig {
         window_ms: 0.04,
         ..d

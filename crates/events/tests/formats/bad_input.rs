@@ -21,6 +21,7 @@ use evtac_events::npy::NpyWriter;
 use evtac_events::{Event, Resolution};
 
 use crate::alloc::largest_allocation_during;
+use crate::common::with_dict;
 
 /// The sensor every sample declares.
 pub(crate) const SENSOR: Resolution = Resolution::new(64, 32);
@@ -471,18 +472,6 @@ fn npy_bytes(events: &[Event]) -> Vec<u8> {
     let mut writer = NpyWriter::new(std::io::Cursor::new(Vec::new())).unwrap();
     writer.write_events(events).unwrap();
     writer.finish().unwrap().into_inner()
-}
-
-/// Replaces the header dictionary of an NPY 1.0 file by `dict` (padded to the same length).
-fn with_dict(bytes: &[u8], dict: &str) -> Vec<u8> {
-    let len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
-    assert!(dict.len() < len, "dictionary too long");
-    let mut out = bytes.to_vec();
-    let mut text = dict.as_bytes().to_vec();
-    text.resize(len - 1, b' ');
-    text.push(b'\n');
-    out[10..10 + len].copy_from_slice(&text);
-    out
 }
 
 #[test]

@@ -13,12 +13,7 @@ fn write(events: &[Event]) -> Vec<u8> {
 }
 
 fn read_all<R: std::io::BufRead>(source: R) -> Result<Vec<Event>, evtac_events::csv::CsvError> {
-    let mut r = CsvReader::new(source)?;
-    let mut out = Vec::new();
-    while let Some(chunk) = r.next_chunk()? {
-        out.extend_from_slice(chunk);
-    }
-    Ok(out)
+    CsvReader::new(source)?.read_to_end()
 }
 
 #[test]

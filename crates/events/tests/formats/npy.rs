@@ -5,7 +5,7 @@ use evtac_events::npy::{NpyError, NpyReader, NpyWriter};
 use evtac_testkit::run_python;
 use proptest::prelude::*;
 
-use crate::common::{READ_SIZES, Trickle, synthetic_events};
+use crate::common::{self, READ_SIZES, Trickle, synthetic_events};
 
 fn write(events: &[Event]) -> Vec<u8> {
     let mut w = NpyWriter::new(std::io::Cursor::new(Vec::new())).unwrap();
@@ -14,12 +14,7 @@ fn write(events: &[Event]) -> Vec<u8> {
 }
 
 fn read_all<R: std::io::Read>(source: R) -> Result<Vec<Event>, NpyError> {
-    let mut r = NpyReader::new(source)?;
-    let mut out = Vec::new();
-    while let Some(chunk) = r.next_chunk()? {
-        out.extend_from_slice(chunk);
-    }
-    Ok(out)
+    NpyReader::new(source)?.read_to_end()
 }
 
 #[test]
@@ -137,13 +132,7 @@ proptest! {
 
 /// The header of `write(&[Event::default(); 2])` with its dictionary replaced by `dict`.
 fn with_dict(dict: &str) -> Vec<u8> {
-    let mut bytes = write(&[Event::default(); 2]);
-    let len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
-    let mut text = dict.as_bytes().to_vec();
-    text.resize(len - 1, b' ');
-    text.push(b'\n');
-    bytes[10..10 + len].copy_from_slice(&text);
-    bytes
+    common::with_dict(&write(&[Event::default(); 2]), dict)
 }
 
 /// Found by review and the `npy` fuzz target's seeds: two padding fields of `usize::MAX` bytes

@@ -1,6 +1,6 @@
 //! A recording on disk, streamed in the chunks its reader decodes (`evtac_events::open`).
 
-use super::{ChunkInfo, EventSource, InputError};
+use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
 use evtac_events::{Event, EventReader, Resolution};
 use std::path::Path;
@@ -36,11 +36,7 @@ impl FileSource {
 }
 
 impl EventSource for FileSource {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        _notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, _notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         let chunk = self
             .reader

@@ -1,7 +1,7 @@
 //! Events already in memory, handed out in fixed-size chunks: for tests, benchmarks, and
 //! replaying a recording that was read whole.
 
-use super::{ChunkInfo, EventSource, InputError};
+use super::{ChunkInfo, EventSource, Next};
 use crate::Notice;
 use evtac_events::Event;
 
@@ -25,11 +25,7 @@ impl MemorySource {
 }
 
 impl EventSource for MemorySource {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        _notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, _notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         if self.pos >= self.events.len() {
             return Ok(None);

@@ -30,6 +30,10 @@ pub struct ChunkInfo {
     pub horizon: Option<i64>,
 }
 
+/// What [`EventSource::next_chunk`] returns: the chunk's [`ChunkInfo`], `None` at the end of
+/// the stream.
+pub type Next = Result<Option<ChunkInfo>, InputError>;
+
 /// A stream of event chunks.
 ///
 /// The caller owns the buffer a chunk lands in (the pipeline recycles a pool of them), so a
@@ -38,19 +42,11 @@ pub trait EventSource: Send {
     /// Replaces the contents of `out` with the next chunk of events (full-sensor coordinates,
     /// time order; possibly empty); `Ok(None)` at the end of the stream. May block until data
     /// arrives. `notify` receives state changes worth telling the user (e.g. a reconnection).
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError>;
+    fn next_chunk(&mut self, out: &mut Vec<Event>, notify: &mut dyn FnMut(Notice)) -> Next;
 }
 
 impl<S: EventSource + ?Sized> EventSource for Box<S> {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, notify: &mut dyn FnMut(Notice)) -> Next {
         (**self).next_chunk(out, notify)
     }
 }

@@ -8,7 +8,7 @@
 //! loss never arrived and is not. After the last attempt fails the stream ends normally, so the
 //! estimates up to the last event are still emitted.
 
-use super::{ChunkInfo, EventSource, InputError};
+use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::{Backoff, Notice};
 use evtac_events::aedat::{AedatError, AedatReader};
 use evtac_events::{Event, Resolution};
@@ -202,11 +202,7 @@ impl NetworkSource {
 }
 
 impl EventSource for NetworkSource {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         loop {
             if self.ended {

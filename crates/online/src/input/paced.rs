@@ -7,7 +7,7 @@
 //! slice's end has been delivered (its *horizon*), so estimates in quiet stretches are not held
 //! back waiting for the next event.
 
-use super::{ChunkInfo, EventSource, InputError};
+use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
 use evtac_events::Event;
 use std::time::{Duration, Instant};
@@ -81,11 +81,7 @@ impl<S: EventSource> Paced<S> {
 }
 
 impl<S: EventSource> EventSource for Paced<S> {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         let (first_t, start) = match self.origin {
             Some(origin) => origin,

@@ -4,7 +4,7 @@
 //! size-prefixed `IOHeader` (file identifier `IOHE` at bytes 8..12), or anything else read as
 //! `t,x,y,p` CSV.
 
-use super::{ChunkInfo, EventSource, InputError};
+use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
 use evtac_events::aedat::{AedatReader, MAGIC};
 use evtac_events::csv::CsvReader;
@@ -105,11 +105,7 @@ impl StdinSource {
 }
 
 impl EventSource for StdinSource {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        _notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, _notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         let format = |reason: String| InputError::Format {
             input: self.name.clone(),

@@ -5,7 +5,7 @@
 
 use evtac_events::{Event, Resolution};
 use evtac_learn::{Model, ModelBundle, Representation};
-use evtac_online::input::{ChunkInfo, EventSource, InputError, MemorySource};
+use evtac_online::input::{ChunkInfo, EventSource, MemorySource, Next};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::{Estimate, Estimator, Notice};
 use evtac_repr::{DynamicConfig, Mask, ReprConfig, StaticConfig};
@@ -156,11 +156,7 @@ impl Synthetic {
 }
 
 impl EventSource for Synthetic {
-    fn next_chunk(
-        &mut self,
-        out: &mut Vec<Event>,
-        _notify: &mut dyn FnMut(Notice),
-    ) -> Result<Option<ChunkInfo>, InputError> {
+    fn next_chunk(&mut self, out: &mut Vec<Event>, _notify: &mut dyn FnMut(Notice)) -> Next {
         out.clear();
         if self.t >= self.end_us {
             return Ok(None);
