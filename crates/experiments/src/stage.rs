@@ -87,10 +87,15 @@ mod cost {
     pub const SIMULATE_TRIAL: f64 = 0.116;
     /// Features of one trial for every configuration of one pass.
     pub const FEATURES_TRIAL: f64 = 0.03;
-    /// One training epoch of one run, per training trial (Experiment 1 at the small scale,
-    /// 15 runs x 60 epochs on 88 training trials, took 53 s on 2 cores with the sparse backward
-    /// pass: 0.06 s per epoch).
-    pub const EPOCH_TRAIN_TRIAL: f64 = 0.0007;
+    /// One training epoch of one run: a fixed part (validation, the checkpoint, the epoch's
+    /// shuffle and batching) and a part per training trial (its 50 samples). Fitted to two
+    /// measurements on 2 cores running two runs side by side: the small scale (88 training
+    /// trials, 0.06 s per epoch per run and core) and the paper's (700 trials, 0.10-0.16 s,
+    /// `docs/performance.md`). One figure per trial alone, fitted to the small scale, made the
+    /// paper scale's training 3-4 times too expensive and its ETA hours too long.
+    pub const EPOCH_FIXED: f64 = 0.05;
+    /// See [`EPOCH_FIXED`].
+    pub const EPOCH_TRAIN_TRIAL: f64 = 0.000115;
     /// One latency measurement (representation x interval) per test trial.
     pub const LATENCY_TRIAL: f64 = 0.033;
     /// Share of a dataset's trials in its training split.
@@ -167,7 +172,8 @@ impl CostModel {
     pub fn seconds(&self, stage: Stage, units: u64) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
         let units = units as f64;
-        let train = |n: usize| n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
+        let train =
+            |n: usize| cost::EPOCH_FIXED + n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
         match stage {
             Stage::Simulating(_) | Stage::NoiseSimulating => units * cost::SIMULATE_TRIAL,
             Stage::Features(_) => units * cost::FEATURES_TRIAL,
