@@ -50,8 +50,8 @@ enum Command {
     Labels(commands::labels::Args),
     /// Build static, dynamic or combined frames, potentials or pooled features at sample times.
     Represent(commands::represent::Args),
-    /// Render what the sensor and the network see (events, binary frames, pooled features) as
-    /// an animated GIF or a PNG contact sheet.
+    /// Render what the sensor and the network see (events, binary frames, pooled features, a
+    /// model's estimates) as an animated GIF, an MP4 video or a PNG contact sheet.
     Render(commands::render::Args),
     /// Train the MLP regressor on a dataset's training split.
     Train(commands::train::Args),

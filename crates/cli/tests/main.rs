@@ -12,6 +12,8 @@ mod legacy_formats;
 mod online;
 mod predict;
 mod render;
+mod render_model;
+mod render_mp4;
 mod represent;
 mod reproduce;
 mod simulate;

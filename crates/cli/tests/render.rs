@@ -1,5 +1,6 @@
 //! Tests of `evtac render`: the written GIF and PNG decoded again (the `gif` crate's decoder,
-//! the `png` crate) for frame count, size, and the ON event's pixel lit in its frame only.
+//! the `png` crate, and Pillow as a decoder from outside Rust) for frame count, size, frame
+//! duration, and the ON event's pixel lit in its frame only.
 
 use crate::common::{evtac, run_ok};
 use std::fs::File;
@@ -7,15 +8,15 @@ use std::path::Path;
 
 /// Frame size for the default panels (events, static, dynamic, combined): four 240-pixel
 /// columns with 10-pixel margins; a 26-pixel header, a 22-pixel title and a 10-pixel margin.
-const SIZE: (usize, usize) = (10 + 4 * 250, 26 + 22 + 240 + 10);
+pub const SIZE: (usize, usize) = (10 + 4 * 250, 26 + 22 + 240 + 10);
 /// Where crop pixel (50, 60) of the events panel lands in a frame.
-const ON_PIXEL: (usize, usize) = (10 + 50, 48 + 60);
+pub const ON_PIXEL: (usize, usize) = (10 + 50, 48 + 60);
 /// The events panel's ON colour.
 const ON: [u8; 3] = [255, 60, 60];
 
 /// A 240x240 CSV recording (read as already cropped): one ON event at (50, 60) at 150 ms, and
 /// OFF events at (100, 100) through the range.
-fn write_recording(path: &Path) {
+pub fn write_recording(path: &Path) {
     let mut text = String::from("t,x,y,p\n");
     for k in 0..30 {
         text.push_str(&format!("{},100,100,0\n", k * 10_000));
@@ -26,10 +27,19 @@ fn write_recording(path: &Path) {
     std::fs::write(path, format!("t,x,y,p\n{}\n", lines.join("\n"))).unwrap();
 }
 
-fn render(dir: &Path, out: &str, extra: &[&str]) -> std::path::PathBuf {
+/// Renders `write_recording`'s recording from 0 to 300 ms at 10 fps (three frames) to `out` in
+/// `dir`, with `extra` arguments.
+pub fn render(dir: &Path, out: &str, extra: &[&str]) -> std::path::PathBuf {
     let input = dir.join("rec.csv");
     write_recording(&input);
     let out = dir.join(out);
+    render_file(&input, &out, extra);
+    out
+}
+
+/// Renders the recording `input` from 0 to 300 ms at 10 fps (three frames) to `out`, with
+/// `extra` arguments.
+pub fn render_file(input: &Path, out: &Path, extra: &[&str]) {
     let mut args = vec![
         "render",
         input.to_str().unwrap(),
@@ -44,7 +54,6 @@ fn render(dir: &Path, out: &str, extra: &[&str]) -> std::path::PathBuf {
     ];
     args.extend_from_slice(extra);
     run_ok(&args);
-    out
 }
 
 #[test]
@@ -92,26 +101,93 @@ fn png_sheet_holds_every_frame() {
     assert_eq!(at(ON_PIXEL.0, ON_PIXEL.1), [0, 0, 0]);
 }
 
+/// Pillow's view of a GIF: size, frame count, each frame's duration (ms) and the colour of
+/// pixel (x, y) in each frame.
+const PILLOW_GIF: &str = r#"
+import sys
+from PIL import Image, ImageSequence
+x, y = int(sys.argv[2]), int(sys.argv[3])
+with Image.open(sys.argv[1]) as im:
+    print(im.format, *im.size, im.n_frames)
+    for frame in ImageSequence.Iterator(im):
+        print(frame.info["duration"], *frame.convert("RGB").getpixel((x, y)))
+"#;
+
 #[test]
-fn unknown_panel_and_format_are_named() {
+fn pillow_reads_the_gif_frames_duration_and_the_lit_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = render(dir.path(), "r.gif", &[]);
+    let (x, y) = (ON_PIXEL.0.to_string(), ON_PIXEL.1.to_string());
+    let Some(text) = evtac_testkit::run_python(PILLOW_GIF, &[out.to_str().unwrap(), &x, &y]) else {
+        return;
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], format!("GIF {} {} 3", SIZE.0, SIZE.1), "{text}");
+    // 10 fps: 100 ms a frame; the ON event at 150 ms lights its pixel in the second only.
+    assert_eq!(
+        lines[1..],
+        ["100 0 0 0", "100 255 60 60", "100 0 0 0"],
+        "{text}"
+    );
+}
+
+/// Pillow's view of a PNG: format, size, mode and the colour of each pixel given.
+const PILLOW_PNG: &str = r#"
+import sys
+from PIL import Image
+with Image.open(sys.argv[1]) as im:
+    print(im.format, *im.size, im.mode)
+    xy = [int(v) for v in sys.argv[2:]]
+    for x, y in zip(xy[::2], xy[1::2]):
+        print(*im.getpixel((x, y)))
+"#;
+
+#[test]
+fn pillow_reads_the_png_sheet() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = render(dir.path(), "r.png", &[]);
+    let at = |frame: usize| {
+        [
+            ON_PIXEL.0.to_string(),
+            (frame * SIZE.1 + ON_PIXEL.1).to_string(),
+        ]
+    };
+    let (a, b) = (at(0), at(1));
+    let args = [out.to_str().unwrap(), &a[0], &a[1], &b[0], &b[1]];
+    let Some(text) = evtac_testkit::run_python(PILLOW_PNG, &args) else {
+        return;
+    };
+    // Three frames, one column: the ON pixel dark in the first frame, lit in the second.
+    assert_eq!(
+        text.lines().collect::<Vec<_>>(),
+        [
+            format!("PNG {} {} RGB", SIZE.0, 3 * SIZE.1).as_str(),
+            "0 0 0",
+            "255 60 60"
+        ],
+        "{text}"
+    );
+}
+
+#[test]
+fn unknown_panel_and_format_and_angles_without_a_model_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("rec.csv");
     write_recording(&input);
-    let out = evtac()
-        .args(["render", input.to_str().unwrap(), "--out"])
-        .arg(dir.path().join("r.gif"))
-        .args(["--panels", "events,colour"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("unknown panel `colour`"), "{err}");
-    let out = evtac()
-        .args(["render", input.to_str().unwrap(), "--out"])
-        .arg(dir.path().join("r.mp3"))
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("r.mp3: unknown output format"), "{err}");
+    let cases = [
+        ("r.gif", "events,colour", "unknown panel `colour`"),
+        ("r.mp3", "events", "r.mp3: unknown output format"),
+        ("r.gif", "events,angles", "needs a model (--model)"),
+    ];
+    for (file, panels, message) in cases {
+        let out = evtac()
+            .args(["render", input.to_str().unwrap(), "--out"])
+            .arg(dir.path().join(file))
+            .args(["--panels", panels])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{file} {panels} accepted");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(message), "{err}");
+    }
 }

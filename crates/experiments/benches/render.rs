@@ -1,12 +1,13 @@
 //! `evtac render`'s speed against real time: one second of a 300k events/s stream over the
 //! 240x240 crop rendered at 30 fps with the default panels (events, static, dynamic, combined)
-//! into a GIF. Faster than real time when one iteration takes under 1 s.
+//! into a GIF, and into an MP4 when `ffmpeg` is on the PATH. Faster than real time when one
+//! iteration takes under 1 s.
 //!
 //! `nice cargo bench -p evtac-experiments --bench render -- --warm-up-time 1 --measurement-time 5`
 
 use criterion::Criterion;
 use evtac_events::Event;
-use evtac_experiments::render::{self, Output, Panel, Timing};
+use evtac_experiments::render::{self, Output, Panel, Scene, Timing};
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -52,27 +53,35 @@ fn main() {
         ReprConfig::Dynamic(DynamicConfig::default()),
     );
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let out = dir.path().join("bench.gif");
     let Ok(timing) = Timing::new(&events, Some(0), Some(DURATION_US), 30.0, 1.0) else {
         eprintln!("the synthetic stream is empty");
         return;
     };
-    let mut c = Criterion::default().sample_size(10).configure_from_args();
-    c.bench_function("render 1 s of 300k ev/s, 30 fps, 4 panels, GIF", |b| {
-        b.iter(|| {
-            render::render(
-                &out,
-                Output::Gif,
-                &events,
-                &reprs,
-                &[None, None, None],
-                &Panel::DEFAULT,
-                &timing,
-            )
-        })
-    });
-    c.final_summary();
-    if let Ok(meta) = std::fs::metadata(&out) {
-        eprintln!("GIF of {} frames: {} bytes", timing.count, meta.len());
+    let ffmpeg = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ffmpeg {
+        eprintln!("no ffmpeg on the PATH: the MP4 case is skipped");
     }
+    let mut c = Criterion::default().sample_size(10).configure_from_args();
+    for (output, name) in [(Output::Gif, "GIF"), (Output::Mp4, "MP4")] {
+        if output == Output::Mp4 && !ffmpeg {
+            continue;
+        }
+        let out = dir.path().join(format!("bench.{}", name.to_lowercase()));
+        c.bench_function(
+            &format!("render 1 s of 300k ev/s, 30 fps, 4 panels, {name}"),
+            |b| {
+                b.iter(|| {
+                    let scene = Scene::new(&Panel::DEFAULT, timing, None)?;
+                    render::render(&out, output, &events, &reprs, &[None, None, None], scene)
+                })
+            },
+        );
+        if let Ok(meta) = std::fs::metadata(&out) {
+            eprintln!("{name} of {} frames: {} bytes", timing.count, meta.len());
+        }
+    }
+    c.final_summary();
 }

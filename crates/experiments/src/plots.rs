@@ -102,7 +102,7 @@ fn canvas(
 
 /// The legend every figure uses: translucent white, framed, at `position` with labels of
 /// `font_size` (for the figure at `path`).
-fn legend<'a, DB, CT>(
+pub(crate) fn legend<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
     font_size: u32,
@@ -123,7 +123,7 @@ where
 }
 
 /// The color of a representation by name (`Static`, `Dynamic`, `Combined`).
-fn repr_color(name: &str) -> RGBColor {
+pub(crate) fn repr_color(name: &str) -> RGBColor {
     match name {
         "Static" => REPR_COLORS[0],
         "Dynamic" => REPR_COLORS[1],
@@ -132,7 +132,7 @@ fn repr_color(name: &str) -> RGBColor {
 }
 
 /// A tick label: at most three decimals, without trailing zeros (`5.5`, `100`, `0.25`).
-fn tick(v: &f64) -> String {
+pub(crate) fn tick(v: &f64) -> String {
     let text = format!("{v:.3}");
     let text = text.trim_end_matches('0').trim_end_matches('.');
     if text == "-0" {
@@ -143,7 +143,7 @@ fn tick(v: &f64) -> String {
 }
 
 /// A padded range around `values` (never empty).
-fn padded(values: impl Iterator<Item = f64>, floor_zero: bool) -> std::ops::Range<f64> {
+pub(crate) fn padded(values: impl Iterator<Item = f64>, floor_zero: bool) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);

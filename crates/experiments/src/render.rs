@@ -1,15 +1,16 @@
 //! `evtac render`'s engine: a recording (or a dataset trial) as a sequence of frames, each the
-//! panels the sensor and the network see over one frame interval, written as an animated GIF or
-//! a PNG contact sheet.
+//! panels the sensor and the network see over one frame interval, written as an animated GIF, an
+//! MP4 video or a PNG contact sheet.
 //!
 //! The frames come from the same [`evtac_repr::FeatureExtractor`] the feature cache runs,
 //! sampled at the end of every frame interval, and are drawn with the report's plotting stack
 //! (plotters and the pixel helpers of `representations.png`), so a rendered frame is the
-//! report's Fig. 2 at another sample time. Encoding is the `gif` crate's (GIF) and plotters'
-//! (PNG).
+//! report's Fig. 2 at another sample time. Encoding is the `gif` crate's (GIF), an `ffmpeg`
+//! on the `PATH` (MP4) and plotters' (PNG). Every format is written to a temporary file beside
+//! the output and renamed at the end, so a failed or interrupted render leaves no partial file.
 //!
 //! ```no_run
-//! use evtac_experiments::render::{self, Output, Panel, Timing};
+//! use evtac_experiments::render::{self, Output, Panel, Scene, Timing};
 //! use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let events = evtac_experiments::dataset::read_cropped("trial.aedat4".as_ref())?;
@@ -18,27 +19,32 @@
 //!     ReprConfig::Dynamic(DynamicConfig::default()),
 //! );
 //! let timing = Timing::new(&events, None, None, 30.0, 1.0)?;
+//! let scene = Scene::new(&Panel::DEFAULT, timing, None)?;
 //! render::render(
 //!     "trial.gif".as_ref(),
 //!     Output::Gif,
 //!     &events,
 //!     &reprs,
 //!     &[None, None, None],
-//!     &Panel::DEFAULT,
-//!     &timing,
+//!     scene,
 //! )?;
 //! # Ok(())
 //! # }
 //! ```
 
+mod angles;
+mod angles_chart;
 mod draw;
 mod frames;
 mod gif;
+mod mp4;
 mod sheet;
 
-pub use draw::{Layout, draw_frame, layout};
+pub use angles::{Angles, estimate_times, repr_name};
+pub use draw::{Layout, Scene, draw_frame, layout};
 pub use frames::{Frame, ReprFrame, Timing, for_each_frame};
 pub use gif::GifWriter;
+pub use mp4::Mp4Writer;
 pub use sheet::{MAX_SHEET_FRAMES, SheetWriter};
 
 use evtac_events::Event;
@@ -58,6 +64,9 @@ pub enum Panel {
     Combined,
     /// The 30x30 pooled features of each representation drawn, in a row below the frames.
     Features,
+    /// A model's pitch and roll estimates over the rendered span, beside the labels, with a
+    /// cursor at the frame's time (needs the [`Angles`]).
+    Angles,
 }
 
 impl Panel {
@@ -69,7 +78,8 @@ impl Panel {
         Panel::Combined,
     ];
 
-    /// The panel called `name` (`events`, `static`, `dynamic`, `combined`, `features`).
+    /// The panel called `name` (`events`, `static`, `dynamic`, `combined`, `features`,
+    /// `angles`).
     pub fn parse(name: &str) -> Result<Panel, Error> {
         match name.trim().to_ascii_lowercase().as_str() {
             "events" => Ok(Panel::Events),
@@ -77,6 +87,7 @@ impl Panel {
             "dynamic" => Ok(Panel::Dynamic),
             "combined" => Ok(Panel::Combined),
             "features" => Ok(Panel::Features),
+            "angles" => Ok(Panel::Angles),
             _ => Err(Error::UnknownPanel {
                 name: name.to_string(),
             }),
@@ -90,7 +101,7 @@ impl Panel {
             Panel::Static => Some("Static"),
             Panel::Dynamic => Some("Dynamic"),
             Panel::Combined => Some("Combined"),
-            Panel::Events | Panel::Features => None,
+            Panel::Events | Panel::Features | Panel::Angles => None,
         }
     }
 }
@@ -100,12 +111,14 @@ impl Panel {
 pub enum Output {
     /// An animated GIF, one image per frame.
     Gif,
+    /// An H.264 MP4 video, encoded by `ffmpeg`.
+    Mp4,
     /// A PNG contact sheet: the frames in a grid.
     Png,
 }
 
 impl Output {
-    /// The format `path`'s extension names (`.gif` or `.png`, any case).
+    /// The format `path`'s extension names (`.gif`, `.mp4` or `.png`, any case).
     pub fn from_path(path: &Path) -> Result<Output, Error> {
         let ext = path
             .extension()
@@ -113,6 +126,7 @@ impl Output {
             .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("gif") => Ok(Output::Gif),
+            Some("mp4") => Ok(Output::Mp4),
             Some("png") => Ok(Output::Png),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
@@ -125,14 +139,16 @@ impl Output {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// A panel name is not one of the five.
-    #[error("unknown panel `{name}` (expected events, static, dynamic, combined or features)")]
+    /// A panel name is not one of the six.
+    #[error(
+        "unknown panel `{name}` (expected events, static, dynamic, combined, features or angles)"
+    )]
     UnknownPanel {
         /// The name given.
         name: String,
     },
     /// The output's extension names no format evtac writes.
-    #[error("{}: unknown output format (expected .gif or .png)", path.display())]
+    #[error("{}: unknown output format (expected .gif, .mp4 or .png)", path.display())]
     UnknownFormat {
         /// The output file.
         path: PathBuf,
@@ -140,6 +156,17 @@ pub enum Error {
     /// The time range or frame timing is unusable.
     #[error("{0}")]
     Timing(String),
+    /// The angles panel was asked for without a model's estimates to draw.
+    #[error("the angles panel shows a model's estimates: it needs a model (--model)")]
+    NoAngles,
+    /// The model could not predict from the features.
+    #[error("{}: predicting the angles failed: {message}", model.display())]
+    Predict {
+        /// The model bundle's folder.
+        model: PathBuf,
+        /// The predictor's message.
+        message: String,
+    },
     /// The representations could not be built.
     #[error("building the representations: {0}")]
     Repr(#[from] ReprError),
@@ -154,10 +181,51 @@ pub enum Error {
         /// The encoder's message.
         message: String,
     },
+    /// No `ffmpeg` on the `PATH` for an MP4.
+    #[error(
+        "{}: writing MP4 needs ffmpeg, which is not on the PATH (install it, e.g. `apt install \
+         ffmpeg`, or write .gif or .png, which need nothing else)",
+        path.display()
+    )]
+    FfmpegMissing {
+        /// The output file.
+        path: PathBuf,
+    },
+    /// ffmpeg failed to encode the MP4.
+    #[error("{}: encoding the MP4 with ffmpeg failed: {message}", path.display())]
+    Ffmpeg {
+        /// The output file.
+        path: PathBuf,
+        /// What failed, with ffmpeg's own message.
+        message: String,
+    },
+    /// Creating the temporary file or renaming it to the output failed.
+    #[error(transparent)]
+    Io(#[from] crate::io::IoError),
+}
+
+impl<'a> Scene<'a> {
+    /// The scene of `panels` (in the order given) over `timing`, with a model's `angles` for
+    /// the angles panel (an error when that panel is asked for without them).
+    pub fn new(
+        panels: &[Panel],
+        timing: Timing,
+        angles: Option<&'a Angles>,
+    ) -> Result<Scene<'a>, Error> {
+        let layout = layout(panels);
+        if layout.angles && angles.is_none() {
+            return Err(Error::NoAngles);
+        }
+        Ok(Scene {
+            layout,
+            timing,
+            angles,
+        })
+    }
 }
 
 /// Renders `events` (cropped to [`evtac_repr::CROP`], time order) to `path` as `output`: the
-/// frames of `timing`, each with `panels`, the representations `reprs` (name, config, as
+/// frames of `scene`, the representations `reprs` (name, config, as
 /// [`crate::exp1::representations`] lists them) built with `masks` (one per config, `None` for
 /// none).
 pub fn render(
@@ -166,19 +234,51 @@ pub fn render(
     events: &[Event],
     reprs: &[(&str, ReprConfig)],
     masks: &[Option<&Mask>],
-    panels: &[Panel],
-    timing: &Timing,
+    scene: Scene<'_>,
 ) -> Result<(), Error> {
-    let layout = layout(panels);
+    let timing = scene.timing;
+    let temp = temporary_beside(path)?;
     match output {
         Output::Gif => {
-            let mut gif = GifWriter::create(path, layout, *timing)?;
-            for_each_frame(events, reprs, masks, timing, |f| gif.push(f))
+            let mut gif = GifWriter::create(&temp, path, scene)?;
+            for_each_frame(events, reprs, masks, &timing, |f| gif.push(f))?;
+            gif.finish()?;
+        }
+        Output::Mp4 => {
+            let mut mp4 = Mp4Writer::create(&temp, path, scene)?;
+            for_each_frame(events, reprs, masks, &timing, |f| mp4.push(f))?;
+            mp4.finish()?;
         }
         Output::Png => {
-            let mut sheet = SheetWriter::create(path, layout, *timing)?;
-            for_each_frame(events, reprs, masks, timing, |f| sheet.push(f))?;
-            sheet.finish()
+            let mut sheet = SheetWriter::create(&temp, path, scene)?;
+            for_each_frame(events, reprs, masks, &timing, |f| sheet.push(f))?;
+            sheet.finish()?;
         }
     }
+    temp.persist(path)
+        .map_err(|e| crate::io::IoError::at(path)(e.error))?;
+    Ok(())
+}
+
+/// An empty temporary file in `path`'s folder (so the final rename is atomic), named like it
+/// (`.NAME.XXXXXX.EXT`: plotters picks the PNG encoder by the extension), deleted when dropped
+/// unless persisted.
+fn temporary_beside(path: &Path) -> Result<tempfile::TempPath, Error> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = path.extension().unwrap_or_default().to_string_lossy();
+    let (prefix, suffix) = (format!(".{name}."), format!(".{ext}"));
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(&suffix);
+    // A temporary file is private (0600); the output is an ordinary file, so it gets the
+    // permissions `File::create` gives (0666 less the umask).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    builder
+        .tempfile_in(dir)
+        .map(tempfile::NamedTempFile::into_temp_path)
+        .map_err(|e| Error::Io(crate::io::IoError::at(dir)(e)))
 }

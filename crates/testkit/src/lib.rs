@@ -1,5 +1,6 @@
 //! Test support shared by evtac's crates: where the shared fixtures are, and how to reach the
-//! Python reference tools (dv-processing, numpy, safetensors) that interop tests compare against.
+//! Python reference tools (dv-processing, numpy, safetensors, Pillow) and ffmpeg that interop
+//! tests compare against.
 //!
 //! Fixtures live in `../shared` beside the checkout, or wherever `$EVTAC_SHARED` points. The
 //! Python interpreter is `$EVTAC_PYTHON`, else `.venv/bin/python` at the workspace root (made by
@@ -83,6 +84,20 @@ pub fn run_python(script: &str, args: &[&str]) -> Option<String> {
         );
     }
     Some(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// Whether `ffmpeg` and `ffprobe` run from the `PATH` (`evtac render`'s MP4 output and its
+/// independent decoder). `false` (test skipped) outside CI when either is missing; `.ci/run`
+/// installs them (`.ci/system-packages`).
+pub fn ffmpeg() -> bool {
+    let runs = |tool: &str| {
+        Command::new(tool)
+            .arg("-version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    (runs("ffmpeg") && runs("ffprobe"))
+        || missing("ffmpeg and ffprobe on the PATH (`apt install ffmpeg`)").is_some()
 }
 
 /// Whether a Slurm cluster answers on this machine (`scontrol ping`; `bash .ci/slurm-up` starts

@@ -1,15 +1,21 @@
-//! `evtac render`: what the sensor and the network see, as an animated GIF or a PNG contact
-//! sheet (`evtac_experiments::render` draws and encodes).
+//! `evtac render`: what the sensor and the network see, as an animated GIF, an MP4 video
+//! (through an `ffmpeg` on the `PATH`) or a PNG contact sheet (`evtac_experiments::render`
+//! draws and encodes).
 //!
 //! The input is a recording in any format evtac reads, or with `--trial` a dataset folder and
 //! one of its trials (its no-contact mask applied to the static representation, as in
-//! training). Events are cropped to the centered 240x240 crop. The representations use the
-//! default settings unless `--tau-ms` / `--window-ms` say otherwise.
+//! training). Events are cropped to the centered 240x240 crop. Each representation setting is
+//! `--tau-ms` / `--window-ms` when given, else the `--model`'s (what the network was trained
+//! on), else the default. With `--model`, the angles panel shows the model's estimates (the
+//! offline prediction's, on the model's own representation and mask) beside the trial's IMU
+//! labels and, for simulated data, the truth.
 
 use anyhow::Context;
 use evtac_experiments::dataset::{self, Dataset};
-use evtac_experiments::render::{self, Output, Panel, Timing};
-use evtac_repr::{DynamicConfig, Mask, ReprConfig, StaticConfig};
+use evtac_experiments::render::{self, Angles, Output, Panel, Scene, Timing};
+use evtac_labels::series::LabelSeries;
+use evtac_learn::Model;
+use evtac_repr::{Mask, ReprConfig};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -18,7 +24,8 @@ use std::time::Instant;
 pub struct Args {
     /// A recording (AEDAT4, EVT2/EVT3 raw, CSV or NPY), or with `--trial` a dataset folder.
     pub input: PathBuf,
-    /// Output file: `.gif` (animated) or `.png` (contact sheet of every frame).
+    /// Output file: `.gif` (animated), `.mp4` (H.264 video; needs `ffmpeg` on the PATH) or
+    /// `.png` (contact sheet of every frame). Written beside and renamed at the end.
     #[arg(long)]
     pub out: PathBuf,
     /// Render this trial of the dataset INPUT.
@@ -37,19 +44,31 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
     /// Panels, comma-separated: events, static, dynamic, combined, features (the pooled
-    /// features of each frame panel, in a second row).
+    /// features of each frame panel, in a second row), angles (the model's estimates over
+    /// time; added whenever --model is given).
     #[arg(
         long,
         value_delimiter = ',',
         default_value = "events,static,dynamic,combined"
     )]
     pub panels: Vec<String>,
-    /// Static representation: decay time constant in milliseconds [default: 1000].
+    /// Static representation: decay time constant in milliseconds [default: the --model's when
+    /// it has a static part, else 1000].
     #[arg(long)]
     pub tau_ms: Option<f64>,
-    /// Dynamic representation: window length in milliseconds [default: 640].
+    /// Dynamic representation: window length in milliseconds [default: the --model's when it
+    /// has a dynamic part, else 640].
     #[arg(long)]
     pub window_ms: Option<f64>,
+    /// A model bundle written by `evtac train`: adds the angles panel (its pitch and roll
+    /// estimates over the rendered span, every frame interval divided into steps of at most
+    /// 10 ms; the trial's IMU labels and simulated truth beside them), and its representation
+    /// settings become the frames' defaults.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// With --model: also write the estimates as CSV (t_us,pitch_deg,roll_deg).
+    #[arg(long, requires = "model")]
+    pub estimates_csv: Option<PathBuf>,
     #[command(flatten)]
     pub inputs: crate::inputs::InputArgs,
 }
@@ -57,16 +76,31 @@ pub struct Args {
 /// Runs `evtac render`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let output = Output::from_path(&args.out)?;
-    let panels = args
+    let mut panels = args
         .panels
         .iter()
         .map(|p| Panel::parse(p))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut static_cfg = StaticConfig::default();
+    let model = match &args.model {
+        Some(dir) => Some(
+            Model::load(dir)
+                .with_context(|| format!("loading the model bundle {}", dir.display()))?,
+        ),
+        None => None,
+    };
+    if model.is_some() && !panels.contains(&Panel::Angles) {
+        panels.push(Panel::Angles);
+    }
+    let model_cfg = model.as_ref().map(Model::repr_config);
+    let mut static_cfg = model_cfg
+        .and_then(|c| c.static_part().copied())
+        .unwrap_or_default();
     if let Some(tau) = args.tau_ms {
         static_cfg.tau_ms = tau;
     }
-    let mut dynamic_cfg = DynamicConfig::default();
+    let mut dynamic_cfg = model_cfg
+        .and_then(|c| c.dynamic_part().copied())
+        .unwrap_or_default();
     if let Some(window) = args.window_ms {
         dynamic_cfg.window_ms = window;
     }
@@ -77,12 +111,21 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for (_, c) in &reprs {
         c.validate()?;
     }
+    // The model's mask for every frame with its static settings (the mask is built from
+    // those alone), so a frame like the model's shows what the network saw.
+    let model_mask = |c: &ReprConfig| -> Option<Mask> {
+        let m = model.as_ref()?;
+        let same = c.static_part().is_some() && c.static_part() == m.repr_config().static_part();
+        if same { m.mask().cloned() } else { None }
+    };
 
+    let mut references: (Option<LabelSeries>, Option<LabelSeries>) = (None, None);
     let (events, masks): (_, Vec<Option<Mask>>) = match &args.trial {
         None => {
             let events = dataset::read_cropped(&args.input)
                 .with_context(|| format!("reading {}", args.input.display()))?;
-            (events, vec![None; reprs.len()])
+            let masks = reprs.iter().map(|(_, c)| model_mask(c)).collect();
+            (events, masks)
         }
         Some(trial) => {
             let ds = Dataset::open(&args.input, args.inputs.inputs())
@@ -92,8 +135,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let no_contact = ds.no_contact_events()?;
             let masks = reprs
                 .iter()
-                .map(|(_, c)| ds.mask_for(c, no_contact.as_deref()))
+                .map(|(_, c)| match model_mask(c) {
+                    Some(m) => Ok(Some(m)),
+                    None => ds.mask_for(c, no_contact.as_deref()),
+                })
                 .collect::<Result<_, _>>()?;
+            if model.is_some() {
+                let truth = match &meta.truth {
+                    Some(file) => {
+                        let path = ds.dir.join(file);
+                        Some(
+                            LabelSeries::read_csv(&path)
+                                .with_context(|| format!("reading {}", path.display()))?,
+                        )
+                    }
+                    None => None,
+                };
+                references = (Some(ds.labels(meta)?), truth);
+            }
             (events, masks)
         }
     };
@@ -102,9 +161,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("rendering {}", args.input.display()))?;
 
     let started = Instant::now();
-    render::render(
-        &args.out, output, &events, &reprs, &mask_refs, &panels, &timing,
-    )?;
+    let angles = match &model {
+        Some(m) => {
+            let mut angles = Angles::estimate(&events, m, &timing)?;
+            let (labels, truth) = &references;
+            angles.labels = labels.as_ref().map(|s| angles.sample(s));
+            angles.truth = truth.as_ref().map(|s| angles.sample(s));
+            if let Some(path) = &args.estimates_csv {
+                std::fs::write(path, angles.estimates_csv())
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+            Some(angles)
+        }
+        None => None,
+    };
+    let scene = Scene::new(&panels, timing, angles.as_ref())?;
+    render::render(&args.out, output, &events, &reprs, &mask_refs, scene)?;
     let took = started.elapsed().as_secs_f64();
     let span = timing.count as f64 * timing.step_us as f64 / 1e6;
     eprintln!(

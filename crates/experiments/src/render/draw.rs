@@ -1,8 +1,11 @@
 //! One frame drawn with the report's plotting stack: a row of 240x240 panels (the interval's
-//! events by polarity, each representation's binary frame) and, with `features`, each
-//! representation's pooled features below its frame, scaled to the same size.
+//! events by polarity, each representation's binary frame), with `features` each
+//! representation's pooled features below its frame, scaled to the same size, and with
+//! `angles` a model's estimates over time below them all.
 
 use super::Panel;
+use super::angles::Angles;
+use super::angles_chart::draw_angles;
 use super::frames::{Frame, Timing};
 use crate::plots::images::{draw_image, grey, polarity_color};
 use crate::plots::{Error, FAMILY, draw_err};
@@ -19,6 +22,10 @@ const HEADER: i32 = 26;
 const TITLE: i32 = 22;
 /// Pooling cell of the features (8x8 pixels per feature).
 const CELL: usize = 8;
+/// Height of the angles panel.
+const ANGLES_HEIGHT: i32 = 240;
+/// The narrowest angles panel: two charts with readable axes.
+const ANGLES_MIN_WIDTH: i32 = 760;
 
 /// Where the panels of a frame go.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -27,6 +34,8 @@ pub struct Layout {
     pub columns: Vec<Panel>,
     /// Whether the second row shows the features under each frame.
     pub features: bool,
+    /// Whether the angles panel goes below the images.
+    pub angles: bool,
     /// Size of the frame in pixels.
     pub size: (u32, u32),
 }
@@ -36,18 +45,36 @@ pub fn layout(panels: &[Panel]) -> Layout {
     let columns: Vec<Panel> = panels
         .iter()
         .copied()
-        .filter(|p| *p != Panel::Features)
+        .filter(|p| !matches!(p, Panel::Features | Panel::Angles))
         .collect();
     let features = panels.contains(&Panel::Features);
+    let angles = panels.contains(&Panel::Angles);
     let side = i32::from(CROP.width);
     let rows = 1 + i32::from(features);
-    let width = MARGIN + columns.len().max(1) as i32 * (side + MARGIN);
-    let height = HEADER + rows * (TITLE + side + MARGIN);
+    let mut width = MARGIN + columns.len().max(1) as i32 * (side + MARGIN);
+    let mut height = HEADER + rows * (TITLE + side + MARGIN);
+    if angles {
+        width = width.max(ANGLES_MIN_WIDTH + 2 * MARGIN);
+        height += ANGLES_HEIGHT + MARGIN;
+    }
     Layout {
         columns,
         features,
+        angles,
         size: (width as u32, height as u32),
     }
+}
+
+/// What every frame of a render shares: where the panels go, when the frames are, and the
+/// angles panel's data.
+#[derive(Debug, Clone)]
+pub struct Scene<'a> {
+    /// Where the panels go.
+    pub layout: Layout,
+    /// When the frames are.
+    pub timing: Timing,
+    /// The model's estimates and their references, for the angles panel.
+    pub angles: Option<&'a Angles>,
 }
 
 /// Top-left corner of the image in column `c`, row `r`.
@@ -59,15 +86,16 @@ fn origin(c: usize, r: i32) -> (i32, i32) {
     )
 }
 
-/// Draws `frame` in `layout` onto `area` (white background; the output at `path`, named in
-/// errors). Frame panels whose representation was not rendered stay blank.
+/// Draws `frame` of `scene` onto `area` (white background; the output at `path`, named in
+/// errors). Frame panels whose representation was not rendered stay blank, as does the angles
+/// panel without angles.
 pub fn draw_frame<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    layout: &Layout,
+    scene: &Scene<'_>,
     frame: &Frame<'_>,
-    timing: &Timing,
     path: &Path,
 ) -> Result<(), Error> {
+    let (layout, timing) = (&scene.layout, &scene.timing);
     let e = draw_err(path);
     crate::plots::register_font()?;
     area.fill(&WHITE).map_err(&e)?;
@@ -143,6 +171,15 @@ pub fn draw_frame<DB: DrawingBackend>(
                 path,
             )?;
         }
+    }
+    if let (true, Some(angles)) = (layout.angles, scene.angles) {
+        let side = i32::from(CROP.width);
+        let top = HEADER + (1 + i32::from(layout.features)) * (TITLE + side + MARGIN);
+        let width = layout.size.0 as i32 - 2 * MARGIN;
+        let panel = area
+            .clone()
+            .shrink((MARGIN, top), (width as u32, ANGLES_HEIGHT as u32));
+        draw_angles(&panel, angles, frame.t_us, timing, path)?;
     }
     Ok(())
 }

@@ -1,19 +1,19 @@
 //! The animated GIF: each frame drawn into an RGB buffer, mapped to one fixed global palette and
 //! encoded by the `gif` crate.
 //!
-//! A fixed palette (the panels' exact colours, 32 greys for the features, a 6x6x6 colour cube
-//! for the anti-aliased text) instead of a per-frame quantizer: the panels have few colours,
+//! A fixed palette (the panels' exact colours, the angles panel's curve colours, 32 greys for
+//! the features, a 6x6x6 colour cube for the anti-aliased text) instead of a per-frame quantizer: the panels have few colours,
 //! the colours stay the same from frame to frame, and a 32x32x32 lookup table maps a pixel in
 //! a few nanoseconds where NeuQuant would dominate the render time.
 
 use super::Error;
-use super::draw::{Layout, draw_frame};
-use super::frames::{Frame, Timing};
+use super::draw::{Scene, draw_frame};
+use super::frames::Frame;
 use crate::plots::images::{BOTH, OFF, ON};
 use plotters::prelude::*;
 use std::borrow::Cow;
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -22,7 +22,8 @@ fn palette() -> &'static [[u8; 3]] {
     static PALETTE: OnceLock<Vec<[u8; 3]>> = OnceLock::new();
     PALETTE.get_or_init(|| {
         let mut p = vec![[0, 0, 0], [255, 255, 255]];
-        for c in [ON, OFF, BOTH] {
+        let curves = ["Static", "Dynamic", "Combined"].map(crate::plots::repr_color);
+        for c in [ON, OFF, BOTH].into_iter().chain(curves) {
             p.push([c.0, c.1, c.2]);
         }
         // The features' greys (`grey()` rounds v * 255): 32 levels, 0 and 255 included.
@@ -77,21 +78,21 @@ fn quantize(rgb: &[u8], out: &mut Vec<u8>) {
 /// Streams frames into a GIF file.
 pub struct GifWriter<'p> {
     path: &'p Path,
-    layout: Layout,
-    timing: Timing,
+    scene: Scene<'p>,
     encoder: gif::Encoder<BufWriter<File>>,
     rgb: Vec<u8>,
     indices: Vec<u8>,
 }
 
 impl<'p> GifWriter<'p> {
-    /// Creates `path` for frames of `layout`, played at `timing.fps` and looping.
-    pub fn create(path: &'p Path, layout: Layout, timing: Timing) -> Result<Self, Error> {
+    /// Creates `file` for frames of `scene`, played at its fps and looping; errors name `path`,
+    /// the output `file` becomes.
+    pub fn create(file: &Path, path: &'p Path, scene: Scene<'p>) -> Result<Self, Error> {
         let err = |m: String| Error::Gif {
             path: path.to_path_buf(),
             message: m,
         };
-        let (w, h) = layout.size;
+        let (w, h) = scene.layout.size;
         let (w16, h16) = match (u16::try_from(w), u16::try_from(h)) {
             (Ok(a), Ok(b)) => (a, b),
             _ => {
@@ -100,7 +101,7 @@ impl<'p> GifWriter<'p> {
                 )));
             }
         };
-        let file = File::create(path).map_err(|e| err(e.to_string()))?;
+        let file = File::create(file).map_err(|e| err(e.to_string()))?;
         let flat: Vec<u8> = palette().iter().flatten().copied().collect();
         let mut encoder = gif::Encoder::new(BufWriter::new(file), w16, h16, &flat)
             .map_err(|e| err(e.to_string()))?;
@@ -110,8 +111,7 @@ impl<'p> GifWriter<'p> {
         let pixels = w as usize * h as usize;
         Ok(GifWriter {
             path,
-            layout,
-            timing,
+            scene,
             encoder,
             rgb: vec![0; pixels * 3],
             indices: Vec::with_capacity(pixels),
@@ -120,10 +120,10 @@ impl<'p> GifWriter<'p> {
 
     /// Draws and appends `frame`.
     pub fn push(&mut self, frame: &Frame<'_>) -> Result<(), Error> {
-        let (w, h) = self.layout.size;
+        let (w, h) = self.scene.layout.size;
         {
             let area = BitMapBackend::with_buffer(&mut self.rgb, (w, h)).into_drawing_area();
-            draw_frame(&area, &self.layout, frame, &self.timing, self.path)?;
+            draw_frame(&area, &self.scene, frame, self.path)?;
             area.present().map_err(crate::plots::draw_err(self.path))?;
         }
         quantize(&self.rgb, &mut self.indices);
@@ -133,7 +133,7 @@ impl<'p> GifWriter<'p> {
             height: h as u16,
             buffer: Cow::Borrowed(&self.indices),
             // GIF delays are whole hundredths of a second: 30 fps plays at 1/0.03 = 33.3 fps.
-            delay: (100.0 / self.timing.fps).round().clamp(1.0, 65535.0) as u16,
+            delay: (100.0 / self.scene.timing.fps).round().clamp(1.0, 65535.0) as u16,
             ..gif::Frame::default()
         };
         self.encoder.write_frame(&out).map_err(|e| Error::Gif {
@@ -141,11 +141,24 @@ impl<'p> GifWriter<'p> {
             message: e.to_string(),
         })
     }
+
+    /// Writes the GIF's trailer and flushes the file (dropping the writer would do both but
+    /// lose their errors).
+    pub fn finish(self) -> Result<(), Error> {
+        let path = self.path;
+        let err = |e: &dyn std::fmt::Display| Error::Gif {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let mut file = self.encoder.into_inner().map_err(|e| err(&e))?;
+        file.flush().map_err(|e| err(&e))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::angles_chart::TRUTH;
 
     #[test]
     fn panel_colours_map_to_themselves() {
@@ -154,6 +167,8 @@ mod tests {
             [255, 255, 255],
             [ON.0, ON.1, ON.2],
             [OFF.0, OFF.1, OFF.2],
+            [TRUTH.0, TRUTH.1, TRUTH.2],
+            [31, 119, 180],
         ] {
             let mut out = Vec::new();
             quantize(&c, &mut out);
