@@ -551,6 +551,31 @@ mod tests {
         }
     }
 
+    /// DV's own table (written by the C++ flatbuffers builder, a real DVXplorer recording) is
+    /// vouched for in passes: a real session's check holds constant memory too.
+    #[test]
+    fn a_dv_written_table_is_valid_streamed() {
+        use std::io::{Seek, SeekFrom};
+        let Some(path) = evtac_testkit::real_fixture("dvxplorer_320x240_imu.aedat4") else {
+            return;
+        };
+        let reader = super::super::AedatReader::open(&path).unwrap();
+        let (position, c) = (
+            reader.header().data_table_position.unwrap(),
+            reader.compression(),
+        );
+        let mut file = reader.into_inner();
+        let seek: fn(&mut std::io::BufReader<std::fs::File>, u64) -> std::io::Result<()> =
+            |r, at| r.seek(SeekFrom::Start(at)).map(drop);
+        let length = std::fs::metadata(&path).unwrap().len() - position;
+        for per_pass in [3, ENTRIES_PER_PASS] {
+            assert_eq!(
+                check(&mut file, seek, position, c, per_pass),
+                Verdict::Valid(length)
+            );
+        }
+    }
+
     /// Every byte of a table damaged (three ways), then compressed: the streamed check calls
     /// valid only what the whole verifier accepts, and still vouches for damage the verifier
     /// cannot see (a changed timestamp).
