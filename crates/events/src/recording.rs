@@ -400,6 +400,16 @@ impl EventReader {
         }
     }
 
+    /// Hands out only the triggers from now on, where the format lets the reader pass the
+    /// rest undecoded (AEDAT4: event and IMU packets are read past, not decompressed): a pass
+    /// for the triggers of a long session then costs a read of the file. Other formats still
+    /// decode everything and hand it out; callers look at the triggers only.
+    pub fn triggers_only(&mut self) {
+        if let Inner::Aedat(r) = &mut self.inner {
+            r.triggers_only();
+        }
+    }
+
     /// The next chunk; `Ok(None)` at the end of the file (or, after
     /// [`select_range`](Self::select_range), of the range).
     pub fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {

@@ -645,3 +645,47 @@ proptest! {
         prop_assert!(AedatReader::from_slice(clean).and_then(decode).is_err());
     }
 }
+
+/// A file read from disk checks its data table in passes over it (constant memory), a file in
+/// memory whole: every byte of the table damaged, and the file cut anywhere in it, the two give
+/// the same result and the same error.
+#[test]
+fn streamed_table_check_rejects_what_the_whole_check_rejects_with_its_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("damaged.aedat4");
+    for c in ALL {
+        let bytes = small_file(c);
+        let table = AedatReader::from_slice(&bytes)
+            .unwrap()
+            .header()
+            .data_table_position
+            .unwrap() as usize;
+        let mut cases: Vec<Vec<u8>> = (table..bytes.len()).map(|n| bytes[..n].to_vec()).collect();
+        for at in table..bytes.len() {
+            for flip in [0x01u8, 0xff] {
+                let mut bad = bytes.clone();
+                bad[at] ^= flip;
+                cases.push(bad);
+            }
+        }
+        cases.push(bytes.clone());
+        let (mut same_ok, mut same_err) = (0, 0);
+        for bad in cases {
+            std::fs::write(&path, &bad).unwrap();
+            let whole = AedatReader::from_slice(&bad).and_then(decode);
+            let streamed = AedatReader::open(&path).and_then(decode);
+            match (&whole, &streamed) {
+                (Ok(a), Ok(b)) if a == b => same_ok += 1,
+                (Err(a), Err(b)) if a.to_string() == b.to_string() => same_err += 1,
+                _ => panic!(
+                    "{c}, {} bytes: whole {whole:?}, streamed {streamed:?}",
+                    bad.len()
+                ),
+            }
+        }
+        assert!(
+            same_ok > 0 && same_err > 0,
+            "{c}: {same_ok} read, {same_err} refused"
+        );
+    }
+}

@@ -268,3 +268,26 @@ fn triggers_going_backwards_are_rejected_naming_the_trigger() {
     assert!(matches!(err, AedatError::InvalidInput { .. }), "{err}");
     assert!(err.to_string().contains("trigger 3"), "{err}");
 }
+
+/// A pass for the triggers only (`--sync trigger` before the cuts) hands out every trigger and
+/// nothing else, every compression, from a file and through `evtac_events::open`.
+#[test]
+fn a_triggers_only_read_hands_out_the_triggers_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let (events, triggers) = synthetic(5);
+    for c in ALL {
+        let path = dir.path().join(format!("t-{c}.aedat4"));
+        write(&path, c, &events, &triggers);
+        let mut reader = AedatReader::open(&path).unwrap();
+        reader.triggers_only();
+        assert_eq!(read_all(reader), (Vec::new(), triggers.clone()), "{c}");
+        let mut reader = evtac_events::open(&path).unwrap();
+        reader.triggers_only();
+        let mut found = Vec::new();
+        while let Some(chunk) = reader.next_chunk().unwrap() {
+            assert!(chunk.events.is_empty() && chunk.imu.is_empty(), "{c}");
+            found.extend_from_slice(chunk.triggers);
+        }
+        assert_eq!(found, triggers, "{c}");
+    }
+}

@@ -8,8 +8,8 @@
 //! of per-trial files), make one dataset with [`import_parts`].
 //!
 //! A session's trials are cut in one sequential pass over it, each chunk streamed into the
-//! trials it overlaps (a trial whose data trails by more than a second is cut again by a
-//! time-range read), so no index is loaded per trial and every packet is read once. Everything is written into a temporary folder beside the
+//! trials it overlaps, each closed once every stream has passed its end (a trial whose data
+//! trails by more than [`KEEP_OPEN_US`] is cut again by a time-range read), so no index is loaded per trial and every packet is read once. Everything is written into a temporary folder beside the
 //! output, checked with [`crate::check`] (a motion outside the recording, a session without IMU,
 //! a lead-in too short for the labels are errors naming the log's line), and renamed at the end:
 //! a failed import leaves nothing behind.
@@ -172,6 +172,10 @@ struct Copied {
     events: u64,
     imu: u64,
     index: Option<RangeIndex>,
+    /// Written again by a range read (an element came after its file was closed); read by the
+    /// tests, which check that trailing streams do not cause it.
+    #[cfg_attr(not(test), allow(dead_code))]
+    redone: bool,
 }
 
 /// Copies `[from, to)` of `source` (everything when `None`) into the AEDAT4 file `dest`,
@@ -196,7 +200,12 @@ fn copy_range(
         imu += chunk.imu.len() as u64;
     }
     writer.finish()?;
-    Ok(Copied { events, imu, index })
+    Ok(Copied {
+        events,
+        imu,
+        index,
+        redone: false,
+    })
 }
 
 /// One file cut from a session: its elements with `from <= t < to`.
@@ -206,11 +215,16 @@ struct Cut {
     dest: PathBuf,
 }
 
-/// How long a cut's file stays open after the latest time read (in any stream) passes its end,
-/// us: a recorder writes each stream's packets as they fill, so one stream (IMU, triggers)
-/// trails another by about a packet's span (10 ms in DV). An element that trails by more is
-/// not lost: its cut is written again by a range read.
-const KEEP_OPEN_US: i64 = 1_000_000;
+/// How long a cut's file stays open at most after the latest time read (in any stream) passes
+/// its end, us. A cut is closed as soon as each of the events, IMU and triggers has passed its
+/// end (each stream's time never goes back, so nothing more can fall into it); this bounds the
+/// wait for a stream that has stopped or that the recording does not have (a minute of trials
+/// open at once: a few dozen files' buffers). A recorder writes each stream's packets as they fill: DV's trail
+/// by about a packet's span (10 ms), but a packet closed by its span only when the stream's
+/// next element comes (evtac's writer: a trigger packet is written at the next trigger, a
+/// trial later) trails by as long as the stream is quiet. An element that trails by more than
+/// this is not lost: its cut is written again by a range read, which loads the data table.
+const KEEP_OPEN_US: i64 = 60_000_000;
 
 /// The part of `elements` (sorted by time) with `from <= t < to`.
 fn within<T>(elements: &[T], t: impl Fn(&T) -> i64, from: i64, to: i64) -> &[T] {
@@ -220,8 +234,8 @@ fn within<T>(elements: &[T], t: impl Fn(&T) -> i64, from: i64, to: i64) -> &[T] 
 }
 
 /// Cuts every range of `cuts` out of `source` in one pass over the file, each chunk written into
-/// the cuts it overlaps: memory holds a chunk and the few cuts open at a time (those within
-/// [`KEEP_OPEN_US`] of the reading position), never an index or the session, and every packet
+/// the cuts it overlaps: memory holds a chunk and the few cuts open at a time (those whose end
+/// a stream has not passed yet, within [`KEEP_OPEN_US`]), never an index or the session, and every packet
 /// is read once however many trials there are. Writes exactly what [`copy_range`] of each
 /// range writes (the same elements, in the same order): a cut that receives an element after
 /// it was closed is rewritten with [`copy_range`]. `on_cut(k)` is called as `cuts[k]` is done.
@@ -247,6 +261,8 @@ fn cut_session(
     let mut closed_to = i64::MIN;
     let mut redo = vec![false; cuts.len()];
     let mut latest = i64::MIN;
+    // Per stream (events, IMU, triggers), the latest time read, `None` before its first.
+    let mut stream_latest: [Option<i64>; 3] = [None; 3];
     while let Some(chunk) = reader.next_chunk()? {
         let firsts = [
             chunk.events.first().map(|e| e.t),
@@ -290,10 +306,19 @@ fn cut_session(
             }
         }
         latest = latest.max(hi);
+        for (stream, last) in stream_latest.iter_mut().zip(lasts) {
+            *stream = (*stream).max(last);
+        }
+        // The earliest of the streams: every later element is at or after it (a stream not
+        // read yet may still bring anything, its first packet trailing like the others).
+        let passed = stream_latest
+            .iter()
+            .try_fold(i64::MAX, |m, s| s.map(|s| m.min(s)))
+            .unwrap_or(i64::MIN);
         let mut i = 0;
         while i < open.len() {
             let k = open[i].0;
-            if cuts[k].to.saturating_add(KEEP_OPEN_US) <= latest {
+            if cuts[k].to <= passed || cuts[k].to.saturating_add(KEEP_OPEN_US) <= latest {
                 open.remove(i).1.finish()?;
                 closed.push(k);
                 closed_to = closed_to.max(cuts[k].to);
@@ -313,7 +338,10 @@ fn cut_session(
         on_cut(k);
     }
     for (k, cut) in cuts.iter().enumerate().filter(|(k, _)| redo[*k]) {
-        copied[k] = copy_range(source, Some((cut.from, cut.to)), &cut.dest)?;
+        copied[k] = Copied {
+            redone: true,
+            ..copy_range(source, Some((cut.from, cut.to)), &cut.dest)?
+        };
     }
     Ok(copied)
 }
@@ -479,7 +507,7 @@ mod tests {
     use super::*;
     use evtac_events::{Event, ImuSample, Resolution, Trigger};
 
-    /// Writes a 3 s session: events every 100 us, IMU every 1250 us, a trigger every 0.5 s;
+    /// Writes a 3 s session: events every 100 us, IMU every 1250 us, a trigger every 1.2 s;
     /// with `trailing`, all the IMU and triggers after all the events (streams trailing by up
     /// to 3 s), else interleaved every 10 ms as a recorder writes them.
     fn session(path: &Path, trailing: bool) {
@@ -499,9 +527,11 @@ mod tests {
                 temperature: 30.0,
             })
             .collect();
-        let triggers: Vec<Trigger> = (0..6)
+        // Every 1.2 s: the writer closes a trigger packet at the next trigger, so in the
+        // interleaved file each trigger trails the events by 1.2 s, as in a simulated session.
+        let triggers: Vec<Trigger> = (0..3)
             .map(|i| Trigger {
-                t: i * 500_000 + 3,
+                t: i * 1_200_000 + 3,
                 kind: 1,
             })
             .collect();
@@ -546,6 +576,10 @@ mod tests {
                 })
                 .collect();
             let copied = cut_session(&source, &cuts, &|_| {}).unwrap();
+            if !trailing {
+                // Streams that trail (the triggers) keep a cut open: nothing is read twice.
+                assert!(copied.iter().all(|c| !c.redone), "a cut was redone");
+            }
             for (cut, copied) in cuts.iter().zip(&copied) {
                 let expected = dir.path().join("expected.aedat4");
                 let by_range = copy_range(&source, Some((cut.from, cut.to)), &expected).unwrap();

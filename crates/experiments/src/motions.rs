@@ -118,93 +118,184 @@ pub struct FoundMotion {
     pub pauses: usize,
 }
 
-/// Everything the search needs per sample, in the sensor frame.
+/// More than the farthest any step of the search looks back from the sample it is at (the bias
+/// window and its guard, 550 ms): samples older than this are forgotten.
+const LOOKBACK_US: i64 = 1_000_000;
+
+/// Forgotten samples are dropped from the window's front once there are this many, so that
+/// dropping costs a constant per sample.
+const DROP_AT: usize = 1 << 12;
+
+/// Appends the next samples (in time order, one per timestamp) to the vector; `false` at the
+/// end of the recording.
+type Source<'a> = dyn FnMut(&mut Vec<ImuSample>) -> bool + 'a;
+
+/// Everything the search needs per sample, in the sensor frame, over a window of the recording
+/// that is read as the search reaches it and, when `forget`, forgotten [`LOOKBACK_US`] behind
+/// it: memory holds the longest motion and a few seconds, not the recording. Samples are named
+/// by their index in the whole recording; the running sums run from its start, so every value
+/// is the one the whole recording in memory gives, bit for bit.
 struct Samples<'a> {
-    imu: &'a [ImuSample],
-    /// Running sums of the sensor-frame rate: `sum[k]` over samples before `k`.
+    source: &'a mut Source<'a>,
+    calibration: &'a Calibration,
+    forget: bool,
+    /// The recording's index of `imu[0]`.
+    base: usize,
+    /// The samples held.
+    imu: Vec<ImuSample>,
+    /// Running sums of the sensor-frame rate: `sum[i]` over the samples before `base + i`.
     sum: Vec<[f64; 3]>,
     /// Running sums of the sensor-frame accelerometer, likewise.
     accel: Vec<[f64; 3]>,
+    /// The recording's first timestamp.
+    first_t: Option<i64>,
+    ended: bool,
+    /// The most samples held at once.
+    peak: usize,
 }
 
 impl<'a> Samples<'a> {
-    fn new(imu: &'a [ImuSample], calibration: &Calibration) -> Self {
-        let running = |value: &dyn Fn(&ImuSample) -> [f64; 3]| {
-            let mut sums = Vec::with_capacity(imu.len() + 1);
-            let mut acc = [0.0; 3];
-            sums.push(acc);
-            for s in imu {
-                let v = value(s);
+    fn new(source: &'a mut Source<'a>, calibration: &'a Calibration, forget: bool) -> Self {
+        Self {
+            source,
+            calibration,
+            forget,
+            base: 0,
+            imu: Vec::new(),
+            sum: vec![[0.0; 3]],
+            accel: vec![[0.0; 3]],
+            first_t: None,
+            ended: false,
+            peak: 0,
+        }
+    }
+
+    /// Reads the next samples; `false` at the end of the recording.
+    fn load(&mut self) -> bool {
+        if self.ended {
+            return false;
+        }
+        let held = self.imu.len();
+        if !(self.source)(&mut self.imu) {
+            self.ended = true;
+        }
+        for s in &self.imu[held..] {
+            for (sums, v) in [
+                (&mut self.sum, s.gyroscope),
+                (&mut self.accel, s.accelerometer),
+            ] {
+                let v = self.calibration.imu_to_sensor(v.map(f64::from));
+                let mut acc = *sums.last().unwrap_or(&[0.0; 3]);
                 for i in 0..3 {
                     acc[i] += v[i];
                 }
                 sums.push(acc);
             }
-            sums
-        };
-        Self {
-            imu,
-            sum: running(&|s| calibration.imu_to_sensor(s.gyroscope.map(f64::from))),
-            accel: running(&|s| calibration.imu_to_sensor(s.accelerometer.map(f64::from))),
+        }
+        self.first_t = self.first_t.or(self.imu.first().map(|s| s.t));
+        self.peak = self.peak.max(self.imu.len());
+        self.imu.len() > held || !self.ended
+    }
+
+    /// Whether the recording has a sample `k`.
+    fn has(&mut self, k: usize) -> bool {
+        while k >= self.base + self.imu.len() {
+            if !self.load() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Sample `k` (held: at most [`LOOKBACK_US`] behind the search, and read).
+    fn at(&self, k: usize) -> &ImuSample {
+        &self.imu[k - self.base]
+    }
+
+    /// Sample `k`'s time.
+    fn t(&self, k: usize) -> i64 {
+        self.at(k).t
+    }
+
+    /// Forgets the samples more than [`LOOKBACK_US`] before sample `k`, but the last of them
+    /// (a walk back from a motion reads the time of the sample before it).
+    fn forget_before(&mut self, k: usize) {
+        if !self.forget {
+            return;
+        }
+        let t = self.t(k) - LOOKBACK_US;
+        let behind = self.imu.partition_point(|s| s.t < t).saturating_sub(1);
+        if behind >= DROP_AT {
+            self.imu.drain(..behind);
+            self.sum.drain(..behind);
+            self.accel.drain(..behind);
+            self.base += behind;
         }
     }
 
     /// Sample `k`'s sensor-frame rate less `bias`.
     fn rate(&self, k: usize, bias: [f64; 3]) -> [f64; 3] {
-        std::array::from_fn(|i| self.sum[k + 1][i] - self.sum[k][i] - bias[i])
+        let i = k - self.base;
+        std::array::from_fn(|c| self.sum[i + 1][c] - self.sum[i][c] - bias[c])
     }
 
-    /// The first sample at or after `t`.
-    fn index(&self, t: i64) -> usize {
-        self.imu.partition_point(|s| s.t < t)
+    /// The first sample at or after `t` (read up to the first sample after it).
+    fn index(&mut self, t: i64) -> usize {
+        while self.imu.last().is_none_or(|s| s.t < t) && self.load() {}
+        self.base + self.imu.partition_point(|s| s.t < t)
+    }
+
+    /// Mean of `sums` over samples `[a, b)`, `None` when empty.
+    fn mean_of(&self, sums: &[[f64; 3]], a: usize, b: usize) -> Option<[f64; 3]> {
+        let (i, j) = (a - self.base, b - self.base);
+        (b > a).then(|| std::array::from_fn(|c| (sums[j][c] - sums[i][c]) / (b - a) as f64))
     }
 
     /// Mean rate over samples `[a, b)`, `None` when empty.
     fn mean(&self, a: usize, b: usize) -> Option<[f64; 3]> {
-        (b > a).then(|| std::array::from_fn(|i| (self.sum[b][i] - self.sum[a][i]) / (b - a) as f64))
+        self.mean_of(&self.sum, a, b)
     }
 
     /// Mean rate over the times `[from, to)`.
-    fn mean_over(&self, from: i64, to: i64) -> Option<[f64; 3]> {
-        self.mean(self.index(from), self.index(to))
+    fn mean_over(&mut self, from: i64, to: i64) -> Option<[f64; 3]> {
+        let (a, b) = (self.index(from), self.index(to));
+        self.mean(a, b)
     }
 
     /// The smoothed rate at sample `k`.
-    fn smoothed(&self, k: usize) -> [f64; 3] {
-        let t = self.imu[k].t;
+    fn smoothed(&mut self, k: usize) -> [f64; 3] {
+        let t = self.t(k);
         self.mean_over(t - SMOOTH_US / 2, t + SMOOTH_US / 2 + 1)
             .unwrap_or([0.0; 3])
     }
 
     /// The bias before sample `k`, if the recording reaches back far enough.
-    fn bias_before(&self, k: usize) -> Option<[f64; 3]> {
-        let t = self.imu[k].t;
-        if t - BIAS_GUARD_US - BIAS_WINDOW_US < self.imu[0].t {
+    fn bias_before(&mut self, k: usize) -> Option<[f64; 3]> {
+        let t = self.t(k);
+        if t - BIAS_GUARD_US - BIAS_WINDOW_US < self.first_t? {
             return None;
         }
         self.mean_over(t - BIAS_GUARD_US - BIAS_WINDOW_US, t - BIAS_GUARD_US)
     }
 
     /// The smoothed rate's distance from `bias` at sample `k`.
-    fn deviation(&self, k: usize, bias: [f64; 3]) -> f64 {
+    fn deviation(&mut self, k: usize, bias: [f64; 3]) -> f64 {
         let w = self.smoothed(k);
         norm(std::array::from_fn(|i| w[i] - bias[i]))
     }
 
     /// The accelerometer's mean over `[from, to)`.
-    fn gravity(&self, from: i64, to: i64) -> Option<[f64; 3]> {
+    fn gravity(&mut self, from: i64, to: i64) -> Option<[f64; 3]> {
         let (a, b) = (self.index(from), self.index(to));
-        (b > a).then(|| {
-            std::array::from_fn(|i| (self.accel[b][i] - self.accel[a][i]) / (b - a) as f64)
-        })
+        self.mean_of(&self.accel, a, b)
     }
 
     /// Whether gravity turned between the two [`GRAVITY_WINDOW_US`] windows before sample `k`,
     /// the way a turn at `omega` (sensor frame) turns it: a vector fixed in the world turns at
     /// `-omega x v` in the sensor's frame. (The simulator puts the sensor back upright between
     /// trials without a motion: gravity jumps then, against the motion before.)
-    fn gravity_turns(&self, k: usize, omega: [f64; 3]) -> bool {
-        let t = self.imu[k].t + 1;
+    fn gravity_turns(&mut self, k: usize, omega: [f64; 3]) -> bool {
+        let t = self.t(k) + 1;
         let w = GRAVITY_WINDOW_US;
         match (self.gravity(t - 2 * w, t - w), self.gravity(t - w, t)) {
             (Some(a), Some(b)) => {
@@ -251,19 +342,97 @@ fn round_to(v: f64, step: f64) -> f64 {
     }
 }
 
-/// The motions in `imu` (in time order), found and measured as the module docs say.
+/// The motions in `imu` (in time order, one sample per timestamp), found and measured as the
+/// module docs say.
 pub fn find_motions(
     imu: &[ImuSample],
     calibration: &Calibration,
     config: &FindConfig,
 ) -> Vec<FoundMotion> {
-    let samples = Samples::new(imu, calibration);
+    let mut whole = Some(imu);
+    let mut source = |out: &mut Vec<ImuSample>| {
+        out.extend_from_slice(whole.take().unwrap_or_default());
+        false
+    };
+    let mut samples = Samples::new(&mut source, calibration, false);
+    search(&mut samples, config)
+}
+
+/// What [`find_motions_in`] read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Streamed {
+    /// The motions.
+    pub found: Vec<FoundMotion>,
+    /// The most IMU samples held at once (the longest motion and a few seconds, or the whole
+    /// recording when its samples were out of time order and were read whole).
+    pub peak_samples: usize,
+}
+
+/// The motions in the gyroscope of the recording at `path`, read as the search goes and
+/// forgotten behind it: the same motions as [`find_motions`] of all its samples (sorted, one per
+/// timestamp, as [`crate::imu_sync::read_imu`] reads them), in memory bounded by the longest
+/// motion. A recording whose samples go back in time (several IMU streams) is read whole.
+pub fn find_motions_in(
+    path: &Path,
+    calibration: &Calibration,
+    config: &FindConfig,
+) -> Result<Streamed, evtac_events::Error> {
+    let mut reader = evtac_events::open(path)?;
+    let mut error = None;
+    let mut unordered = false;
+    let mut last_t = i64::MIN;
+    let mut source = |out: &mut Vec<ImuSample>| loop {
+        match reader.next_chunk() {
+            Ok(Some(chunk)) if chunk.imu.is_empty() => {}
+            Ok(Some(chunk)) => {
+                for s in chunk.imu {
+                    unordered |= s.t < last_t;
+                    // Repeated across packets: counted once, as `read_imu` does.
+                    if s.t != last_t {
+                        out.push(*s);
+                    }
+                    last_t = last_t.max(s.t);
+                }
+                return !unordered;
+            }
+            Ok(None) => return false,
+            Err(e) => {
+                error = Some(e);
+                return false;
+            }
+        }
+    };
+    let mut samples = Samples::new(&mut source, calibration, true);
+    let found = search(&mut samples, config);
+    let peak_samples = samples.peak;
+    drop(samples);
+    if let Some(e) = error {
+        return Err(e);
+    }
+    if unordered {
+        let imu = crate::imu_sync::read_imu(path)?;
+        return Ok(Streamed {
+            found: find_motions(&imu, calibration, config),
+            peak_samples: imu.len(),
+        });
+    }
+    Ok(Streamed {
+        found,
+        peak_samples,
+    })
+}
+
+/// The search over `samples`.
+fn search(samples: &mut Samples, config: &FindConfig) -> Vec<FoundMotion> {
     let mut found = Vec::new();
     let mut k = 0;
     // Where to look next after a motion ending (or a candidate rejected whole) at time `t`: a
     // bias window later, so that the next bias does not hold the motion.
-    let past = |t: i64, k: usize| samples.index(t + BIAS_WINDOW_US + BIAS_GUARD_US).max(k + 1);
-    while k < imu.len() {
+    let past = |samples: &mut Samples, t: i64, k: usize| {
+        samples.index(t + BIAS_WINDOW_US + BIAS_GUARD_US).max(k + 1)
+    };
+    while samples.has(k) {
+        samples.forget_before(k);
         let Some(bias) = samples.bias_before(k) else {
             k += 1;
             continue;
@@ -274,14 +443,14 @@ pub fn find_motions(
         }
         // Not a tilt (a step of the bias, not yet out of the bias window): the next sample is
         // looked at afresh, with the bias window moved on by one sample.
-        let Some(omega) = tilts_at_first(&samples, k, bias, config) else {
+        let Some(omega) = tilts_at_first(samples, k, bias, config) else {
             k += 1;
             continue;
         };
         // Moving while the rate is off the held bias and gravity turns, until neither for a
         // stop's length (a bias step alone, or a jump of gravity alone, does not keep it going).
         let (mut last_active, mut j) = (k, k);
-        while j < imu.len() && imu[j].t - imu[last_active].t <= config.max_stop_us {
+        while samples.has(j) && samples.t(j) - samples.t(last_active) <= config.max_stop_us {
             if samples.deviation(j, bias) > config.threshold_deg_s
                 && samples.gravity_turns(j, omega)
             {
@@ -289,27 +458,31 @@ pub fn find_motions(
             }
             j += 1;
         }
-        let (t_first, t_last) = (imu[k].t, imu[last_active].t);
+        let (t_first, t_last) = (samples.t(k), samples.t(last_active));
         let mut start = k;
         while start > 0
-            && t_first - imu[start - 1].t <= MAX_EDGE_US
+            && t_first - samples.t(start - 1) <= MAX_EDGE_US
             && samples.deviation(start - 1, bias) > EDGE_DEG_S
         {
             start -= 1;
         }
         let mut end = last_active;
-        while end + 1 < imu.len()
-            && imu[end + 1].t - t_last <= MAX_EDGE_US
+        while samples.has(end + 1)
+            && samples.t(end + 1) - t_last <= MAX_EDGE_US
             && samples.deviation(end + 1, bias) > EDGE_DEG_S
         {
             end += 1;
         }
-        match measure(&samples, start, end, bias, config) {
+        match measure(samples, start, end, bias, config) {
             Some(m) => {
                 found.push(m);
-                k = past(imu[end].t, end);
+                let t = samples.t(end);
+                k = past(samples, t, end);
             }
-            None => k = past(imu[k].t, k),
+            None => {
+                let t = samples.t(k);
+                k = past(samples, t, k);
+            }
         }
     }
     number_from(&mut found, 0);
@@ -329,12 +502,12 @@ pub fn number_from(found: &mut [FoundMotion], first: usize) {
 /// `bias` at sample `k`, if they look like a tilt: the rate about an axis in the x-y plane, and
 /// gravity turning with it.
 fn tilts_at_first(
-    samples: &Samples,
+    samples: &mut Samples,
     k: usize,
     bias: [f64; 3],
     config: &FindConfig,
 ) -> Option<[f64; 3]> {
-    let t0 = samples.imu[k].t;
+    let t0 = samples.t(k);
     let t1 = t0 + config.min_motion_us;
     let mean = samples.mean_over(t0, t1)?;
     let w: [f64; 3] = std::array::from_fn(|i| mean[i] - bias[i]);
@@ -353,14 +526,13 @@ fn tilts_at_first(
 
 /// The motion from sample `start` to `end` with `bias`, or `None` when it is no tilt.
 fn measure(
-    samples: &Samples,
+    samples: &mut Samples,
     start: usize,
     end: usize,
     bias: [f64; 3],
     config: &FindConfig,
 ) -> Option<FoundMotion> {
-    let imu = samples.imu;
-    let (t0, t1) = (imu[start].t, imu[end].t);
+    let (t0, t1) = (samples.t(start), samples.t(end));
     if t1 - t0 < config.min_motion_us {
         return None;
     }
@@ -371,10 +543,8 @@ fn measure(
         return None;
     }
     let phi = w[0].atan2(-w[1]).to_degrees().rem_euclid(360.0);
-    let rates: Vec<(i64, f64)> = imu[start..=end]
-        .iter()
-        .zip(start..=end)
-        .map(|(s, k)| (s.t, axial_rate(samples.rate(k, bias), phi)))
+    let rates: Vec<(i64, f64)> = (start..=end)
+        .map(|k| (samples.t(k), axial_rate(samples.rate(k, bias), phi)))
         .collect();
     let total: f64 = rates
         .windows(2)
@@ -422,7 +592,7 @@ fn measure(
 /// Pauses of at least 100 ms inside the motion from sample `start` to `end`: runs with the
 /// smoothed rate within `threshold` of `bias` (Experiment 2's stop is one).
 fn count_pauses(
-    samples: &Samples,
+    samples: &mut Samples,
     start: usize,
     end: usize,
     bias: [f64; 3],
@@ -431,7 +601,7 @@ fn count_pauses(
     let mut count = 0;
     let mut since = None;
     for k in start..=end {
-        let t = samples.imu[k].t;
+        let t = samples.t(k);
         match (samples.deviation(k, bias) <= threshold, since) {
             (true, None) => since = Some(t),
             (false, Some(t0)) => {
@@ -596,6 +766,44 @@ mod tests {
         assert!((m.total_gyro_deg - 12.0).abs() < 0.05, "{m:?}");
         assert!((m.total_gravity_deg - 12.0).abs() < 0.05, "{m:?}");
         assert_eq!((m.meta.trial.as_str(), m.pauses), ("m0000", 0));
+    }
+
+    /// Samples read in pieces and forgotten behind the search find what all of them in memory
+    /// find, value for value, holding a bounded window: six bias steps and tilts in a row (a
+    /// minute, three windows' worth of samples to forget).
+    #[test]
+    fn a_bounded_window_finds_what_the_whole_recording_finds() {
+        let (one, _) = bias_step_then_tilt();
+        let span = one.last().unwrap().t + 1250;
+        let imu: Vec<ImuSample> = (0..6)
+            .flat_map(|r| {
+                one.iter().map(move |s| ImuSample {
+                    t: s.t + r * span,
+                    ..*s
+                })
+            })
+            .collect();
+        let (calibration, config) = (Calibration::default(), FindConfig::new(2.0));
+        let whole = find_motions(&imu, &calibration, &config);
+        assert_eq!(whole.len(), 6, "{whole:?}");
+        for piece in [1, 77, 4000] {
+            let mut pieces = imu.chunks(piece);
+            let mut source = |out: &mut Vec<ImuSample>| match pieces.next() {
+                Some(p) => {
+                    out.extend_from_slice(p);
+                    true
+                }
+                None => false,
+            };
+            let mut samples = Samples::new(&mut source, &calibration, true);
+            assert_eq!(search(&mut samples, &config), whole, "pieces of {piece}");
+            assert!(
+                samples.base > 0 && samples.peak < imu.len() / 2,
+                "held {} of {}",
+                samples.peak,
+                imu.len()
+            );
+        }
     }
 
     #[test]

@@ -134,7 +134,9 @@ pub fn synchronise(session: &Path, log: RobotLog, sync: Sync) -> Result<Synced, 
 /// Each row's offset from the session's triggers of type `kind` (rows paired with triggers in
 /// the order of their onsets), in log order.
 fn trigger_offsets(session: &Path, log: &RobotLog, kind: i8) -> Result<Vec<i64>, SyncError> {
+    // A pass of its own before the cuts (which depend on it), decoding the triggers only.
     let mut reader = evtac_events::open(session)?;
+    reader.triggers_only();
     let mut triggers = Vec::new();
     while let Some(chunk) = reader.next_chunk()? {
         triggers.extend(

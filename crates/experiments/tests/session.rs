@@ -9,7 +9,7 @@ use evtac_experiments::check::check;
 use evtac_experiments::import::{ImportConfig, NoContact, import_session};
 use evtac_experiments::imu_sync::read_imu;
 use evtac_experiments::inputs::Inputs;
-use evtac_experiments::motions::{FindConfig, as_log, find_motions};
+use evtac_experiments::motions::{FindConfig, as_log, find_motions, find_motions_in};
 use evtac_experiments::robot_log::RobotLog;
 use evtac_experiments::sync::{Sync, SyncError, synchronise};
 use evtac_labels::dataset::{label_trial, read_calibration, read_calibration_file};
@@ -222,6 +222,20 @@ fn a_session_imported_without_its_log_finds_every_motion_and_labels_as_well_as_p
         found.len(),
         record.trials.len(),
         "every motion, nothing else"
+    );
+    // What `evtac import` runs: read as the search goes, forgotten behind it, the same motions.
+    let streamed = find_motions_in(
+        &session.join("session.aedat4"),
+        &calibration,
+        &FindConfig::new(1.5),
+    )
+    .unwrap();
+    assert_eq!(streamed.found, found);
+    assert!(
+        streamed.peak_samples < imu.len() / 2,
+        "held {} of {} samples",
+        streamed.peak_samples,
+        imu.len()
     );
     let mut onset_errors_ms = Vec::new();
     for (m, truth) in found.iter().zip(&record.trials) {

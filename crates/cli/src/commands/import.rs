@@ -10,7 +10,6 @@ use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_experiments::import::{
     DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, Part, import_parts,
 };
-use evtac_experiments::imu_sync::read_imu;
 use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
 use evtac_experiments::motions::{self, FoundMotion};
 use evtac_experiments::robot_log::RobotLog;
@@ -135,13 +134,13 @@ fn find_config(args: &Args) -> anyhow::Result<(Calibration, motions::FindConfig)
     Ok((calibration, config))
 }
 
-/// The motions in the gyroscope of `file`.
+/// The motions in the gyroscope of `file`, read as the search goes (memory bounded by the
+/// longest motion, not the session).
 fn found_motions(
     file: &Path,
     (calibration, config): &(Calibration, motions::FindConfig),
 ) -> anyhow::Result<Vec<FoundMotion>> {
-    let imu = read_imu(file)?;
-    Ok(motions::find_motions(&imu, calibration, config))
+    Ok(motions::find_motions_in(file, calibration, config)?.found)
 }
 
 /// The motions found in `file`, as a table.

@@ -20,7 +20,48 @@ pub const MAX_PACKET_BYTES: u64 = 1 << 30;
 const MAX_BULK_RATIO: u64 = 64;
 
 /// LZ4 frame magic number (little-endian `04 22 4D 18`).
-const LZ4_MAGIC: u32 = 0x184D_2204;
+pub(crate) const LZ4_MAGIC: u32 = 0x184D_2204;
+
+/// What an LZ4 frame's descriptor (its `FLG` and `BD` bytes) says.
+pub(crate) struct Lz4Frame {
+    /// Blocks may refer to the 64 KiB of output before them.
+    pub linked: bool,
+    /// Bytes of checksum after each block.
+    pub block_checksum: usize,
+    /// Largest decoded block.
+    pub max_block: usize,
+    /// Bytes from the frame's start to its first block.
+    pub header_len: usize,
+    /// Bytes of checksum after the end mark.
+    pub content_checksum: usize,
+}
+
+impl Lz4Frame {
+    /// Reads the descriptor bytes `flg` and `bd` (after the 4-byte magic).
+    pub fn parse(flg: u8, bd: u8) -> Result<Self, String> {
+        if flg >> 6 != 1 {
+            return Err(format!("unsupported LZ4 frame version {}", flg >> 6));
+        }
+        let max_block = match (bd >> 4) & 7 {
+            4 => 64 << 10,
+            5 => 256 << 10,
+            6 => 1 << 20,
+            7 => 4 << 20,
+            other => return Err(format!("bad LZ4 block size code {other}")),
+        };
+        Ok(Self {
+            linked: flg & 0x20 == 0,
+            block_checksum: if flg & 0x10 != 0 { 4 } else { 0 },
+            max_block,
+            // magic, FLG, BD, optional content size (8) and dictionary id (4), header checksum.
+            header_len: 6
+                + if flg & 0x08 != 0 { 8 } else { 0 }
+                + if flg & 0x01 != 0 { 4 } else { 0 }
+                + 1,
+            content_checksum: if flg & 0x04 != 0 { 4 } else { 0 },
+        })
+    }
+}
 
 /// Decodes one LZ4 frame (the format of the LZ4 frame specification, v1.6) into
 /// the front of `out`, growing `out` as needed; returns the decoded length.
@@ -41,22 +82,14 @@ fn lz4_decode_frame(bytes: &[u8], out: &mut Vec<u8>) -> Result<usize, String> {
     if word(0)? != LZ4_MAGIC {
         return Err("not an LZ4 frame (bad magic number)".to_owned());
     }
-    let flg = take(4, 1)?[0];
-    let bd = take(5, 1)?[0];
-    if flg >> 6 != 1 {
-        return Err(format!("unsupported LZ4 frame version {}", flg >> 6));
-    }
-    let linked = flg & 0x20 == 0;
-    let block_checksum = if flg & 0x10 != 0 { 4 } else { 0 };
-    let max_block = match (bd >> 4) & 7 {
-        4 => 64 << 10,
-        5 => 256 << 10,
-        6 => 1 << 20,
-        7 => 4 << 20,
-        other => return Err(format!("bad LZ4 block size code {other}")),
-    };
-    // magic, FLG, BD, optional content size (8) and dictionary id (4), header checksum (1).
-    let mut pos = 6 + if flg & 0x08 != 0 { 8 } else { 0 } + if flg & 0x01 != 0 { 4 } else { 0 } + 1;
+    let Lz4Frame {
+        linked,
+        block_checksum,
+        max_block,
+        header_len,
+        content_checksum,
+    } = Lz4Frame::parse(take(4, 1)?[0], take(5, 1)?[0])?;
+    let mut pos = header_len;
     let mut len = 0usize;
     loop {
         let head = word(pos)?;
@@ -95,7 +128,7 @@ fn lz4_decode_frame(bytes: &[u8], out: &mut Vec<u8>) -> Result<usize, String> {
         };
         len += n;
     }
-    pos += if flg & 0x04 != 0 { 4 } else { 0 };
+    pos += content_checksum;
     match pos.cmp(&bytes.len()) {
         std::cmp::Ordering::Equal => Ok(len),
         std::cmp::Ordering::Greater => Err(cut()),

@@ -52,6 +52,8 @@ mod index;
 mod packet;
 mod reader;
 pub mod schema;
+mod table_check;
+mod table_stream;
 mod writer;
 
 pub use compression::MAX_PACKET_BYTES;

@@ -11,6 +11,7 @@ use super::error::{AedatError, Result};
 use super::header::{AedatHeader, Compression, MAGIC, StreamKind};
 use super::index::{self, Plan, PlannedPacket};
 use super::packet::{self, StreamState};
+use super::table_check::{self, ENTRIES_PER_PASS, Verdict};
 use crate::range::{RangeIndex, ScanReason, retain_within};
 use crate::{Event, ImuSample, Resolution, Trigger};
 
@@ -93,9 +94,14 @@ pub struct AedatReader<R> {
     data_start: u64,
     /// Where the packets end: the data table, when there is one.
     table_end: Option<u64>,
+    /// Decode trigger packets only ([`Self::triggers_only`]).
+    triggers_only: bool,
     /// Whether to verify the data table on reaching it (not when a range read already found it
     /// unusable and said so).
     check_table: bool,
+    /// How to seek, when the input can: the data table is then checked in passes over it,
+    /// holding constant memory ([`table_check`]), rather than read whole.
+    rewind: Option<SeekTo<R>>,
     decompressor: Decompressor,
     streams: Vec<StreamState>,
     events: Vec<Event>,
@@ -111,7 +117,9 @@ impl AedatReader<BufReader<File>> {
     /// Opens an AEDAT 4.0 file (buffered).
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let file = File::open(path).map_err(|source| AedatError::Io { offset: 0, source })?;
-        Self::new(BufReader::with_capacity(1 << 16, file))
+        let mut reader = Self::new(BufReader::with_capacity(1 << 16, file))?;
+        reader.rewind = Some(seek_to);
+        Ok(reader)
     }
 }
 
@@ -218,6 +226,8 @@ impl<R: Read> AedatReader<R> {
             decompressor: Decompressor::new(header.compression),
             table_end: header.data_table_position,
             check_table: true,
+            triggers_only: false,
+            rewind: None,
             header,
             offset: offset + 4 + size,
             data_start: offset + 4 + size,
@@ -258,6 +268,13 @@ impl<R: Read> AedatReader<R> {
     /// Gives back the underlying reader.
     pub fn into_inner(self) -> R {
         self.reader
+    }
+
+    /// From now on, decodes trigger packets only: event and IMU packets are read past like
+    /// frames, undecoded (their data is not checked either), so that finding a long
+    /// recording's triggers decompresses nothing else.
+    pub fn triggers_only(&mut self) {
+        self.triggers_only = true;
     }
 
     /// Decodes the next packet of events, IMU samples or triggers (frame packets and unknown
@@ -522,10 +539,16 @@ impl<R: Read> AedatReader<R> {
             });
         }
         let state = &mut self.streams[index];
-        if !matches!(
-            state.kind,
-            StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
-        ) {
+        // A range read's plan lists the packets it needs: those are all decoded.
+        let decoded = if self.triggers_only && planned.is_none() {
+            matches!(state.kind, StreamKind::Triggers)
+        } else {
+            matches!(
+                state.kind,
+                StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
+            )
+        };
+        if !decoded {
             return Ok(Packet::Skipped);
         }
         let payload =
@@ -546,8 +569,22 @@ impl<R: Read> AedatReader<R> {
     }
 
     /// Reads the data table at `offset` (the rest of the file) and verifies it, so that a file
-    /// cut at or inside its data table is reported rather than taken as complete.
+    /// cut at or inside its data table is reported rather than taken as complete: streamed when
+    /// the input can seek, whole when it cannot or the streamed check is unsure (a damaged
+    /// table then gets the whole verifier's error).
     fn check_data_table(&mut self, offset: u64) -> Result<()> {
+        if let Some(seek) = self.rewind {
+            let compression = self.header.compression;
+            let per_pass = ENTRIES_PER_PASS;
+            match table_check::check(&mut self.reader, seek, offset, compression, per_pass) {
+                Verdict::Valid(length) => {
+                    self.offset = offset + length;
+                    return Ok(());
+                }
+                Verdict::Unsure => seek(&mut self.reader, offset)
+                    .map_err(|source| AedatError::Io { offset, source })?,
+            }
+        }
         let input = self.decompressor.input();
         let got = (&mut self.reader)
             .take(MAX_PACKET_BYTES)
@@ -622,6 +659,7 @@ impl<R: Read + Seek> AedatReader<R> {
         self.finished = false;
         self.table_end = self.header.data_table_position;
         self.check_table = true;
+        self.rewind = Some(seek_to::<R>);
         for s in &mut self.streams {
             s.count = 0;
             s.last_t = i64::MIN;
