@@ -10,6 +10,7 @@ use super::frames::{Frame, Timing};
 use crate::plots::images::{draw_image, grey, polarity_color};
 use crate::plots::{Error, FAMILY, draw_err};
 use evtac_repr::CROP;
+use evtac_repr::pool::CELL;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -20,8 +21,6 @@ const MARGIN: i32 = 10;
 const HEADER: i32 = 26;
 /// Height of a panel's title above it.
 const TITLE: i32 = 22;
-/// Pooling cell of the features (8x8 pixels per feature).
-const CELL: usize = 8;
 /// Height of the angles panel.
 const ANGLES_HEIGHT: i32 = 240;
 /// The narrowest angles panel: two charts with readable axes.
