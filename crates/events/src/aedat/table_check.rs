@@ -18,7 +18,7 @@
 //! table as before, so a damaged file gets exactly the error it always got; only a good table
 //! is checked in constant memory.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::io::Read;
 use std::ops::ControlFlow;
 
@@ -324,6 +324,8 @@ struct Walk<'a> {
     tables: Vec<(u64, u64)>,
     /// Vtables read in this pass.
     found: HashMap<u64, Vtable>,
+    /// Vtables asked for in this pass (read, pending or behind), so each is asked for once.
+    wanted: HashSet<u64>,
     /// Vtables named after the stream had passed them.
     behind: Vec<u64>,
     failed: bool,
@@ -362,6 +364,7 @@ impl<'a> Walk<'a> {
             total: 0,
             tables: Vec::new(),
             found: HashMap::new(),
+            wanted: HashSet::new(),
             behind: Vec::new(),
             failed: false,
         }
@@ -437,19 +440,12 @@ impl<'a> Walk<'a> {
                 };
                 self.tables.push((pos, vtable));
                 let known = self.known.is_some_and(|k| k.contains_key(&vtable));
-                if !known && !self.found.contains_key(&vtable) {
-                    if self.found.len() + self.behind.len() > MAX_VTABLES {
+                if !known && !self.wanted.contains(&vtable) {
+                    if self.wanted.len() + self.behind.len() > MAX_VTABLES {
                         self.failed = true;
                         return;
                     }
-                    // Marked found at once (as a placeholder) so that it is wanted once.
-                    self.found.insert(
-                        vtable,
-                        Vtable {
-                            bytes: [0; VTABLE_READ as usize],
-                            read: 0,
-                        },
-                    );
+                    self.wanted.insert(vtable);
                     self.want(vtable, Want::Vtable);
                 }
             }
