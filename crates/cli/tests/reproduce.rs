@@ -25,7 +25,7 @@ pub fn tiny_run() -> &'static Path {
         // Not a terminal: plain lines say each stage's start, end and the overall ETA.
         for line in [
             "estimated run time ",
-            "experiment 1 training: 6 to do (overall eta ",
+            "experiment 1 training: 10 to do (overall eta ",
             "experiment 1 training: done in ",
             "latency: done in ",
         ] {
@@ -95,8 +95,25 @@ fn results(out: &Path) -> serde_json::Value {
 fn tiny_reproduction_writes_the_report_with_every_figure() {
     let out = tiny_run();
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    for row in ["| Static |", "| Dynamic |", "| Combined |"] {
+    for row in [
+        "| Static |",
+        "| Dynamic |",
+        "| Combined |",
+        "| Stacked |",
+        "| Late |",
+    ] {
         assert!(report.contains(row), "no `{row}` row in:\n{report}");
+    }
+    // The learned fusions: beside the paper's three, and the section's verdicts, computed.
+    assert!(report.contains("| Late | ") && report.contains("not in the paper"));
+    assert!(report.contains("## Beyond OR: learned fusion"), "{report}");
+    for line in [
+        "- Experiment 1: Stacked (",
+        "- Experiment 1: Late (",
+        "against the best single representation, ",
+        "- Experiment 2 (",
+    ] {
+        assert!(report.contains(line), "no `{line}` in:\n{report}");
     }
     assert!(
         report.contains("0.160 ± 0.004"),
@@ -164,12 +181,13 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         results["choices"].as_array().map(Vec::len),
         Some(expected.len())
     );
-    assert_eq!(results["exp1"].as_array().map(Vec::len), Some(3));
-    // Experiment 1 at every noise level of the plan, for the three representations; x1 is
+    let reprs = evtac_experiments::exp1::NAMES.len();
+    assert_eq!(results["exp1"].as_array().map(Vec::len), Some(reprs));
+    // Experiment 1 at every noise level of the plan, for every representation; x1 is
     // Experiment 1 itself, and no noise means no background events.
     let levels = Plan::for_scale(Scale::Tiny).noise_levels;
     let noise = results["noise"].as_array().unwrap();
-    assert_eq!(noise.len(), 3 * levels.len());
+    assert_eq!(noise.len(), reprs * levels.len());
     for p in noise {
         let level = p["level"].as_f64().unwrap();
         assert!(levels.contains(&level), "{p}");
@@ -193,14 +211,22 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         );
     }
     assert!(report.contains("Dynamic minus static test MAE: "));
-    assert_eq!(results["exp2"].as_array().map(Vec::len), Some(9));
+    let settings = 3; // continuous-only, pause-motion, pause-motion-stop
+    assert_eq!(
+        results["exp2"].as_array().map(Vec::len),
+        Some(settings * reprs)
+    );
     let speeds = results["exp3_speed"].as_array().unwrap();
     assert!(
         speeds.iter().any(|p| p["seen"] == false),
         "Experiment 3 has no unseen speed"
     );
     assert!(!results["exp3_depth"].as_array().unwrap().is_empty());
-    assert_eq!(results["latency"].as_array().map(Vec::len), Some(12));
+    let intervals = Plan::for_scale(Scale::Tiny).latency_intervals_ms.len();
+    assert_eq!(
+        results["latency"].as_array().map(Vec::len),
+        Some(reprs * intervals)
+    );
     let mae = results["exp1"][0]["test"]["overall"]["mean"]
         .as_f64()
         .unwrap();

@@ -48,7 +48,7 @@ fn stream() -> Vec<Event> {
 
 fn main() {
     let events = stream();
-    let reprs = evtac_experiments::exp1::representations(
+    let reprs = evtac_experiments::exp1::paper_representations(
         ReprConfig::Static(StaticConfig::default()),
         ReprConfig::Dynamic(DynamicConfig::default()),
     );

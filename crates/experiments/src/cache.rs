@@ -9,6 +9,7 @@
 //!                                                  per calibration and label settings)
 //! cache/m50-s0/<cache_key>-<mask id>/config.json   the config and mask identity (for people)
 //! cache/m50-s0/<cache_key>-<mask id>/<trial>.npy   N x 900 float32, one row per sample
+//!                                                   (N x 1800 for stacked and late: two frames)
 //! ```
 //!
 //! A file exists only once complete (written to a temporary name, then renamed), so an
@@ -30,8 +31,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Number of features per sample (30 x 30 cells of the 240 x 240 crop).
+/// Number of features per pooled frame (30 x 30 cells of the 240 x 240 crop); a sample has
+/// [`ReprConfig::frames`] of them side by side.
 pub const FEATURES: usize = 900;
+
+/// Features per sample of `config`.
+pub fn width(config: &ReprConfig) -> usize {
+    config.frames() * FEATURES
+}
 
 /// Errors computing or reading cached features.
 #[derive(Debug, thiserror::Error)]
@@ -52,12 +59,14 @@ pub enum Error {
     #[error(transparent)]
     Io(#[from] IoError),
     /// A cache file does not have the expected shape.
-    #[error("{path}: expected {expected_rows} x {FEATURES} features, found {rows} x {cols}")]
+    #[error("{path}: expected {expected_rows} x {expected_cols} features, found {rows} x {cols}")]
     Shape {
         /// The file.
         path: PathBuf,
         /// Rows expected (samples of the trial).
         expected_rows: usize,
+        /// Columns expected (features per sample).
+        expected_cols: usize,
         /// Rows found.
         rows: usize,
         /// Columns found.
@@ -101,7 +110,8 @@ pub struct SampleMeta {
 /// Features and labels of a list of trials plus per-sample meta, in trial then time order.
 #[derive(Debug, Clone, Default)]
 pub struct LoadedSet {
-    /// Features (N x 900) and labels (N x 2, pitch then roll, degrees).
+    /// Features (N x 900, or N x 1800 for two frames) and labels (N x 2, pitch then roll,
+    /// degrees).
     pub set: FeatureSet,
     /// Per-sample meta (N).
     pub samples: Vec<SampleMeta>,
@@ -279,7 +289,10 @@ impl<'a> FeatureCache<'a> {
         };
         let mut fx = FeatureExtractor::new_with_masks(&sel, CROP, &sel_masks).map_err(repr)?;
         let times: Vec<i64> = samples.times.iter().map(|s| s.t_us).collect();
-        let mut out: Vec<Vec<f32>> = vec![Vec::with_capacity(times.len() * FEATURES); sel.len()];
+        let mut out: Vec<Vec<f32>> = sel
+            .iter()
+            .map(|c| Vec::with_capacity(times.len() * width(c)))
+            .collect();
         fx.run(&events, &times, |_, fx| {
             for (i, o) in out.iter_mut().enumerate() {
                 o.extend_from_slice(fx.features(i));
@@ -289,8 +302,8 @@ impl<'a> FeatureCache<'a> {
         for (k, &i) in which.iter().enumerate() {
             let path = dirs[i].join(format!("{}.npy", meta.trial));
             let values = std::mem::take(&mut out[k]);
-            let array =
-                Array2::from_shape_vec((times.len(), FEATURES), values).map_err(io(&path))?;
+            let array = Array2::from_shape_vec((times.len(), width(&configs[i])), values)
+                .map_err(io(&path))?;
             std::fs::create_dir_all(&dirs[i]).map_err(io(&dirs[i]))?;
             let tmp = crate::jobs::tmp_path(&path);
             ndarray_npy::write_npy(&tmp, &array).map_err(io(&tmp))?;
@@ -318,10 +331,11 @@ impl<'a> FeatureCache<'a> {
                 let path = dir.join(format!("{}.npy", meta.trial));
                 let array: Array2<f32> = ndarray_npy::read_npy(&path).map_err(io(&path))?;
                 let (rows, cols) = array.dim();
-                if rows != samples.times.len() || cols != FEATURES {
+                if rows != samples.times.len() || cols != width(config) {
                     return Err(Error::Shape {
                         path,
                         expected_rows: samples.times.len(),
+                        expected_cols: width(config),
                         rows,
                         cols,
                     });
@@ -343,7 +357,10 @@ impl<'a> FeatureCache<'a> {
                 Ok((f, l, m))
             })
             .collect::<Result<_, _>>()?;
-        let mut out = LoadedSet::default();
+        let mut out = LoadedSet {
+            set: FeatureSet::empty(width(config)),
+            samples: Vec::new(),
+        };
         for (f, l, m) in parts {
             out.set.features.extend(f);
             out.set.labels.extend(l);

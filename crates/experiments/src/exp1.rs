@@ -1,6 +1,6 @@
-//! Experiment 1: the static, dynamic and combined representations with the chosen settings,
-//! trained with several seeds on the continuous-motion dataset; test MAE overall, pitch and roll
-//! as mean ± std over seeds.
+//! Experiment 1: the static, dynamic and combined representations with the chosen settings, and
+//! evtac's two learned fusions of the same parts (stacked, late), trained with several seeds on
+//! the continuous-motion dataset; test MAE overall, pitch and roll as mean ± std over seeds.
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
@@ -16,20 +16,66 @@ use evtac_learn::ModelBundle;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 
-/// The three representations compared: display name and config.
+/// The display names of the representations compared, in report order: the paper's three, then
+/// evtac's learned fusions.
+pub const NAMES: [&str; 5] = ["Static", "Dynamic", "Combined", "Stacked", "Late"];
+/// The learned fusions among [`NAMES`] (not in the paper).
+pub const FUSIONS: [&str; 2] = ["Stacked", "Late"];
+
+/// The representations of [`NAMES`] among `names` (results' names, in any order and repeated),
+/// in report order: the columns and panels of a table or figure.
+pub fn in_order<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'static str> {
+    let names: Vec<&str> = names.collect();
+    NAMES.into_iter().filter(|n| names.contains(n)).collect()
+}
+
+/// The paper's three representations, display name and config: static, dynamic and their
+/// OR (what `evtac render` draws as frames).
+pub fn paper_representations(
+    static_cfg: ReprConfig,
+    dynamic_cfg: ReprConfig,
+) -> Vec<(&'static str, ReprConfig)> {
+    let mut out = representations(static_cfg, dynamic_cfg);
+    out.truncate(3);
+    out
+}
+
+/// The representations compared, display name and config: the paper's three (static,
+/// dynamic, their OR) and the two learned fusions of the same tuned parts (`Stacked`: one dense
+/// network over both frames; `Late`: a branch per frame joined before the head), which are not
+/// tuned on their own: they take the settings chosen for static and dynamic.
 pub fn representations(
     static_cfg: ReprConfig,
     dynamic_cfg: ReprConfig,
 ) -> Vec<(&'static str, ReprConfig)> {
-    let mut out = vec![("Static", static_cfg), ("Dynamic", dynamic_cfg)];
-    if let (Some(s), Some(d)) = (static_cfg.static_part(), dynamic_cfg.dynamic_part()) {
-        out.push((
-            "Combined",
-            ReprConfig::Combined {
-                static_part: *s,
-                dynamic_part: *d,
-            },
-        ));
+    let [st, dy, combined, stacked, late] = NAMES;
+    let mut out = vec![(st, static_cfg), (dy, dynamic_cfg)];
+    if let (Some(&static_part), Some(&dynamic_part)) =
+        (static_cfg.static_part(), dynamic_cfg.dynamic_part())
+    {
+        out.extend([
+            (
+                combined,
+                ReprConfig::Combined {
+                    static_part,
+                    dynamic_part,
+                },
+            ),
+            (
+                stacked,
+                ReprConfig::Stacked {
+                    static_part,
+                    dynamic_part,
+                },
+            ),
+            (
+                late,
+                ReprConfig::Late {
+                    static_part,
+                    dynamic_part,
+                },
+            ),
+        ]);
     }
     out
 }

@@ -249,7 +249,13 @@ pub fn reproduce(
     let test = ds1.trials(splits1.get(Split::Test))?;
     let (repr_example, sensor) = match test.first() {
         Some(meta) => {
-            let example = repr_example::example(&cache1, meta, &reprs)?;
+            // The paper's three frames (the fusions' are the static and dynamic ones).
+            let paper_reprs: Vec<_> = reprs
+                .iter()
+                .filter(|(_, c)| c.frames() == 1)
+                .copied()
+                .collect();
+            let example = repr_example::example(&cache1, meta, &paper_reprs)?;
             // The tilt at the example's sample (commanded: constant speed from onset).
             let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
                 (meta.speed_deg_s * e.t_ms / 1000.0).min(meta.total_deg)
@@ -335,8 +341,16 @@ pub fn train_command(
         ReprConfig::Combined {
             static_part: s,
             dynamic_part: d,
+        }
+        | ReprConfig::Stacked {
+            static_part: s,
+            dynamic_part: d,
+        }
+        | ReprConfig::Late {
+            static_part: s,
+            dynamic_part: d,
         } => {
-            args.extend(["--repr".into(), "combined".into()]);
+            args.extend(["--repr".into(), spec.repr.kind_name().into()]);
             args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
             args.extend(["--threshold".into(), s.threshold.to_string()]);
             args.extend(["--window-ms".into(), d.window_ms.to_string()]);

@@ -45,10 +45,12 @@ static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 pub(crate) const FAMILY: &str = "sans-serif";
 
 /// Colors of the three representations, used in every figure.
-const REPR_COLORS: [RGBColor; 3] = [
+const REPR_COLORS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
 ];
 /// Colors of Experiment 2's three training settings.
 const SETTING_COLORS: [RGBColor; 3] = [
@@ -135,13 +137,11 @@ where
         .map_err(draw_err(path))
 }
 
-/// The color of a representation by name (`Static`, `Dynamic`, `Combined`).
+/// The color of a representation by name (one per [`crate::exp1::NAMES`], in that order; the
+/// combined one's for any other name).
 pub(crate) fn repr_color(name: &str) -> RGBColor {
-    match name {
-        "Static" => REPR_COLORS[0],
-        "Dynamic" => REPR_COLORS[1],
-        _ => REPR_COLORS[2],
-    }
+    let i = crate::exp1::NAMES.iter().position(|n| *n == name);
+    REPR_COLORS[i.unwrap_or(2)]
 }
 
 /// A tick label: at most three decimals, without trailing zeros (`5.5`, `100`, `0.25`).

@@ -14,7 +14,7 @@
 //! use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let events = evtac_experiments::dataset::read_cropped("trial.aedat4".as_ref())?;
-//! let reprs = evtac_experiments::exp1::representations(
+//! let reprs = evtac_experiments::exp1::paper_representations(
 //!     ReprConfig::Static(StaticConfig::default()),
 //!     ReprConfig::Dynamic(DynamicConfig::default()),
 //! );
@@ -95,7 +95,7 @@ impl Panel {
     }
 
     /// The representation (`Static`, `Dynamic`, `Combined`, as
-    /// [`crate::exp1::representations`] names them) a frame panel shows.
+    /// [`crate::exp1::paper_representations`] names them) a frame panel shows.
     pub fn repr_name(self) -> Option<&'static str> {
         match self {
             Panel::Static => Some("Static"),
@@ -226,7 +226,7 @@ impl<'a> Scene<'a> {
 
 /// Renders `events` (cropped to [`evtac_repr::CROP`], time order) to `path` as `output`: the
 /// frames of `scene`, the representations `reprs` (name, config, as
-/// [`crate::exp1::representations`] lists them) built with `masks` (one per config, `None` for
+/// [`crate::exp1::paper_representations`] lists them) built with `masks` (one per config, `None` for
 /// none).
 pub fn render(
     path: &Path,

@@ -8,6 +8,8 @@ use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, SensorKind};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod fusion;
+
 /// A mean and a standard deviation, in degrees.
 pub type MeanStd = (f64, f64);
 
@@ -153,11 +155,13 @@ fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str),
     values.dedup_by(|a, b| a.0 == b.0);
     let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit, paper_gap));
     let unit = format!("{axis} ({unit})");
+    let names = crate::exp1::in_order(points.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         md,
-        "| {unit} | seen | trials | Static | Dynamic | Combined |"
+        "| {unit} | seen | trials | {} |\n| ---: | :---: | ---: |{}",
+        names.join(" | "),
+        " ---: |".repeat(names.len())
     );
-    let _ = writeln!(md, "| ---: | :---: | ---: | ---: | ---: | ---: |");
     for (v, seen) in values {
         let get = |name: &str| {
             points
@@ -166,13 +170,12 @@ fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str),
                 .map_or("-".to_string(), |p| cell(&p.stats.overall))
         };
         let trials = points.iter().find(|p| p.value == v).map_or(0, |p| p.trials);
+        let cells: Vec<String> = names.iter().map(|n| get(n)).collect();
         let _ = writeln!(
             md,
-            "| {v} | {} | {trials} | {} | {} | {} |",
+            "| {v} | {} | {trials} | {} |",
             if seen { "seen" } else { "unseen" },
-            get("Static"),
-            get("Dynamic"),
-            get("Combined")
+            cells.join(" | ")
         );
     }
 }
@@ -292,18 +295,26 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         "| Representation | Overall MAE | Pitch MAE | Roll MAE | Paper overall | Paper pitch | Paper roll |"
     );
     let _ = writeln!(md, "| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (name, po, pp, pr) in PAPER_TABLE {
+    // The paper's three always (its numbers beside ours), then the learned fusions run.
+    let fusions = crate::exp1::in_order(r.exp1.iter().map(|e| e.name.as_str()));
+    let names = PAPER_TABLE.iter().map(|p| p.0).chain(
+        fusions
+            .into_iter()
+            .filter(|n| crate::exp1::FUSIONS.contains(n)),
+    );
+    for name in names {
         let ours = r.exp1.iter().find(|e| e.name == name);
         let s = ours.map(|e| e.test).unwrap_or_default();
+        let theirs = match PAPER_TABLE.iter().find(|p| p.0 == name) {
+            Some(&(_, po, pp, pr)) => format!("{} | {} | {}", paper(po), paper(pp), paper(pr)),
+            None => "not in the paper | | ".to_string(),
+        };
         let _ = writeln!(
             md,
-            "| {name} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {} | {} | {theirs} |",
             cell(&s.overall),
             cell(&s.pitch),
             cell(&s.roll),
-            paper(po),
-            paper(pp),
-            paper(pr)
         );
     }
     let _ = writeln!(md);
@@ -367,6 +378,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     }
     figure(&mut md, figures, 3, None);
     figure(&mut md, figures, 4, None);
+    fusion::section(&mut md, r);
 
     let _ = writeln!(
         md,
@@ -491,10 +503,12 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
+    let names = crate::exp1::in_order(r.noise.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         md,
-        "| noise | background events/s | Static | Dynamic | Combined | dynamic - static |\n\
-         | ---: | ---: | ---: | ---: | ---: | ---: |"
+        "| noise | background events/s | {} | dynamic - static |\n| ---: | ---: |{} ---: |",
+        names.join(" | "),
+        " ---: |".repeat(names.len())
     );
     let mut gaps = Vec::new();
     for &level in &levels {
@@ -515,12 +529,11 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
         if let Some((g, spread)) = gap {
             gaps.push((level, g, spread));
         }
+        let cells: Vec<String> = names.iter().map(|n| cell_of(n)).collect();
         let _ = writeln!(
             md,
-            "| x{level} | {rate:.0} | {} | {} | {} | {} |",
-            cell_of("Static"),
-            cell_of("Dynamic"),
-            cell_of("Combined"),
+            "| x{level} | {rate:.0} | {} | {} |",
+            cells.join(" | "),
             gap.map_or("-".to_string(), |(g, _)| format!("{g:+.3}"))
         );
     }

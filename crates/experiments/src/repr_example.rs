@@ -14,7 +14,7 @@ use evtac_events::manifest::TrialMeta;
 use evtac_repr::{CROP, FeatureExtractor, ReprConfig};
 
 /// Fig. 2's data for the middle motion sample of `meta`, with `reprs` (display name, config:
-/// static, dynamic, combined as [`crate::exp1::representations`] lists them). `None` when the
+/// static, dynamic, combined as [`crate::exp1::paper_representations`] lists them). `None` when the
 /// trial has no motion sample.
 pub fn example(
     cache: &FeatureCache<'_>,

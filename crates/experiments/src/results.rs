@@ -130,7 +130,7 @@ pub struct Tuning {
 /// Experiment 1 for one representation: ten seeds with the chosen settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp1Repr {
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// The representation config.
     pub config: serde_json::Value,
@@ -149,7 +149,7 @@ pub struct Exp1Repr {
 pub struct NoisePoint {
     /// The factor on the simulator's leak, shot and hot-pixel noise (1: Experiment 1 itself).
     pub level: f64,
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// Events per second in the 240x240 crop of the dataset's no-contact recording: the
     /// background activity at this level.
@@ -165,7 +165,7 @@ pub struct NoisePoint {
 pub struct Exp2Cell {
     /// `continuous-only`, `pause-motion` or `pause-motion-stop`.
     pub setting: String,
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// Motion-phase test MAE per seed.
     pub motion_runs: Vec<Mae>,
@@ -180,7 +180,7 @@ pub struct Exp2Cell {
 /// Experiment 3: one condition value (a speed or a depth) for one representation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp3Point {
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// Speed in deg/s or depth in mm.
     pub value: f64,
@@ -197,7 +197,7 @@ pub struct Exp3Point {
 /// Latency of one (representation, sampling interval).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LatencyCell {
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// Sampling interval in ms.
     pub interval_ms: u32,
@@ -295,7 +295,7 @@ pub struct ReprExample {
 /// One representation of [`ReprExample`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ReprPanel {
-    /// `Static`, `Dynamic` or `Combined`.
+    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
     pub name: String,
     /// The binary frame (0/1, `width x height`, row-major).
     pub frame: Vec<u8>,

@@ -82,6 +82,10 @@ impl std::fmt::Display for Stage {
 
 /// Reference costs in seconds on the 2-core development machine, measured in `evtac reproduce
 /// --scale small` (7.7 min).
+/// Representations trained per seed in Experiments 1 and 2 and the noise study
+/// ([`crate::exp1::NAMES`]).
+const REPRS: usize = crate::exp1::NAMES.len();
+
 mod cost {
     /// Simulating one trial (52 s for 448 trials).
     pub const SIMULATE_TRIAL: f64 = 0.116;
@@ -205,17 +209,20 @@ impl CostModel {
                 Stage::Tuning(Kind::Static),
                 plan.static_grid().len() + plan.dynamic_grid().len(),
             )
-            + c(Stage::Exp1Training, 3 * plan.seeds)
-            + c(Stage::Latency, 3 * plan.latency_intervals_ms.len());
+            + c(Stage::Exp1Training, REPRS * plan.seeds)
+            + c(Stage::Latency, REPRS * plan.latency_intervals_ms.len());
         if counts.exp2 > 0 {
-            sum += c(Stage::Exp2Training, 9 * plan.exp2_seeds);
+            sum += c(
+                Stage::Exp2Training,
+                crate::exp2::SETTINGS.len() * REPRS * plan.exp2_seeds,
+            );
         }
         // Every noise level but Experiment 1's own: a dataset, its features and the runs.
         let levels = crate::noise::simulated_levels(&plan.noise_levels).len();
         sum += levels as f64
             * (c(Stage::NoiseSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::Noise), counts.exp1)
-                + c(Stage::NoiseTraining, 3 * plan.seeds));
+                + c(Stage::NoiseTraining, REPRS * plan.seeds));
         sum
     }
 }
@@ -247,7 +254,7 @@ mod tests {
             simulate: 80,
         };
         let model = CostModel::new(&plan, counts);
-        let training = model.seconds(Stage::Exp1Training, 3 * plan.seeds as u64);
+        let training = model.seconds(Stage::Exp1Training, (REPRS * plan.seeds) as u64);
         assert!(training > 0.0);
         let with_exp2 = CostModel::new(&plan, TrialCounts { exp2: 30, ..counts });
         assert!(with_exp2.total_seconds() > model.total_seconds());
@@ -260,7 +267,7 @@ mod tests {
         let noise = model.total_seconds() - without_noise;
         let per_level = model.seconds(Stage::NoiseSimulating, 60)
             + model.seconds(Stage::Features(FeatureSet::Noise), 60)
-            + model.seconds(Stage::NoiseTraining, 3 * plan.seeds as u64);
+            + model.seconds(Stage::NoiseTraining, (REPRS * plan.seeds) as u64);
         assert!(
             (noise - 2.0 * per_level).abs() < 1e-9,
             "{noise} vs 2 x {per_level}"

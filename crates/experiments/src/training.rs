@@ -123,6 +123,7 @@ pub fn train_job(
     let cfg = TrainConfig {
         epochs: spec.epochs,
         seed: spec.seed,
+        architecture: evtac_learn::Architecture::for_repr(&spec.repr),
         ..TrainConfig::default()
     };
     let trained = evtac_learn::train(&train.set, &val.set, &cfg, on_epoch).map_err(|source| {

@@ -18,7 +18,7 @@ fn the_fig2_sample_shows_the_cached_features_and_the_window_events() {
     let ds = Dataset::open(dir.path(), Inputs::FROM_FILES).unwrap();
     let cache = FeatureCache::new(&ds).unwrap();
     let meta = &ds.manifest.trials[0];
-    let reprs = exp1::representations(
+    let reprs = exp1::paper_representations(
         plan::static_config(1000.0, 2.0),
         plan::dynamic_config(640.0, 0),
     );

@@ -3,6 +3,10 @@
 //! two threads (how `evtac reproduce` and `tune` use a 2-core machine: one run per core). The
 //! last one is the machine's throughput to set against PyTorch on 2 threads.
 //!
+//! The learned fusions (`stacked`, `late`) train on 1800 features per sample, a static frame
+//! then a dynamic one at their own densities: `epoch_35000x1800/{stacked,late}` times one epoch
+//! of each network, to set against the 900-feature epochs above.
+//!
 //! The PyTorch CPU reference for the same model is `benches/pytorch_baseline.py`; run both in
 //! the same session and compare:
 //!
@@ -21,7 +25,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use evtac_learn::data::Shuffler;
-use evtac_learn::{FeatureSet, Parameters, TrainConfig, Trainer};
+use evtac_learn::{Architecture, FeatureSet, Parameters, TrainConfig, Trainer};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -35,29 +39,34 @@ const SAMPLES: usize = 35_000;
 /// its speed depends on them; PyTorch's does not.
 const DENSITIES: [(&str, f32); 2] = [("static", 0.138), ("dynamic_combined", 0.752)];
 
-/// Features with a fraction `density` non-zero, uniform in [0, 1), and labels in +-20 degrees.
-fn dataset(n: usize, density: f32) -> FeatureSet {
+/// Features of one frame per entry of `densities` side by side, each frame's a fraction
+/// `density` non-zero, uniform in [0, 1), and labels in +-20 degrees.
+fn dataset(n: usize, densities: &[f32]) -> FeatureSet {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let features = (0..n * 900)
-        .map(|_| {
-            if rng.random_range(0.0..1.0_f32) < density {
-                rng.random_range(0.0..1.0_f32)
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let width = 900 * densities.len();
+    let mut features = Vec::with_capacity(n * width);
+    for _ in 0..n {
+        for &density in densities {
+            features.extend((0..900).map(|_| {
+                if rng.random_range(0.0..1.0_f32) < density {
+                    rng.random_range(0.0..1.0_f32)
+                } else {
+                    0.0
+                }
+            }));
+        }
+    }
     let labels = (0..n * 2)
         .map(|_| rng.random_range(-20.0..20.0_f32))
         .collect();
-    FeatureSet::new(features, labels).expect("valid")
+    FeatureSet::with_width(features, labels, width).expect("valid")
 }
 
 fn bench(c: &mut Criterion) {
     evtac_learn::flush_denormals();
     let cfg = TrainConfig::default();
     for (name, density) in DENSITIES {
-        let data = dataset(SAMPLES, density);
+        let data = dataset(SAMPLES, &[density]);
         let mut trainer = Trainer::new(&Parameters::init(0), &cfg).expect("trainer");
         let mut shuffler = Shuffler::new(data.len(), 0);
         let (mut x, mut y) = (Vec::new(), Vec::new());
@@ -106,6 +115,25 @@ fn bench(c: &mut Criterion) {
         });
         group.finish();
     }
+
+    // The learned fusions: a static frame and a dynamic frame per sample.
+    let data = dataset(SAMPLES, &[DENSITIES[0].1, DENSITIES[1].1]);
+    let mut group = c.benchmark_group("epoch_35000x1800");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    for architecture in [Architecture::Stacked, Architecture::Late] {
+        let cfg = TrainConfig {
+            architecture,
+            ..TrainConfig::default()
+        };
+        let params = Parameters::init_for(architecture, 0);
+        let mut trainer = Trainer::new(&params, &cfg).expect("trainer");
+        let mut shuffler = Shuffler::new(data.len(), 0);
+        group.bench_function(architecture.name(), |b| {
+            b.iter(|| black_box(epoch(&mut trainer, &mut shuffler, &data)))
+        });
+    }
+    group.finish();
 }
 
 /// One epoch of `trainer` over `data`; returns the summed batch losses.

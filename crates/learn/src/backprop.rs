@@ -20,14 +20,22 @@
 //! deterministic: one order, the same on every CPU.
 
 use crate::adamw::{self, AdamW, StepScalars};
-use crate::model::{INPUTS, LAYER_SIZES, LAYERS, LayerParameters, OUTPUTS, Parameters};
+use crate::model::{
+    Architecture, LAYER_SIZES, LAYERS, LayerParameters, MAX_INPUTS, OUTPUTS, Parameters,
+};
 use crate::panels::{self, BLOCK, Dense, GROUP};
 
 const H1: usize = LAYER_SIZES[1];
 
+// Late fusion's branches are whole panels of the first layer, so a block of units is in one
+// branch (see `first_layer_rows`).
+const _: () = assert!(crate::architecture::BRANCH.is_multiple_of(BLOCK));
+
 /// The weights being trained, in the panel layout.
 #[derive(Debug, Clone)]
 pub(crate) struct Network {
+    /// Which network (input count; late fusion's first layer is block-diagonal).
+    pub architecture: Architecture,
     /// The four layers, input first.
     pub layers: [Dense; LAYERS],
 }
@@ -35,17 +43,25 @@ pub(crate) struct Network {
 impl Network {
     /// The network of `params` (PyTorch layout; validated by the caller).
     pub fn new(params: &Parameters) -> Self {
+        let sizes = params.architecture.layer_sizes();
         Self {
+            architecture: params.architecture,
             layers: std::array::from_fn(|i| {
                 let p = &params.layers[i];
-                Dense::from_pytorch(&p.weight, &p.bias, LAYER_SIZES[i], LAYER_SIZES[i + 1])
+                Dense::from_pytorch(&p.weight, &p.bias, sizes[i], sizes[i + 1])
             }),
         }
+    }
+
+    /// Features per sample.
+    pub fn inputs(&self) -> usize {
+        self.layers[0].fan_in
     }
 
     /// The weights in PyTorch layout.
     pub fn parameters(&self) -> Parameters {
         Parameters {
+            architecture: self.architecture,
             layers: self
                 .layers
                 .iter()
@@ -107,8 +123,8 @@ fn smooth_l1(e: f32, beta: f32, norm: f32) -> (f32, f32) {
 }
 
 impl Scratch {
-    /// Indexes the non-zeros of the batch `x` (`n x 900`) by sample and by feature.
-    fn index_batch(&mut self, x: &[f32], n: usize) {
+    /// Indexes the non-zeros of the batch `x` (`n x width`) by sample and by feature.
+    fn index_batch(&mut self, x: &[f32], n: usize, width: usize) {
         // Branch-free compaction: every value is written, the cursor advances past non-zeros
         // only (a branch per value mispredicts on these sparse rows). Local slices keep the
         // buffers' pointers in registers (through `self` they are reloaded on every write).
@@ -116,16 +132,17 @@ impl Scratch {
         self.value.resize(x.len(), 0.0);
         self.row_start.clear();
         self.row_start.push(0);
-        let mut counts = [0_usize; INPUTS];
+        let mut counts = [0_usize; MAX_INPUTS];
+        let counts = &mut counts[..width];
         let mut len = 0;
         {
             let (index, value) = (&mut self.index[..], &mut self.value[..]);
-            for row in x.chunks_exact(INPUTS) {
-                let (index, value) = (&mut index[len..len + INPUTS], &mut value[len..len + INPUTS]);
+            for row in x.chunks_exact(width) {
+                let (index, value) = (&mut index[len..len + width], &mut value[len..len + width]);
                 let mut k = 0;
                 for (i, (&v, count)) in row.iter().zip(counts.iter_mut()).enumerate() {
                     let nonzero = usize::from(v != 0.0);
-                    // `INPUTS` (900) fits in u16; `k <= i < INPUTS`.
+                    // `width <= MAX_INPUTS` (1800) fits in u16; `k <= i < width`.
                     index[k] = i as u16;
                     value[k] = v;
                     *count += nonzero;
@@ -140,9 +157,9 @@ impl Scratch {
         // The same entries by feature: a counting sort, samples stay ascending.
         self.col_start.clear();
         self.col_start.push(0);
-        let mut next = [0_usize; INPUTS];
+        let mut next = [0_usize; MAX_INPUTS];
         let mut start = 0;
-        for (next, &c) in next.iter_mut().zip(&counts) {
+        for (next, &c) in next.iter_mut().zip(counts.iter()) {
             *next = start;
             start += c;
             self.col_start.push(start);
@@ -173,7 +190,7 @@ const GROUPED_DENSITY: f64 = 0.35;
 /// The most samples one step takes (sample numbers are stored as u16).
 pub(crate) const MAX_BATCH: usize = u16::MAX as usize;
 
-/// One AdamW step of `net` on the batch `x` (`n x 900`), `y` (`n x 2`) with SmoothL1 threshold
+/// One AdamW step of `net` on the batch `x` (`n x inputs`), `y` (`n x 2`) with SmoothL1 threshold
 /// `beta`; returns the batch's mean loss before the update. Sizes are checked by the caller.
 pub(crate) fn step(
     net: &mut Network,
@@ -184,8 +201,9 @@ pub(crate) fn step(
     beta: f32,
 ) -> f32 {
     let n = y.len() / OUTPUTS;
-    debug_assert!(n <= MAX_BATCH && x.len() == n * INPUTS);
-    scratch.index_batch(x, n);
+    let inputs = net.inputs();
+    debug_assert!(n <= MAX_BATCH && x.len() == n * inputs);
+    scratch.index_batch(x, n, inputs);
     for k in 0..LAYERS {
         scratch.h[k].resize(n * LAYER_SIZES[k + 1], 0.0);
         scratch.d[k].resize(n * LAYER_SIZES[k + 1], 0.0);
@@ -195,15 +213,15 @@ pub(crate) fn step(
     // Forward.
     let [h1, h2, h3, out] = &mut scratch.h;
     if scratch.index.len() as f64 > GROUPED_DENSITY * x.len() as f64 {
-        for (x, h) in x.chunks(GROUP * INPUTS).zip(h1.chunks_mut(GROUP * H1)) {
-            let rows = x.len() / INPUTS;
+        for (x, h) in x.chunks(GROUP * inputs).zip(h1.chunks_mut(GROUP * H1)) {
+            let rows = x.len() / inputs;
             panels::grouped_forward(&l0.weights, &l0.bias, x, rows, h, true);
         }
     } else {
         for (s, h) in h1.chunks_exact_mut(H1).enumerate() {
             let nz = scratch.row_start[s]..scratch.row_start[s + 1];
             let (index, value) = (&scratch.index[nz.clone()], &scratch.value[nz]);
-            panels::sparse_forward(&l0.weights, &l0.bias, INPUTS, index, value, h, true);
+            panels::sparse_forward(&l0.weights, &l0.bias, inputs, index, value, h, true);
         }
     }
     for s in 0..n {
@@ -299,21 +317,38 @@ fn first_layer_update(
     d1: &[f32],
     bias_grad: &[f32],
 ) {
+    let architecture = net.architecture;
     let layer = &mut net.layers[0];
     let (m, v) = optimizer.moments(0, layer.weights.len());
-    first_layer_rows(s, columns, d1, &mut layer.weights, m, v);
+    let rows = FirstLayer {
+        fan_in: layer.fan_in,
+        architecture,
+    };
+    first_layer_rows(s, columns, d1, rows, &mut layer.weights, m, v);
     optimizer.update(s, 1, &mut layer.bias, bias_grad);
+}
+
+/// The first layer's shape as [`first_layer_rows`] needs it.
+#[derive(Clone, Copy)]
+struct FirstLayer {
+    fan_in: usize,
+    architecture: Architecture,
 }
 
 /// The loop of [`first_layer_update`] over the weight's rows, compiled for AVX-512 and AVX2
 /// besides the baseline (the same bits on each: see [`crate::panels`]). Most of its time is
 /// AdamW's square root and two divisions per weight (fused multiply-adds in the gradient sum
 /// were tried: no change).
+///
+/// Late fusion's cross-branch rows (a block of one branch's units and an input of the other
+/// frame) get no gradient: their weights are zero, and AdamW with a zero gradient and zero
+/// moments keeps them exactly zero (decay of 0 is 0, the moments stay 0, the step is `0 / eps`).
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 fn first_layer_rows(
     s: &StepScalars,
     columns: &Columns,
     d1: &[f32],
+    layer: FirstLayer,
     weights: &mut [f32],
     m: &mut [f32],
     v: &mut [f32],
@@ -322,11 +357,18 @@ fn first_layer_rows(
         .chunks_exact_mut(BLOCK)
         .zip(m.chunks_exact_mut(BLOCK))
         .zip(v.chunks_exact_mut(BLOCK));
-    // Chunk `c` of the panel layout is block `c / INPUTS`, input row `c % INPUTS`.
+    let fan_in = layer.fan_in;
+    // Chunk `c` of the panel layout is block `c / fan_in`, input row `c % fan_in`.
     for (c, ((p, m), v)) in rows.enumerate() {
-        let (b, i) = (c / INPUTS, c % INPUTS);
+        let (b, i) = (c / fan_in, c % fan_in);
         let mut g = [0.0_f32; BLOCK];
-        for k in columns.start[i]..columns.start[i + 1] {
+        // A block's units are all in one branch (`BRANCH` is a multiple of `BLOCK`).
+        let columns_of_row = if layer.architecture.connects(b * BLOCK, i) {
+            columns.start[i]..columns.start[i + 1]
+        } else {
+            0..0
+        };
+        for k in columns_of_row {
             let (sample, xi) = (usize::from(columns.sample[k]), columns.value[k]);
             let d = &d1[sample * H1 + b * BLOCK..][..BLOCK];
             for (g, &dd) in g.iter_mut().zip(d) {
@@ -348,9 +390,9 @@ mod tests {
     use burn::nn::loss::{HuberLossConfig, Reduction};
     use burn::tensor::{Device, Tensor, TensorData};
 
-    /// A batch of `n` samples, a fraction `density` of the features non-zero, labels within
-    /// +-20 degrees.
-    fn batch(n: usize, seed: u64, density: f32) -> (Vec<f32>, Vec<f32>) {
+    /// A batch of `n` samples of `width` features, a fraction `density` of them non-zero,
+    /// labels within +-20 degrees.
+    fn batch(n: usize, width: usize, seed: u64, density: f32) -> (Vec<f32>, Vec<f32>) {
         let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
         let mut next = || {
             state ^= state << 13;
@@ -358,7 +400,7 @@ mod tests {
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        let x = (0..n * INPUTS)
+        let x = (0..n * width)
             .map(|_| if next() >= density { 0.0 } else { next() })
             .collect();
         let y = (0..n * OUTPUTS).map(|_| 40.0 * next() - 20.0).collect();
@@ -370,7 +412,8 @@ mod tests {
         let device = Device::flex().autodiff();
         let mlp = Mlp::from_parameters(params, &device).expect("fits");
         let n = y.len() / OUTPUTS;
-        let x = Tensor::<2>::from_data(TensorData::new(x.to_vec(), [n, INPUTS]), &device);
+        let sizes = params.architecture.layer_sizes();
+        let x = Tensor::<2>::from_data(TensorData::new(x.to_vec(), [n, sizes[0]]), &device);
         let y = Tensor::<2>::from_data(TensorData::new(y.to_vec(), [n, OUTPUTS]), &device);
         let loss = HuberLossConfig::new(1.0)
             .init()
@@ -380,7 +423,7 @@ mod tests {
         let layers = mlp
             .layers
             .iter()
-            .zip(LAYER_SIZES.windows(2))
+            .zip(sizes.windows(2))
             .map(|(l, w)| {
                 let gw = l.weight.val().grad(&grads).expect("weight grad");
                 let gb = l.bias.as_ref().and_then(|b| b.val().grad(&grads));
@@ -396,25 +439,42 @@ mod tests {
                 }
             })
             .collect();
-        (value, Parameters { layers })
+        let architecture = params.architecture;
+        (
+            value,
+            Parameters {
+                architecture,
+                layers,
+            },
+        )
     }
 
     /// The hand-written gradients equal burn's autodiff ones. The first layer's gradient is
     /// never stored, so it is read from the step itself: with beta1 = beta2 = 0, no decay and
     /// a huge eps, AdamW's first step is `p -= lr * g / (|g| + eps)`, i.e. `(lr / eps) * g` to
     /// a relative 1e-5 while |g| < 1e-2 * eps.
+    ///
+    /// Late fusion as burn sees it is a dense network with zero cross-branch weights, whose
+    /// gradients are not zero: the step must leave those weights at exactly zero and match
+    /// burn on every other weight (the branches' and the head's gradients are the same in the
+    /// two views).
     #[test]
     fn gradients_match_burn_autodiff() {
         // Dense batches take the grouped first layer, sparse ones the per-sample one.
-        for (n, seed, density) in [
-            (32, 1, 0.75),
-            (7, 2, 0.5),
-            (1, 3, 0.6),
-            (32, 4, 0.1),
-            (5, 5, 0.2),
+        let (mlp, stacked, late) = (Architecture::Mlp, Architecture::Stacked, Architecture::Late);
+        for (architecture, n, seed, density) in [
+            (mlp, 32, 1, 0.75),
+            (mlp, 7, 2, 0.5),
+            (mlp, 1, 3, 0.6),
+            (mlp, 32, 4, 0.1),
+            (mlp, 5, 5, 0.2),
+            (stacked, 32, 6, 0.75),
+            (stacked, 9, 7, 0.15),
+            (late, 32, 8, 0.75),
+            (late, 9, 9, 0.15),
         ] {
-            let params = Parameters::init(seed);
-            let (x, y) = batch(n, seed, density);
+            let params = Parameters::init_for(architecture, seed);
+            let (x, y) = batch(n, architecture.inputs(), seed, density);
             let (burn_loss, want) = burn_gradients(&params, &x, &y);
             let cfg = AdamWConfig {
                 learning_rate: 1.0,
@@ -445,7 +505,15 @@ mod tests {
                     ("bias", &b.bias, &a.bias, &w.bias),
                 ] {
                     let peak = want.iter().fold(0.0_f64, |m, g| m.max(f64::from(g.abs())));
+                    let inputs = architecture.inputs();
                     for (j, ((&p0, &p1), &g)) in before.iter().zip(after).zip(want).enumerate() {
+                        if k == 0
+                            && name == "weight"
+                            && !architecture.connects(j / inputs, j % inputs)
+                        {
+                            assert_eq!(p1.to_bits(), 0, "cross-branch weight [{j}] moved");
+                            continue;
+                        }
                         let got = (f64::from(p0) - f64::from(p1)) * scale;
                         // Summation order differs from burn's (1e-3 of the layer's largest
                         // gradient), and the new weight is rounded to f32 (one ulp, scaled).

@@ -2,15 +2,28 @@
 //!
 //! | file                | contents |
 //! |---------------------|----------|
-//! | `model.safetensors` | weights in PyTorch `nn.Linear` layout: `layers.{i}.weight` f32 `[out, in]` and `layers.{i}.bias` f32 `[out]` for `i = 0..4` (900-256-128-64-2); metadata `{"format": "pt"}` |
+//! | `model.safetensors` | weights in PyTorch `nn.Linear` layout: `layers.{i}.weight` f32 `[out, in]` and `layers.{i}.bias` f32 `[out]` for `i = 0..4` (900-256-128-64-2, or 1800-256-128-64-2 for `stacked`); late fusion's under its branches' names (below); metadata `{"format": "pt"}` |
 //! | `config.json`       | [`BundleConfig`]: format version, architecture, training config (with the seed), the [`Representation`] the features were built with (config, crop, how the samples were drawn), metrics |
 //! | `mask.npy`          | optional no-contact mask, u8 `H x W` = the crop (absent when none was used) |
 //! | `history.csv`       | one row per epoch: `epoch,train_loss,val_mae,val_mae_pitch,val_mae_roll,seconds` |
 //!
 //! In PyTorch the weights load into
 //! `nn.Module` with `self.layers = nn.ModuleList([nn.Linear(900, 256), nn.Linear(256, 128),
-//! nn.Linear(128, 64), nn.Linear(64, 2)])` (ReLU after all but the last) through
-//! `model.load_state_dict(safetensors.torch.load_file(path))`.
+//! nn.Linear(128, 64), nn.Linear(64, 2)])` (ReLU after all but the last; `nn.Linear(1800, 256)`
+//! first for `stacked`) through `model.load_state_dict(safetensors.torch.load_file(path))`.
+//!
+//! A late-fusion model (`late`) is saved as the module that computes it, so that its state dict
+//! loads the same way (the Python package ships it as `evtac.torch.LateFusion`):
+//!
+//! ```text
+//! static_branch   nn.Linear(900, 128)    static_branch.weight [128, 900], static_branch.bias [128]
+//! dynamic_branch  nn.Linear(900, 128)    dynamic_branch.weight, dynamic_branch.bias
+//! head            nn.Sequential(nn.Linear(256, 128), nn.ReLU(), nn.Linear(128, 64), nn.ReLU(),
+//!                               nn.Linear(64, 2))         head.0.*, head.2.*, head.4.*
+//! forward(x):     x is [N, 1800], the static frame's 900 features then the dynamic frame's
+//!     s = relu(static_branch(x[:, :900])); d = relu(dynamic_branch(x[:, 900:]))
+//!     return head(torch.cat([s, d], dim=1))
+//! ```
 //!
 //! The safetensors file depends only on the weights, so the same seed and data give the same
 //! bytes; `history.csv` also records wall-clock times and differs between runs.
@@ -29,8 +42,9 @@ use serde::{Deserialize, Serialize};
 
 use evtac_repr::{CROP, Mask, ReprConfig};
 
+use crate::architecture::{BRANCH, HIDDEN, INPUTS, OUTPUTS};
 use crate::metrics::Mae;
-use crate::model::{self, LAYER_SIZES, LAYERS, LayerParameters, Parameters};
+use crate::model::{self, Architecture, LAYERS, LayerParameters, Parameters};
 use crate::predictor::{self, Predictor};
 use crate::training::{EpochRecord, TrainConfig, Trained};
 
@@ -121,7 +135,7 @@ pub enum Error {
     /// `config.json`'s `representation` is not one this build understands.
     #[error(
         "{path}: `representation` is not an evtac representation (expected \
-         {{\"config\": {{\"kind\": \"static\" | \"dynamic\" | \"combined\", ...}}, \
+         {{\"config\": {{\"kind\": \"static\" | \"dynamic\" | \"combined\" | \"stacked\" | \"late\", ...}}, \
          \"frame\": \"240x240\"}}, or in format 1 a bare config): {reason}"
     )]
     Representation {
@@ -156,6 +170,23 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// The weights are of another network than the representation needs (e.g. a late-fusion
+    /// model's weights with a `stacked` representation).
+    #[error(
+        "{path}: the weights are a {} network but the representation `{kind}` needs {}",
+        weights.describe(),
+        needed.describe()
+    )]
+    Architecture {
+        /// The bundle folder.
+        path: PathBuf,
+        /// The network the weights file holds.
+        weights: Architecture,
+        /// The representation's kind.
+        kind: &'static str,
+        /// The network it needs.
+        needed: Architecture,
+    },
     /// Building the predictor failed.
     #[error(transparent)]
     Predictor(#[from] predictor::Error),
@@ -183,7 +214,8 @@ pub struct SampleCounts {
     pub stop_points: usize,
 }
 
-/// What the model's 900 inputs are: everything needed to compute the features again.
+/// What the model's inputs are (900 features, 1800 for `stacked` and `late`): everything needed
+/// to compute the features again.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Representation {
     /// The representation config.
@@ -231,7 +263,9 @@ mod resolution_text {
 pub struct BundleConfig {
     /// Bundle format version ([`FORMAT_VERSION`] when written by this build).
     pub format_version: u32,
-    /// Layer widths, input first (always `[900, 256, 128, 64, 2]`; informational).
+    /// Layer widths, input first, as stored (`[900, 256, 128, 64, 2]`, or 1800 inputs for
+    /// `stacked` and `late`; informational: the network is the weights file's and the
+    /// representation's, which must agree).
     pub architecture: Vec<usize>,
     /// The training recipe, including the seed.
     pub training: TrainConfig,
@@ -307,11 +341,12 @@ impl ModelBundle {
         representation: Representation,
         mask: Option<Mask>,
     ) -> Self {
+        let architecture = trained.parameters.architecture.layer_sizes().to_vec();
         Self {
             parameters: trained.parameters,
             config: BundleConfig {
                 format_version: FORMAT_VERSION,
-                architecture: LAYER_SIZES.to_vec(),
+                architecture,
                 training,
                 representation,
                 metrics: BundleMetrics {
@@ -325,22 +360,25 @@ impl ModelBundle {
         }
     }
 
-    /// An untrained bundle: PyTorch's initial weights from `seed`, no training curve, zero
-    /// metrics. For checking a pipeline end to end without training first (tests, benchmarks).
+    /// An untrained bundle: PyTorch's initial weights from `seed` for the representation's
+    /// network, no training curve, zero metrics. For checking a pipeline end to end without
+    /// training first (tests, benchmarks).
     pub fn untrained(seed: u64, representation: Representation, mask: Option<Mask>) -> Self {
         let zero = Mae {
             overall: 0.0,
             pitch: 0.0,
             roll: 0.0,
         };
+        let architecture = Architecture::for_repr(&representation.config);
         let trained = Trained {
-            parameters: Parameters::init(seed),
+            parameters: Parameters::init_for(architecture, seed),
             best_epoch: 0,
             best_val: zero,
             history: Vec::new(),
         };
         let training = TrainConfig {
             seed,
+            architecture,
             ..TrainConfig::default()
         };
         Self::from_trained(trained, training, representation, mask)
@@ -432,6 +470,15 @@ impl ModelBundle {
             source,
         })?;
         let config = raw.typed(&config_path)?;
+        let needed = Architecture::for_repr(&config.representation.config);
+        if parameters.architecture != needed {
+            return Err(Error::Architecture {
+                path: dir.to_path_buf(),
+                weights: parameters.architecture,
+                kind: config.representation.config.kind_name(),
+                needed,
+            });
+        }
 
         let mask_path = dir.join(MASK_FILE);
         let mask = if mask_path.is_file() {
@@ -475,44 +522,86 @@ fn read_mask(path: &Path, frame: evtac_events::Resolution) -> Result<Mask, Error
     Mask::from_pixels(frame, &pixels).map_err(|e| err(e.to_string()))
 }
 
-/// Reads and checks only the weights of `model.safetensors` (e.g. for prediction).
+/// The linear layers of `architecture` as the safetensors file names them, input first, with
+/// their `(in, out)` sizes: `layers.{i}` for the MLPs; for late fusion the two branches, then
+/// the head (see the module docs).
+fn linear_names(architecture: Architecture) -> Vec<(String, usize, usize)> {
+    match architecture {
+        Architecture::Mlp | Architecture::Stacked => {
+            let sizes = architecture.layer_sizes();
+            (0..LAYERS)
+                .map(|i| (format!("layers.{i}"), sizes[i], sizes[i + 1]))
+                .collect()
+        }
+        Architecture::Late => vec![
+            ("static_branch".into(), INPUTS, BRANCH),
+            ("dynamic_branch".into(), INPUTS, BRANCH),
+            ("head.0".into(), HIDDEN[0], HIDDEN[1]),
+            ("head.2".into(), HIDDEN[1], HIDDEN[2]),
+            ("head.4".into(), HIDDEN[2], OUTPUTS),
+        ],
+    }
+}
+
+/// Reads and checks only the weights of `model.safetensors` (e.g. for prediction). The network
+/// is the file's: late fusion by its branches' names, else the MLP whose first layer has the
+/// file's input count (900 or 1800).
 pub fn load_weights(path: &Path) -> Result<Parameters, Error> {
     let bytes = std::fs::read(path).map_err(io(path))?;
     let st = SafeTensors::deserialize(&bytes).map_err(|e| Error::SafeTensors {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let mut layers = Vec::with_capacity(LAYERS);
-    for (i, w) in LAYER_SIZES.windows(2).enumerate() {
-        let (fan_in, fan_out) = (w[0], w[1]);
-        let read = |suffix: &str, expected: Vec<usize>| -> Result<Vec<f32>, Error> {
-            let name = format!("layers.{i}.{suffix}");
-            let view = st.tensor(&name).map_err(|_| Error::MissingTensor {
-                path: path.to_path_buf(),
-                name: name.clone(),
-            })?;
-            if view.dtype() != Dtype::F32 || view.shape() != expected.as_slice() {
-                return Err(Error::TensorLayout {
-                    path: path.to_path_buf(),
-                    name,
-                    dtype: format!("{:?}", view.dtype()),
-                    shape: view.shape().to_vec(),
-                    expected,
-                });
+    let architecture = if st.tensor("static_branch.weight").is_ok() {
+        Architecture::Late
+    } else {
+        match st.tensor("layers.0.weight").map(|v| v.shape().to_vec()) {
+            Ok(shape) if shape == [HIDDEN[0], Architecture::Stacked.inputs()] => {
+                Architecture::Stacked
             }
-            // safetensors stores little-endian values; the length was checked by the parser
-            // against the shape, so `chunks_exact(4)` covers every byte.
-            Ok(view
-                .data()
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect())
-        };
-        let weight = read("weight", vec![fan_out, fan_in])?;
-        let bias = read("bias", vec![fan_out])?;
-        layers.push(LayerParameters { weight, bias });
+            // Anything else is read as the paper's MLP, whose checks name what is wrong.
+            _ => Architecture::Mlp,
+        }
+    };
+    let read = |name: String, expected: Vec<usize>| -> Result<Vec<f32>, Error> {
+        let view = st.tensor(&name).map_err(|_| Error::MissingTensor {
+            path: path.to_path_buf(),
+            name: name.clone(),
+        })?;
+        if view.dtype() != Dtype::F32 || view.shape() != expected.as_slice() {
+            return Err(Error::TensorLayout {
+                path: path.to_path_buf(),
+                name,
+                dtype: format!("{:?}", view.dtype()),
+                shape: view.shape().to_vec(),
+                expected,
+            });
+        }
+        // safetensors stores little-endian values; the length was checked by the parser
+        // against the shape, so `chunks_exact(4)` covers every byte.
+        Ok(view
+            .data()
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect())
+    };
+    let mut linears = Vec::with_capacity(LAYERS + 1);
+    for (name, fan_in, fan_out) in linear_names(architecture) {
+        let weight = read(format!("{name}.weight"), vec![fan_out, fan_in])?;
+        let bias = read(format!("{name}.bias"), vec![fan_out])?;
+        linears.push(LayerParameters { weight, bias });
     }
-    let parameters = Parameters { layers };
+    if architecture == Architecture::Late {
+        let head = linears.split_off(2);
+        let branches: [LayerParameters; 2] = [linears[0].clone(), linears[1].clone()];
+        linears = std::iter::once(model::join_branches(&branches))
+            .chain(head)
+            .collect();
+    }
+    let parameters = Parameters {
+        architecture,
+        layers: linears,
+    };
     parameters.validate().map_err(|source| Error::Model {
         path: path.to_path_buf(),
         source,
@@ -522,15 +611,23 @@ pub fn load_weights(path: &Path) -> Result<Parameters, Error> {
 
 /// Serialises the weights as safetensors bytes (names and layout in the module docs).
 fn weights_to_safetensors(params: &Parameters) -> Result<Vec<u8>, String> {
-    let mut buffers: Vec<(String, Vec<usize>, Vec<u8>)> = Vec::with_capacity(2 * LAYERS);
-    for (i, (layer, w)) in params.layers.iter().zip(LAYER_SIZES.windows(2)).enumerate() {
+    let linears: Vec<LayerParameters> = match params.branches() {
+        Some(branches) => branches
+            .into_iter()
+            .chain(params.layers[1..].iter().cloned())
+            .collect(),
+        None => params.layers.clone(),
+    };
+    let names = linear_names(params.architecture);
+    let mut buffers: Vec<(String, Vec<usize>, Vec<u8>)> = Vec::with_capacity(2 * names.len());
+    for ((name, fan_in, fan_out), layer) in names.into_iter().zip(&linears) {
         let le = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
         buffers.push((
-            format!("layers.{i}.weight"),
-            vec![w[1], w[0]],
+            format!("{name}.weight"),
+            vec![fan_out, fan_in],
             le(&layer.weight),
         ));
-        buffers.push((format!("layers.{i}.bias"), vec![w[1]], le(&layer.bias)));
+        buffers.push((format!("{name}.bias"), vec![fan_out], le(&layer.bias)));
     }
     let views = buffers
         .iter()
@@ -649,6 +746,65 @@ mod tests {
             b.save(dir.path()).expect("save");
             assert_eq!(ModelBundle::load(dir.path()).expect("load"), b);
         }
+    }
+
+    /// The two-frame networks save under their names (late fusion as its branches and head),
+    /// load back as the same weights, and a bundle whose weights are of another network than
+    /// its representation's is refused, naming both.
+    #[test]
+    fn two_frame_networks_round_trip_and_must_match_the_representation() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (static_part, dynamic_part) = Default::default();
+        let stacked = ReprConfig::Stacked {
+            static_part,
+            dynamic_part,
+        };
+        let late = ReprConfig::Late {
+            static_part,
+            dynamic_part,
+        };
+        for config in [stacked, late] {
+            let b = ModelBundle::untrained(3, Representation::new(config), None);
+            assert_eq!(b.parameters.architecture, Architecture::for_repr(&config));
+            b.save(dir.path()).expect("save");
+            assert_eq!(ModelBundle::load(dir.path()).expect("load"), b);
+        }
+        let bytes = std::fs::read(dir.path().join(MODEL_FILE)).expect("read");
+        let st = SafeTensors::deserialize(&bytes).expect("safetensors");
+        let mut names: Vec<String> = st.names().into_iter().map(str::to_string).collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "dynamic_branch.bias",
+                "dynamic_branch.weight",
+                "head.0.bias",
+                "head.0.weight",
+                "head.2.bias",
+                "head.2.weight",
+                "head.4.bias",
+                "head.4.weight",
+                "static_branch.bias",
+                "static_branch.weight",
+            ]
+        );
+        assert_eq!(
+            st.tensor("static_branch.weight").unwrap().shape(),
+            [128, 900]
+        );
+        // Late weights with a stacked representation.
+        with_config(
+            dir.path(),
+            FORMAT_VERSION,
+            serde_json::to_value(Representation::new(stacked)).expect("json"),
+        );
+        let msg = ModelBundle::load(dir.path())
+            .expect_err("mismatch")
+            .to_string();
+        assert!(
+            msg.contains("2x(900-128)-256-128-64-2") && msg.contains("`stacked` needs 1800-256"),
+            "{msg}"
+        );
     }
 
     #[test]

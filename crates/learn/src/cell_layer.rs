@@ -10,8 +10,9 @@
 //! z_j = f32( f64(bias_j) + (sum_i count_i * q_ij) * 2^-s / 64 )
 //! ```
 //!
-//! The sum has at most 900 terms of at most `64 * 2^30`, so it and every partial sum are
-//! integers below `2^46` in magnitude: exact in `f64`, whatever the order of the terms. That
+//! The sum has at most 1800 terms (two pooled frames side by side) of at most `64 * 2^30`, so
+//! it and every partial sum are integers below `2^47` in magnitude: exact in `f64`, whatever
+//! the order of the terms. That
 //! is the point: adding `(new - old) * q_i` for the cells that changed since the previous
 //! sample gives the same bits as summing every cell from scratch, so a live estimator only
 //! touches the rows of the few cells that changed (50-85 of 900 per millisecond at 3 M
@@ -21,9 +22,10 @@
 //!
 //! Fixed point moves each weight by at most `2^-30` of the largest weight (`s` puts the largest
 //! above `2^29`), so a pre-activation moves by at most `900 * 2^-30` (8e-7) of the largest
-//! weight: the size of the rounding a float32 sum of 900 terms makes anyway.
+//! weight per frame: the size of the rounding a float32 sum of 900 terms makes anyway. Late
+//! fusion's zero cross-branch weights stay exactly zero in fixed point.
 
-use crate::model::{INPUTS, LAYER_SIZES};
+use crate::model::{LAYER_SIZES, MAX_INPUTS};
 
 /// Width of the first hidden layer: the number of sums.
 const H1: usize = LAYER_SIZES[1];
@@ -31,13 +33,14 @@ const H1: usize = LAYER_SIZES[1];
 /// Cells pooled per feature: a feature is `count / CELL_PIXELS`.
 pub const CELL_PIXELS: u8 = 64;
 
-/// The largest fixed-point weight magnitude, `2^30`: with counts up to 64 and 900 inputs, sums
-/// stay below `2^46`, well inside `f64`'s 53-bit integers.
+/// The largest fixed-point weight magnitude, `2^30`: with counts up to 64 and 1800 inputs, sums
+/// stay below `2^47`, well inside `f64`'s 53-bit integers.
 const Q_MAX: f64 = (1u64 << 30) as f64;
 
-/// Writes the pooled cell counts behind `features` (`count = x * 64`) into `counts`; `false`
-/// when a feature is not a multiple of 1/64 in `[0, 1]` (then `counts` means nothing).
-pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> bool {
+/// Writes the pooled cell counts behind `features` (`count = x * 64`) into the first
+/// `features.len()` of `counts`; `false` when a feature is not a multiple of 1/64 in `[0, 1]`
+/// (then `counts` means nothing).
+pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; MAX_INPUTS]) -> bool {
     let mut on_grid = true;
     for (c, &x) in counts.iter_mut().zip(features) {
         // Exact for every multiple of 1/64: multiplying by a power of two only moves the
@@ -56,7 +59,8 @@ pub(crate) fn cell_counts(features: &[f32], counts: &mut [u8; INPUTS]) -> bool {
 /// a batch through one). Kept apart from the layer, so a batch needs no copy of the weights.
 #[derive(Debug, Clone)]
 pub(crate) struct CellSums {
-    counts: [u8; INPUTS],
+    /// The counts of the layer's inputs (the first `fan_in`; the rest stay 0).
+    counts: [u8; MAX_INPUTS],
     sums: [f64; H1],
 }
 
@@ -64,15 +68,22 @@ impl CellSums {
     /// All-zero counts, whose sums are all zero.
     pub(crate) fn new() -> Self {
         Self {
-            counts: [0; INPUTS],
+            counts: [0; MAX_INPUTS],
             sums: [0.0; H1],
         }
     }
 
-    /// Moves the state to `counts`, updating the sums from the cells that changed, and writes
-    /// the layer's output for them into `h1`.
-    pub(crate) fn update(&mut self, layer: &CellLayer, counts: &[u8; INPUTS], h1: &mut [f32; H1]) {
-        for (cell, (&new, old)) in counts.iter().zip(self.counts.iter_mut()).enumerate() {
+    /// Moves the state to `counts` (the first `fan_in` of them), updating the sums from the
+    /// cells that changed, and writes the layer's output for them into `h1`.
+    pub(crate) fn update(
+        &mut self,
+        layer: &CellLayer,
+        counts: &[u8; MAX_INPUTS],
+        h1: &mut [f32; H1],
+    ) {
+        let fan_in = layer.fan_in();
+        let cells = counts[..fan_in].iter().zip(&mut self.counts[..fan_in]);
+        for (cell, (&new, old)) in cells.enumerate() {
             if new != *old {
                 layer.add_cell(&mut self.sums, cell, i32::from(new) - i32::from(*old));
                 *old = new;
@@ -123,9 +134,14 @@ impl CellLayer {
         add_row(acc, row, f64::from(delta));
     }
 
-    /// The integer sums of `counts` from scratch.
-    pub(crate) fn sums(&self, counts: &[u8; INPUTS], acc: &mut [f64]) {
-        sums(&self.q, self.fan_out, counts, acc);
+    /// Inputs (cells) of the layer.
+    pub(crate) fn fan_in(&self) -> usize {
+        self.q.len() / self.fan_out
+    }
+
+    /// The integer sums of `counts` (the first `fan_in` of them) from scratch.
+    pub(crate) fn sums(&self, counts: &[u8; MAX_INPUTS], acc: &mut [f64]) {
+        sums(&self.q, self.fan_out, &counts[..self.fan_in()], acc);
     }
 
     /// The layer's output from its integer sums: `relu(f32(bias + sum * unit))`.
@@ -161,7 +177,7 @@ const BLOCK: usize = 64;
 /// when `fan_out` is a multiple of [`BLOCK`]; compiled for AVX-512 and AVX2 as well as the
 /// baseline. Exact, so the result does not depend on the order or the CPU.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
-fn sums(q: &[i32], fan_out: usize, counts: &[u8; INPUTS], acc: &mut [f64]) {
+fn sums(q: &[i32], fan_out: usize, counts: &[u8], acc: &mut [f64]) {
     acc.fill(0.0);
     if !fan_out.is_multiple_of(BLOCK) {
         for (row, &c) in q.chunks_exact(fan_out).zip(counts) {
@@ -214,8 +230,8 @@ mod tests {
 
     #[test]
     fn counts_are_read_only_from_multiples_of_a_64th() {
-        let mut counts = [0; INPUTS];
-        let mut x = [0.0_f32; INPUTS];
+        let mut counts = [0; MAX_INPUTS];
+        let mut x = [0.0_f32; MAX_INPUTS];
         x[3] = 1.0;
         x[7] = 5.0 / 64.0;
         assert!(cell_counts(&x, &mut counts));
@@ -228,16 +244,16 @@ mod tests {
 
     #[test]
     fn changed_cells_give_the_same_sums_as_from_scratch() {
-        let (fan_in, fan_out) = (INPUTS, 8);
+        let (fan_in, fan_out) = (MAX_INPUTS, 8);
         let w: Vec<f32> = (0..fan_in * fan_out)
             .map(|i| ((i * 7919) % 2003) as f32 / 1000.0 - 1.0)
             .collect();
         let layer = CellLayer::new(&w, &[0.25; 8]);
-        let mut counts = [0u8; INPUTS];
+        let mut counts = [0u8; MAX_INPUTS];
         let mut kept = vec![0.0; fan_out];
         let mut fresh = vec![0.0; fan_out];
         for step in 0..50_usize {
-            let cell = (step * 131) % INPUTS;
+            let cell = (step * 131) % MAX_INPUTS;
             let new = ((step * 37) % 65) as u8;
             layer.add_cell(&mut kept, cell, i32::from(new) - i32::from(counts[cell]));
             counts[cell] = new;

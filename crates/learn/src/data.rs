@@ -5,17 +5,25 @@ use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 
-use crate::model::{INPUTS, OUTPUTS};
+use crate::model::{INPUTS, MAX_INPUTS, OUTPUTS};
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The feature buffer is not a whole number of 900-value rows.
-    #[error("{len} feature values is not a multiple of {INPUTS} (one row per sample)")]
+    /// The feature buffer is not a whole number of rows.
+    #[error("{len} feature values is not a multiple of {width} (one row per sample)")]
     RaggedFeatures {
         /// Number of feature values.
         len: usize,
+        /// Features per row.
+        width: usize,
+    },
+    /// The row width is neither one pooled frame (900) nor two (1800).
+    #[error("{width} features per sample: evtac's networks read {INPUTS} or {MAX_INPUTS}")]
+    Width {
+        /// Features per row given.
+        width: usize,
     },
     /// Labels and features describe different sample counts.
     #[error("{features} feature rows but {labels} label values (expected {expected}: 2 per row)")]
@@ -37,27 +45,56 @@ pub enum Error {
     },
 }
 
-/// Samples for training or evaluation: `features` holds `N x 900` f32 row-major, `labels`
-/// `N x 2` (pitch, roll) in degrees.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// Samples for training or evaluation: `features` holds `N x width` f32 row-major (900 per
+/// pooled frame: 900, or 1800 for the stacked and late representations), `labels` `N x 2`
+/// (pitch, roll) in degrees.
+#[derive(Debug, Clone, PartialEq)]
 pub struct FeatureSet {
-    /// Feature rows, `N * 900` values.
+    /// Feature rows, `N * width` values.
     pub features: Vec<f32>,
     /// Labels, `N * 2` values: pitch then roll of each sample.
     pub labels: Vec<f32>,
+    /// Features per sample.
+    pub width: usize,
+}
+
+impl Default for FeatureSet {
+    /// An empty set of one-frame (900-feature) rows.
+    fn default() -> Self {
+        Self::empty(INPUTS)
+    }
 }
 
 impl FeatureSet {
-    /// A set from its two buffers, checked with [`FeatureSet::validate`].
+    /// A set of 900-feature rows from its two buffers, checked with [`FeatureSet::validate`].
     pub fn new(features: Vec<f32>, labels: Vec<f32>) -> Result<Self, Error> {
-        let set = Self { features, labels };
+        Self::with_width(features, labels, INPUTS)
+    }
+
+    /// A set of `width`-feature rows from its two buffers, checked with
+    /// [`FeatureSet::validate`].
+    pub fn with_width(features: Vec<f32>, labels: Vec<f32>, width: usize) -> Result<Self, Error> {
+        let set = Self {
+            features,
+            labels,
+            width,
+        };
         set.validate()?;
         Ok(set)
     }
 
+    /// An empty set of `width`-feature rows.
+    pub fn empty(width: usize) -> Self {
+        Self {
+            features: Vec::new(),
+            labels: Vec::new(),
+            width,
+        }
+    }
+
     /// Number of samples (feature rows).
     pub fn len(&self) -> usize {
-        self.features.len() / INPUTS
+        self.features.len() / self.width.max(1)
     }
 
     /// Whether there are no samples.
@@ -65,16 +102,20 @@ impl FeatureSet {
         self.features.is_empty()
     }
 
-    /// The features of sample `i` (900 values). Panics when `i >= len()`.
+    /// The features of sample `i` (`width` values). Panics when `i >= len()`.
     pub fn row(&self, i: usize) -> &[f32] {
-        &self.features[i * INPUTS..(i + 1) * INPUTS]
+        &self.features[i * self.width..(i + 1) * self.width]
     }
 
-    /// Checks the row structure and that every value is finite.
+    /// Checks the width, the row structure and that every value is finite.
     pub fn validate(&self) -> Result<(), Error> {
-        if !self.features.len().is_multiple_of(INPUTS) {
+        if self.width != INPUTS && self.width != MAX_INPUTS {
+            return Err(Error::Width { width: self.width });
+        }
+        if !self.features.len().is_multiple_of(self.width) {
             return Err(Error::RaggedFeatures {
                 len: self.features.len(),
+                width: self.width,
             });
         }
         let n = self.len();
@@ -88,7 +129,7 @@ impl FeatureSet {
         if let Some(i) = self.features.iter().position(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "features",
-                sample: i / INPUTS,
+                sample: i / self.width,
             });
         }
         if let Some(i) = self.labels.iter().position(|v| !v.is_finite()) {
@@ -143,8 +184,14 @@ mod tests {
     fn validation_names_the_problem() {
         assert!(matches!(
             FeatureSet::new(vec![0.0; 901], vec![]),
-            Err(Error::RaggedFeatures { len: 901 })
+            Err(Error::RaggedFeatures { len: 901, .. })
         ));
+        assert!(matches!(
+            FeatureSet::with_width(vec![0.0; 10], vec![], 10),
+            Err(Error::Width { width: 10 })
+        ));
+        let two_frames = FeatureSet::with_width(vec![0.0; 3600], vec![0.0; 4], 1800).unwrap();
+        assert_eq!((two_frames.len(), two_frames.row(1).len()), (2, 1800));
         assert!(matches!(
             FeatureSet::new(vec![0.0; 900], vec![0.0]),
             Err(Error::LabelCount { expected: 2, .. })

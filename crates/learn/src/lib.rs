@@ -3,7 +3,8 @@
 //!
 //! - [`model`]: the 900 -> 256 -> 128 -> 64 -> 2 ReLU MLP as a burn module ([`Mlp`]) and as plain
 //!   weights in PyTorch `nn.Linear` layout ([`Parameters`]), initialised as PyTorch does from a
-//!   seeded `ChaCha8Rng`.
+//!   seeded `ChaCha8Rng`; [`architecture`]: the networks for two frames side by side
+//!   (`stacked`, and `late` fusion's two branches), stored and run as the same four layers.
 //! - [`data`]: in-memory [`FeatureSet`]s and the seeded epoch shuffling.
 //! - [`training`]: [`train`] with SmoothL1 (beta 1) and PyTorch-exact AdamW ([`adamw`]), batch
 //!   32, 100 epochs, validation MAE per epoch, best checkpoint kept.
@@ -41,6 +42,7 @@
 //! ```
 
 pub mod adamw;
+pub mod architecture;
 mod backprop;
 pub mod bundle;
 pub mod cell_layer;
@@ -55,11 +57,12 @@ mod trained_model;
 pub mod training;
 
 pub use adamw::AdamWConfig;
+pub use architecture::Architecture;
 pub use bundle::{BundleConfig, BundleMetrics, ModelBundle, Representation};
 pub use data::FeatureSet;
 pub use ftz::flush_denormals;
 pub use metrics::{Mae, mae};
-pub use model::{INPUTS, Mlp, OUTPUTS, Parameters};
+pub use model::{INPUTS, MAX_INPUTS, Mlp, OUTPUTS, Parameters};
 pub use predictor::Predictor;
 pub use streaming::StreamingPredictor;
 pub use trained_model::Model;

@@ -1,12 +1,14 @@
-//! The regressor: a 900 -> 256 -> 128 -> 64 -> 2 multi-layer perceptron with ReLU, as a burn
-//! module ([`Mlp`]) and as plain host weights in PyTorch's layout ([`Parameters`]).
+//! The regressor: the paper's 900 -> 256 -> 128 -> 64 -> 2 multi-layer perceptron with ReLU (or
+//! one of the two-frame networks of [`crate::architecture`]), as a burn module ([`Mlp`]) and as
+//! plain host weights in PyTorch's layout ([`Parameters`]).
 //!
 //! [`Parameters`] is the common currency: initialisation draws it from a seeded
 //! [`ChaCha8Rng`], the bundle saves and loads it, the trainer uploads it into burn and the
 //! [`crate::Predictor`] runs it. Its layout is PyTorch's `nn.Linear`: layer `i` has
 //! `weight` `[out, in]` row-major and `bias` `[out]`, so a PyTorch
 //! `nn.Sequential(Linear, ReLU, Linear, ReLU, Linear, ReLU, Linear)` whose linear layers are
-//! named `layers.0` .. `layers.3` loads the saved tensors unchanged.
+//! named `layers.0` .. `layers.3` loads the saved tensors unchanged (late fusion's layout in
+//! PyTorch is in `bundle.rs`).
 
 use burn::module::{Module, Param};
 use burn::nn::{Linear, LinearConfig};
@@ -15,14 +17,12 @@ use burn::tensor::{Device, Tensor, TensorData};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Number of input features (a 30 x 30 pooled representation, row-major).
-pub const INPUTS: usize = 900;
-/// Number of outputs: (pitch, roll) in degrees.
-pub const OUTPUTS: usize = 2;
-/// Layer widths from input to output: the paper's three hidden layers of 256, 128 and 64.
-pub const LAYER_SIZES: [usize; 5] = [INPUTS, 256, 128, 64, OUTPUTS];
-/// Number of linear layers.
-pub const LAYERS: usize = LAYER_SIZES.len() - 1;
+pub use crate::architecture::{Architecture, INPUTS, LAYERS, MAX_INPUTS, OUTPUTS};
+use crate::architecture::{BRANCH, HIDDEN};
+
+/// The paper's layer widths from input to output ([`Architecture::Mlp`]'s): 900, its three
+/// hidden layers of 256, 128 and 64, and 2.
+pub const LAYER_SIZES: [usize; LAYERS + 1] = [INPUTS, HIDDEN[0], HIDDEN[1], HIDDEN[2], OUTPUTS];
 /// The hidden layers' activation, by name (for reports; the paper states none): every hidden
 /// layer applies it, the output layer is linear. [`Mlp::forward`], [`Parameters::forward_f64`]
 /// and the [`crate::Predictor`] all apply `max(0, x)`.
@@ -33,10 +33,10 @@ pub const ACTIVATION: &str = "ReLU";
 #[non_exhaustive]
 pub enum Error {
     /// A layer's weight or bias does not have the size the architecture requires.
-    #[error(
-        "layer {layer} {tensor} has {got} values, the 900-256-128-64-2 architecture needs {expected}"
-    )]
+    #[error("layer {layer} {tensor} has {got} values, the {architecture} network needs {expected}")]
     Shape {
+        /// The network, e.g. `900-256-128-64-2`.
+        architecture: String,
         /// Layer index (0 = input layer).
         layer: usize,
         /// `"weight"` or `"bias"`.
@@ -56,6 +56,21 @@ pub enum Error {
         /// Flat index of the first offending value.
         index: usize,
     },
+    /// A late-fusion network has a weight between one branch's units and the other frame.
+    #[error(
+        "layer 0 weight [{unit}, {input}] is {value} but late fusion connects unit {unit} only \
+         to the {frame} frame's inputs (a cross-branch weight must be 0)"
+    )]
+    CrossBranch {
+        /// The hidden unit.
+        unit: usize,
+        /// The input.
+        input: usize,
+        /// The weight found.
+        value: f32,
+        /// `static` or `dynamic`: the frame the unit's branch reads.
+        frame: &'static str,
+    },
     /// burn returned tensor data of an unexpected type.
     #[error("reading a tensor back from burn failed: {0}")]
     Readback(String),
@@ -70,52 +85,102 @@ pub struct LayerParameters {
     pub bias: Vec<f32>,
 }
 
-/// All weights of the MLP in PyTorch layout (see the module docs).
+/// All weights of the network in PyTorch layout (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameters {
+    /// The network they belong to (sizes, and late fusion's zero cross-branch weights).
+    pub architecture: Architecture,
     /// The four linear layers, input first.
     pub layers: Vec<LayerParameters>,
 }
 
 impl Parameters {
+    /// The paper's MLP with PyTorch's default initial weights from `seed`
+    /// ([`Parameters::init_for`] with [`Architecture::Mlp`]).
+    pub fn init(seed: u64) -> Self {
+        Self::init_for(Architecture::Mlp, seed)
+    }
+
     /// PyTorch's default `nn.Linear` initialisation drawn from `ChaCha8Rng::seed_from_u64(seed)`:
     /// weights and biases uniform in `[-1/sqrt(fan_in), 1/sqrt(fan_in))` (Kaiming-uniform with
     /// `a = sqrt(5)` reduces to that bound). Values are drawn layer by layer, the weight
-    /// row-major before the bias, so the same seed gives the same bytes on every machine.
-    pub fn init(seed: u64) -> Self {
+    /// row-major before the bias, so the same seed gives the same bytes on every machine. Late
+    /// fusion draws its layers in PyTorch module order: the static branch (`900 x 128`, fan-in
+    /// 900), the dynamic branch, then the head; the branches are placed in the block-diagonal
+    /// first layer, whose cross-branch weights are zero.
+    pub fn init_for(architecture: Architecture, seed: u64) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let layers = LAYER_SIZES
-            .windows(2)
-            .map(|w| {
-                let (fan_in, fan_out) = (w[0], w[1]);
-                let bound = 1.0 / (fan_in as f32).sqrt();
-                let mut draw = |n: usize| -> Vec<f32> {
-                    (0..n).map(|_| rng.random_range(-bound..bound)).collect()
-                };
-                let weight = draw(fan_out * fan_in);
-                let bias = draw(fan_out);
-                LayerParameters { weight, bias }
-            })
-            .collect();
-        Self { layers }
+        let mut draw = |fan_in: usize, fan_out: usize| -> LayerParameters {
+            let bound = 1.0 / (fan_in as f32).sqrt();
+            let mut values = |n: usize| -> Vec<f32> {
+                (0..n).map(|_| rng.random_range(-bound..bound)).collect()
+            };
+            let weight = values(fan_out * fan_in);
+            let bias = values(fan_out);
+            LayerParameters { weight, bias }
+        };
+        let sizes = architecture.layer_sizes();
+        let mut layers = Vec::with_capacity(LAYERS);
+        if architecture == Architecture::Late {
+            let branches = [draw(INPUTS, BRANCH), draw(INPUTS, BRANCH)];
+            layers.push(join_branches(&branches));
+        } else {
+            layers.push(draw(sizes[0], sizes[1]));
+        }
+        for w in sizes[1..].windows(2) {
+            layers.push(draw(w[0], w[1]));
+        }
+        Self {
+            architecture,
+            layers,
+        }
     }
 
-    /// Checks the sizes against the architecture and that every value is finite.
+    /// Late fusion's two branches (static, dynamic), each `[BRANCH, 900]`, cut out of the
+    /// block-diagonal first layer; `None` for the other architectures.
+    pub fn branches(&self) -> Option<[LayerParameters; 2]> {
+        if self.architecture != Architecture::Late {
+            return None;
+        }
+        let first = self.layers.first()?;
+        Some(std::array::from_fn(|b| {
+            let units = b * BRANCH..(b + 1) * BRANCH;
+            let inputs = b * INPUTS..(b + 1) * INPUTS;
+            LayerParameters {
+                weight: units
+                    .clone()
+                    .flat_map(|u| {
+                        first.weight[u * MAX_INPUTS..][inputs.clone()]
+                            .iter()
+                            .copied()
+                    })
+                    .collect(),
+                bias: first.bias[units].to_vec(),
+            }
+        }))
+    }
+
+    /// Checks the sizes against the architecture, that every value is finite and that late
+    /// fusion's cross-branch weights are zero.
     pub fn validate(&self) -> Result<(), Error> {
+        let sizes = self.architecture.layer_sizes();
+        let architecture = self.architecture.describe();
         if self.layers.len() != LAYERS {
             return Err(Error::Shape {
+                architecture,
                 layer: self.layers.len().min(LAYERS),
                 tensor: "weight",
                 got: 0,
-                expected: LAYER_SIZES[1] * LAYER_SIZES[0],
+                expected: sizes[1] * sizes[0],
             });
         }
-        for (layer, (p, w)) in self.layers.iter().zip(LAYER_SIZES.windows(2)).enumerate() {
+        for (layer, (p, w)) in self.layers.iter().zip(sizes.windows(2)).enumerate() {
             for (tensor, values, expected) in
                 [("weight", &p.weight, w[0] * w[1]), ("bias", &p.bias, w[1])]
             {
                 if values.len() != expected {
                     return Err(Error::Shape {
+                        architecture,
                         layer,
                         tensor,
                         got: values.len(),
@@ -131,13 +196,27 @@ impl Parameters {
                 }
             }
         }
+        let inputs = sizes[0];
+        for (k, &value) in self.layers[0].weight.iter().enumerate() {
+            let (unit, input) = (k / inputs, k % inputs);
+            if value != 0.0 && !self.architecture.connects(unit, input) {
+                let frame = if unit < BRANCH { "static" } else { "dynamic" };
+                return Err(Error::CrossBranch {
+                    unit,
+                    input,
+                    value,
+                    frame,
+                });
+            }
+        }
         Ok(())
     }
 
     /// Reference forward pass in f64 on one sample (slow; for tests and checks).
     pub fn forward_f64(&self, x: &[f32]) -> [f64; OUTPUTS] {
         let mut h: Vec<f64> = x.iter().map(|&v| f64::from(v)).collect();
-        for (i, (p, w)) in self.layers.iter().zip(LAYER_SIZES.windows(2)).enumerate() {
+        let sizes = self.architecture.layer_sizes();
+        for (i, (p, w)) in self.layers.iter().zip(sizes.windows(2)).enumerate() {
             let (fan_in, fan_out) = (w[0], w[1]);
             h = (0..fan_out)
                 .map(|o| {
@@ -156,8 +235,9 @@ impl Parameters {
     }
 }
 
-/// The MLP as a burn module: four [`Linear`] layers named `layers.0` .. `layers.3`, ReLU between
-/// them and none after the last.
+/// The network as a burn module: four [`Linear`] layers named `layers.0` .. `layers.3`, ReLU
+/// between them and none after the last (late fusion as its block-diagonal first layer: the
+/// same function, not the same gradients for the cross-branch weights).
 ///
 /// burn's `Linear` stores its weight `[in, out]`; [`Mlp::from_parameters`] and
 /// [`Mlp::parameters`] transpose to and from PyTorch's `[out, in]`.
@@ -178,10 +258,11 @@ impl Mlp {
     /// Uploads `params` (PyTorch layout) to `device`.
     pub fn from_parameters(params: &Parameters, device: &Device) -> Result<Self, Error> {
         params.validate()?;
+        let sizes = params.architecture.layer_sizes();
         let layers = params
             .layers
             .iter()
-            .zip(LAYER_SIZES.windows(2))
+            .zip(sizes.windows(2))
             .map(|(p, w)| {
                 let (fan_in, fan_out) = (w[0], w[1]);
                 let mut linear = LinearConfig::new(fan_in, fan_out).init(device);
@@ -199,12 +280,22 @@ impl Mlp {
         Ok(Self { layers })
     }
 
-    /// Downloads the weights into PyTorch layout.
-    pub fn parameters(&self) -> Result<Parameters, Error> {
+    /// Downloads the weights into PyTorch layout, as the weights of `architecture` (checked).
+    pub fn parameters(&self, architecture: Architecture) -> Result<Parameters, Error> {
+        let sizes = architecture.layer_sizes();
+        if self.layers.len() != LAYERS {
+            return Err(Error::Shape {
+                architecture: architecture.describe(),
+                layer: self.layers.len().min(LAYERS),
+                tensor: "weight",
+                got: 0,
+                expected: sizes[0] * sizes[1],
+            });
+        }
         let layers = self
             .layers
             .iter()
-            .zip(LAYER_SIZES.windows(2))
+            .zip(sizes.windows(2))
             .map(|(linear, w)| {
                 let (fan_in, fan_out) = (w[0], w[1]);
                 let weight = to_vec(&linear.weight.val())?;
@@ -218,10 +309,15 @@ impl Mlp {
                 })
             })
             .collect::<Result<Vec<_>, Error>>()?;
-        Ok(Parameters { layers })
+        let params = Parameters {
+            architecture,
+            layers,
+        };
+        params.validate()?;
+        Ok(params)
     }
 
-    /// Forward pass: `[batch, 900]` features to `[batch, 2]` (pitch, roll).
+    /// Forward pass: `[batch, inputs]` features to `[batch, 2]` (pitch, roll).
     pub fn forward(&self, x: Tensor<2>) -> Tensor<2> {
         let last = self.layers.len().saturating_sub(1);
         self.layers.iter().enumerate().fold(x, |h, (i, linear)| {
@@ -229,6 +325,20 @@ impl Mlp {
             if i < last { relu(z) } else { z }
         })
     }
+}
+
+/// Late fusion's block-diagonal first layer (`[256, 1800]`) from its two branches (static,
+/// dynamic; each `[BRANCH, 900]`): every cross-branch weight zero.
+pub(crate) fn join_branches(branches: &[LayerParameters; 2]) -> LayerParameters {
+    let mut weight = vec![0.0; HIDDEN[0] * MAX_INPUTS];
+    let mut bias = Vec::with_capacity(HIDDEN[0]);
+    for (b, branch) in branches.iter().enumerate() {
+        for (u, row) in branch.weight.chunks_exact(INPUTS).enumerate() {
+            weight[(b * BRANCH + u) * MAX_INPUTS + b * INPUTS..][..INPUTS].copy_from_slice(row);
+        }
+        bias.extend_from_slice(&branch.bias);
+    }
+    LayerParameters { weight, bias }
 }
 
 /// Row-major `[rows, cols]` to row-major `[cols, rows]`.
@@ -274,7 +384,7 @@ mod tests {
         let device = Device::flex();
         let p = Parameters::init(1);
         let mlp = Mlp::from_parameters(&p, &device).expect("fits");
-        assert_eq!(mlp.parameters().expect("readback"), p);
+        assert_eq!(mlp.parameters(Architecture::Mlp).expect("readback"), p);
         let x: Vec<f32> = (0..2 * INPUTS).map(|i| ((i % 17) as f32) * 0.1).collect();
         let out = to_vec(&mlp.forward(Tensor::from_data(
             TensorData::new(x.clone(), [2, INPUTS]),
@@ -287,6 +397,65 @@ mod tests {
                 assert!((f64::from(out[s * OUTPUTS + k]) - r[k]).abs() < 1e-4);
             }
         }
+    }
+
+    #[test]
+    fn late_fusion_is_two_branches_and_a_head() {
+        let p = Parameters::init_for(Architecture::Late, 5);
+        p.validate().expect("valid");
+        let [s, d] = p.branches().expect("late");
+        // The branches are drawn as two nn.Linear(900, 128), in module order.
+        let bound = 1.0 / 30.0;
+        assert!(s.weight.iter().chain(&d.weight).all(|v| v.abs() <= bound));
+        assert_ne!(s.weight, d.weight);
+        assert_eq!(join_branches(&[s.clone(), d.clone()]), p.layers[0]);
+        // The network is the branches' ReLU outputs, concatenated, through the head.
+        let x: Vec<f32> = (0..MAX_INPUTS)
+            .map(|i| ((i * 13) % 65) as f32 / 64.0)
+            .collect();
+        let branch = |b: &LayerParameters, x: &[f32]| -> Vec<f64> {
+            (0..BRANCH)
+                .map(|u| {
+                    let row = &b.weight[u * INPUTS..][..INPUTS];
+                    let z: f64 = row
+                        .iter()
+                        .zip(x)
+                        .map(|(&w, &v)| f64::from(w) * f64::from(v))
+                        .sum();
+                    (z + f64::from(b.bias[u])).max(0.0)
+                })
+                .collect()
+        };
+        let mut h = [branch(&s, &x[..INPUTS]), branch(&d, &x[INPUTS..])].concat();
+        for (i, layer) in p.layers[1..].iter().enumerate() {
+            let fan_in = h.len();
+            h = (0..layer.bias.len())
+                .map(|o| {
+                    let row = &layer.weight[o * fan_in..][..fan_in];
+                    let z = row
+                        .iter()
+                        .zip(&h)
+                        .map(|(&w, &v)| f64::from(w) * v)
+                        .sum::<f64>()
+                        + f64::from(layer.bias[o]);
+                    if i < 2 { z.max(0.0) } else { z }
+                })
+                .collect();
+        }
+        let got = p.forward_f64(&x);
+        for k in 0..OUTPUTS {
+            assert!((got[k] - h[k]).abs() < 1e-9, "{got:?} vs {h:?}");
+        }
+        // A cross-branch weight is refused, naming it.
+        let mut bad = p.clone();
+        bad.layers[0].weight[3 * MAX_INPUTS + 1000] = 0.5;
+        let msg = bad.validate().expect_err("cross-branch").to_string();
+        assert!(msg.contains("[3, 1000]") && msg.contains("static"), "{msg}");
+        // The stacked network is dense over 1800 inputs, drawn with fan-in 1800.
+        let stacked = Parameters::init_for(Architecture::Stacked, 5);
+        stacked.validate().expect("valid");
+        assert_eq!(stacked.layers[0].weight.len(), 256 * 1800);
+        assert!(stacked.branches().is_none());
     }
 
     #[test]

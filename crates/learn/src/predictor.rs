@@ -18,7 +18,7 @@
 //! with identical results on all three.
 
 use crate::cell_layer::{self, CellLayer, CellSums};
-use crate::model::{self, INPUTS, LAYER_SIZES, Parameters};
+use crate::model::{self, Architecture, LAYER_SIZES, MAX_INPUTS, Parameters};
 use crate::panels::{self, Dense};
 
 /// Errors of this module.
@@ -28,11 +28,13 @@ pub enum Error {
     /// The weights do not fit the architecture.
     #[error(transparent)]
     Model(#[from] model::Error),
-    /// A batch is not a whole number of 900-value rows.
-    #[error("{len} feature values is not a multiple of {INPUTS} (one row per sample)")]
+    /// A batch is not a whole number of rows of the network's width.
+    #[error("{len} feature values is not a multiple of {width} (one row per sample)")]
     RaggedFeatures {
         /// Number of values given.
         len: usize,
+        /// Features per sample the network reads.
+        width: usize,
     },
 }
 
@@ -50,6 +52,7 @@ const H1: usize = LAYER_SIZES[1];
 /// ```
 #[derive(Debug, Clone)]
 pub struct Predictor {
+    architecture: Architecture,
     /// The first layer in fixed point, for pooled features.
     cells: CellLayer,
     layers: [Dense; 4],
@@ -61,36 +64,50 @@ impl Predictor {
     pub fn new(params: &Parameters) -> Result<Self, Error> {
         params.validate()?;
         crate::ftz::flush_denormals();
+        let sizes = params.architecture.layer_sizes();
         let dense = |i: usize| {
             let p = &params.layers[i];
-            Dense::from_pytorch(&p.weight, &p.bias, LAYER_SIZES[i], LAYER_SIZES[i + 1])
+            Dense::from_pytorch(&p.weight, &p.bias, sizes[i], sizes[i + 1])
         };
         let first = &params.layers[0];
         Ok(Self {
+            architecture: params.architecture,
             cells: CellLayer::new(
-                &model::transpose(&first.weight, LAYER_SIZES[1], INPUTS),
+                &model::transpose(&first.weight, LAYER_SIZES[1], sizes[0]),
                 &first.bias,
             ),
             layers: [dense(0), dense(1), dense(2), dense(3)],
         })
     }
 
-    /// (pitch, roll) in degrees for one sample of 900 features. Allocation-free. Pooled
-    /// features (multiples of 1/64 in `[0, 1]`) go through the exact first layer (see the
-    /// module docs), any others through the float32 one.
+    /// The network it runs.
+    pub fn architecture(&self) -> Architecture {
+        self.architecture
+    }
+
+    /// Features per sample: 900, or 1800 for the two-frame networks.
+    pub fn inputs(&self) -> usize {
+        self.layers[0].fan_in
+    }
+
+    /// (pitch, roll) in degrees for one sample of [`Predictor::inputs`] features.
+    /// Allocation-free. Pooled features (multiples of 1/64 in `[0, 1]`) go through the exact
+    /// first layer (see the module docs), any others through the float32 one.
     ///
     /// # Panics
     ///
-    /// When `features.len() != 900`: feature vectors come from the representation code, so a
-    /// wrong length is a programming error (use [`Predictor::predict`] for data from files).
+    /// When `features.len()` is not [`Predictor::inputs`]: feature vectors come from the
+    /// representation code, so a wrong length is a programming error (use
+    /// [`Predictor::predict`] for data from files).
     pub fn predict_one(&self, features: &[f32]) -> [f32; 2] {
+        let inputs = self.inputs();
         assert_eq!(
             features.len(),
-            INPUTS,
-            "predict_one needs {INPUTS} features"
+            inputs,
+            "predict_one needs {inputs} features"
         );
         let mut h1 = [0.0_f32; H1];
-        let mut counts = [0_u8; INPUTS];
+        let mut counts = [0_u8; MAX_INPUTS];
         if cell_layer::cell_counts(features, &mut counts) {
             let mut sums = [0.0_f64; H1];
             self.cells.sums(&counts, &mut sums);
@@ -111,14 +128,15 @@ impl Predictor {
     /// `state` as it was.
     ///
     /// # Panics
-    /// When `features.len() != 900`, as [`Predictor::predict_one`].
+    /// When `features.len()` is not [`Predictor::inputs`], as [`Predictor::predict_one`].
     pub(crate) fn predict_streaming(&self, state: &mut CellSums, features: &[f32]) -> [f32; 2] {
+        let inputs = self.inputs();
         assert_eq!(
             features.len(),
-            INPUTS,
-            "StreamingPredictor::predict needs {INPUTS} features"
+            inputs,
+            "StreamingPredictor::predict needs {inputs} features"
         );
-        let mut counts = [0_u8; INPUTS];
+        let mut counts = [0_u8; MAX_INPUTS];
         if !cell_layer::cell_counts(features, &mut counts) {
             return self.predict_one(features);
         }
@@ -127,18 +145,20 @@ impl Predictor {
         self.after_first_layer(&h1)
     }
 
-    /// (pitch, roll) for every row of `features` (n x 900, flat).
+    /// (pitch, roll) for every row of `features` (n x [`Predictor::inputs`], flat).
     pub fn predict(&self, features: &[f32]) -> Result<Vec<[f32; 2]>, Error> {
-        if !features.len().is_multiple_of(INPUTS) {
+        let width = self.inputs();
+        if !features.len().is_multiple_of(width) {
             return Err(Error::RaggedFeatures {
                 len: features.len(),
+                width,
             });
         }
         // Rows in a set are mostly consecutive samples of a trial, which differ in few cells:
         // streaming through them gives the same results as one at a time, faster.
         let mut stream = CellSums::new();
         Ok(features
-            .chunks_exact(INPUTS)
+            .chunks_exact(width)
             .map(|row| self.predict_streaming(&mut stream, row))
             .collect())
     }
@@ -147,7 +167,7 @@ impl Predictor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::OUTPUTS;
+    use crate::model::{INPUTS, OUTPUTS};
 
     #[test]
     fn matches_the_f64_reference() {
@@ -179,5 +199,34 @@ mod tests {
             p.predict(&x[1..]),
             Err(Error::RaggedFeatures { .. })
         ));
+    }
+
+    /// The two-frame networks, on pooled and on other features, against the f64 reference;
+    /// late fusion's zero cross-branch weights take part in neither path's result.
+    #[test]
+    fn two_frame_networks_match_the_f64_reference() {
+        for architecture in [Architecture::Stacked, Architecture::Late] {
+            let params = Parameters::init_for(architecture, 12);
+            let p = Predictor::new(&params).expect("valid");
+            assert_eq!((p.inputs(), p.architecture()), (MAX_INPUTS, architecture));
+            let pooled: Vec<f32> = (0..2 * MAX_INPUTS)
+                .map(|i| ((i * 11) % 65) as f32 / 64.0)
+                .collect();
+            let off_grid: Vec<f32> = pooled.iter().map(|v| v * 0.9).collect();
+            for x in [&pooled, &off_grid] {
+                let got = p.predict(x).expect("rows");
+                for (row, g) in x.chunks_exact(MAX_INPUTS).zip(&got) {
+                    assert_eq!(*g, p.predict_one(row));
+                    let r = params.forward_f64(row);
+                    for k in 0..OUTPUTS {
+                        assert!((f64::from(g[k]) - r[k]).abs() < 1e-4, "{g:?} vs {r:?}");
+                    }
+                }
+            }
+            assert!(matches!(
+                p.predict(&pooled[..INPUTS]),
+                Err(Error::RaggedFeatures { width: 1800, .. })
+            ));
+        }
     }
 }

@@ -67,28 +67,36 @@ impl StreamingPredictor {
 mod tests {
     use super::*;
     use crate::Parameters;
-    use crate::model::INPUTS;
+    use crate::model::{Architecture, MAX_INPUTS};
     use proptest::prelude::*;
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
-        /// Any sequence of samples, pooled or not, gives what the predictor gives each alone.
+        /// Any sequence of samples, pooled or not, gives what the predictor gives each alone,
+        /// for each network (the two-frame ones read 1800 cells).
         #[test]
         fn a_stream_predicts_what_each_sample_alone_does(
             seed in 0u64..4,
+            architecture in prop_oneof![
+                Just(Architecture::Mlp),
+                Just(Architecture::Stacked),
+                Just(Architecture::Late),
+            ],
             steps in proptest::collection::vec(
-                (proptest::collection::vec((0usize..INPUTS, 0u8..=64), 0..120), any::<bool>()),
+                (proptest::collection::vec((0usize..MAX_INPUTS, 0u8..=64), 0..120), any::<bool>()),
                 1..12,
             ),
         ) {
-            let predictor = Predictor::new(&Parameters::init(seed)).expect("valid");
+            let params = Parameters::init_for(architecture, seed);
+            let predictor = Predictor::new(&params).expect("valid");
             let mut stream = StreamingPredictor::new(predictor.clone());
-            let mut features = [0.0_f32; INPUTS];
+            let inputs = architecture.inputs();
+            let mut features = vec![0.0_f32; inputs];
             for (changes, off_grid) in steps {
                 for (cell, count) in changes {
-                    features[cell] = f32::from(count) / 64.0;
+                    features[cell % inputs] = f32::from(count) / 64.0;
                 }
-                let mut sample = features;
+                let mut sample = features.clone();
                 if off_grid {
                     sample[0] = 0.3;
                 }

@@ -12,7 +12,7 @@ use crate::adamw::{AdamW, AdamWConfig};
 use crate::backprop::{self, MAX_BATCH, Network, Scratch};
 use crate::data::{FeatureSet, Shuffler};
 use crate::metrics::{self, Mae};
-use crate::model::{self, INPUTS, OUTPUTS, Parameters};
+use crate::model::{self, Architecture, OUTPUTS, Parameters};
 
 /// Errors of this module.
 #[derive(Debug, thiserror::Error)]
@@ -44,13 +44,29 @@ pub enum Error {
     },
     /// A batch passed to [`Trainer::step`] is malformed (or over 65,535 samples).
     #[error(
-        "batch of {features} feature values and {labels} labels is not n x 900 and n x 2 with 1 <= n <= 65535"
+        "batch of {features} feature values and {labels} labels is not n x {inputs} and n x 2 with 1 <= n <= 65535"
     )]
     Batch {
         /// Number of feature values.
         features: usize,
+        /// Features per sample the network reads.
+        inputs: usize,
         /// Number of label values.
         labels: usize,
+    },
+    /// A set's features do not have the width the network reads.
+    #[error(
+        "the {set} set has {width} features per sample but the {} network reads {}",
+        architecture.name(),
+        architecture.inputs()
+    )]
+    Width {
+        /// `"training"` or `"validation"`.
+        set: &'static str,
+        /// Its features per sample.
+        width: usize,
+        /// The network.
+        architecture: Architecture,
     },
     /// The loss became NaN or infinite (diverged).
     #[error("the training loss is not finite at epoch {epoch}, step {step}")]
@@ -84,6 +100,10 @@ pub struct TrainConfig {
     pub optimizer: AdamWConfig,
     /// Seed of the initial weights (`ChaCha8Rng` stream 0) and the shuffling (stream 1).
     pub seed: u64,
+    /// The network: the paper's MLP, or one of the two-frame networks for the `stacked` and
+    /// `late` representations ([`Architecture::for_repr`]). Absent in bundles written before
+    /// they existed, which are all the paper's MLP.
+    pub architecture: Architecture,
 }
 
 impl Default for TrainConfig {
@@ -94,6 +114,7 @@ impl Default for TrainConfig {
             huber_beta: 1.0,
             optimizer: AdamWConfig::default(),
             seed: 0,
+            architecture: Architecture::Mlp,
         }
     }
 }
@@ -213,7 +234,17 @@ pub fn train(
     if val.is_empty() {
         return Err(Error::Empty { set: "validation" });
     }
-    let mut trainer = Trainer::new(&Parameters::init(cfg.seed), cfg)?;
+    let inputs = cfg.architecture.inputs();
+    for (set, data) in [("training", train), ("validation", val)] {
+        if data.width != inputs {
+            return Err(Error::Width {
+                set,
+                width: data.width,
+                architecture: cfg.architecture,
+            });
+        }
+    }
+    let mut trainer = Trainer::new(&Parameters::init_for(cfg.architecture, cfg.seed), cfg)?;
     let mut shuffler = Shuffler::new(train.len(), cfg.seed);
     let (mut xb, mut yb) = (Vec::new(), Vec::new());
     let mut history = Vec::with_capacity(cfg.epochs);
@@ -273,7 +304,7 @@ pub struct Trainer {
 
 impl Trainer {
     /// A trainer starting from `params` with `cfg`'s loss and optimiser settings (its `epochs`,
-    /// `batch_size` and `seed` are not used here). Flushes subnormals on this thread.
+    /// `batch_size`, `seed` and `architecture` are not used here: `params` is the network). Flushes subnormals on this thread.
     pub fn new(params: &Parameters, cfg: &TrainConfig) -> Result<Self, Error> {
         cfg.validate()?;
         params.validate()?;
@@ -291,13 +322,15 @@ impl Trainer {
         self.optimizer.steps()
     }
 
-    /// One AdamW step on a batch (`features` n x 900, `labels` n x 2, flat); returns the batch's
-    /// mean SmoothL1 loss before the update.
+    /// One AdamW step on a batch (`features` n x inputs, `labels` n x 2, flat); returns the
+    /// batch's mean SmoothL1 loss before the update.
     pub fn step(&mut self, features: &[f32], labels: &[f32]) -> Result<f32, Error> {
         let n = labels.len() / OUTPUTS;
-        if n == 0 || n > MAX_BATCH || features.len() != n * INPUTS || labels.len() != n * OUTPUTS {
+        let inputs = self.net.inputs();
+        if n == 0 || n > MAX_BATCH || features.len() != n * inputs || labels.len() != n * OUTPUTS {
             return Err(Error::Batch {
                 features: features.len(),
+                inputs,
                 labels: labels.len(),
             });
         }
@@ -307,16 +340,18 @@ impl Trainer {
         ))
     }
 
-    /// Predictions for `features` (n x 900, flat) with the current weights.
+    /// Predictions for `features` (n x inputs, flat) with the current weights.
     pub fn predict(&self, features: &[f32]) -> Result<Vec<[f32; 2]>, Error> {
-        if !features.len().is_multiple_of(INPUTS) {
+        let inputs = self.net.inputs();
+        if !features.len().is_multiple_of(inputs) {
             return Err(Error::Batch {
                 features: features.len(),
+                inputs,
                 labels: 0,
             });
         }
         Ok(features
-            .chunks_exact(INPUTS)
+            .chunks_exact(inputs)
             .map(|x| self.net.predict_one(x))
             .collect())
     }

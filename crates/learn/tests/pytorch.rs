@@ -94,7 +94,10 @@ fn hashed_parameters() -> Parameters {
             LayerParameters { weight, bias }
         })
         .collect();
-    Parameters { layers }
+    Parameters {
+        architecture: evtac_learn::Architecture::Mlp,
+        layers,
+    }
 }
 
 /// The script's batch `s`: 32 x 900 features (half zeros) and 32 x 2 labels in +-20 degrees.

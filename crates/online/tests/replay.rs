@@ -44,7 +44,7 @@ fn offline(model: &Model, events: &[Event], times: &[i64]) -> Vec<[f32; 2]> {
     let features =
         extract_features(&[model.repr_config()], crop, model.mask(), &cropped, times).unwrap();
     features[0]
-        .chunks_exact(900)
+        .chunks_exact(model.predictor.inputs())
         .map(|row| model.predictor.predict_one(row))
         .collect()
 }

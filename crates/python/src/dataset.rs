@@ -13,7 +13,6 @@ use evtac_experiments::inputs::Inputs;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_labels::dataset::{DatasetLabels, label_and_write};
 use evtac_labels::{LabelConfig, read_calibration};
-use evtac_learn::INPUTS;
 use evtac_repr::CROP;
 use evtac_sim::{DatasetConfig, Protocol, Scale, SimParams, simulate_dataset};
 use ndarray::Array2;
@@ -180,7 +179,7 @@ pub fn dataset_features<'py>(
     })?;
     let n = loaded.samples.len();
     let features =
-        Array2::from_shape_vec((n, INPUTS), loaded.set.features).map_err(error::value)?;
+        Array2::from_shape_vec((n, loaded.set.width), loaded.set.features).map_err(error::value)?;
     let labels = Array2::from_shape_vec((n, 2), loaded.set.labels).map_err(error::value)?;
     let trial: Vec<i64> = loaded.samples.iter().map(|s| s.trial as i64).collect();
     let t_us: Vec<i64> = loaded.samples.iter().map(|s| s.t_us).collect();

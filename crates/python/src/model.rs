@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use evtac_events::Resolution;
-use evtac_learn::{INPUTS, ModelBundle};
+use evtac_learn::ModelBundle;
 use evtac_online::Estimate;
 use evtac_repr::CROP;
 use ndarray::Array2;
@@ -60,17 +60,18 @@ impl Model {
             .map_err(error::file)
     }
 
-    /// (pitch, roll) in degrees for each row of `features` (float32 `(N, 900)`):
-    /// float32 `(N, 2)`.
+    /// (pitch, roll) in degrees for each row of `features` (float32 `(N, 900)`, `(N, 1800)` for
+    /// stacked and late models): float32 `(N, 2)`.
     fn predict<'py>(
         &self,
         py: Python<'py>,
         features: PyReadonlyArray2<'py, f32>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let (n, width) = features.as_array().dim();
-        if width != INPUTS {
+        let inputs = self.inner.predictor.inputs();
+        if width != inputs {
             return Err(error::value(format!(
-                "features must have shape (N, {INPUTS}), got ({n}, {width})"
+                "features must have shape (N, {inputs}), got ({n}, {width})"
             )));
         }
         let flat = features.as_slice().map_err(error::value)?;

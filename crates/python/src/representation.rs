@@ -44,10 +44,10 @@ pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
     let (has_static, has_dynamic) = match kind {
         "static" => (true, false),
         "dynamic" => (false, true),
-        "combined" => (true, true),
+        "combined" | "stacked" | "late" => (true, true),
         other => {
             return Err(error::value(format!(
-                "unknown representation kind `{other}` (static, dynamic or combined)"
+                "unknown representation kind `{other}` (static, dynamic, combined, stacked or late)"
             )));
         }
     };
@@ -82,6 +82,14 @@ pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
     let config = match kind {
         "static" => ReprConfig::Static(static_part(st)?),
         "dynamic" => ReprConfig::Dynamic(dynamic_part(dy)?),
+        "stacked" => ReprConfig::Stacked {
+            static_part: static_part(st)?,
+            dynamic_part: dynamic_part(dy)?,
+        },
+        "late" => ReprConfig::Late {
+            static_part: static_part(st)?,
+            dynamic_part: dynamic_part(dy)?,
+        },
         _ => ReprConfig::Combined {
             static_part: static_part(st)?,
             dynamic_part: dynamic_part(dy)?,
@@ -209,9 +217,11 @@ impl Representation {
         })
     }
 
+    /// `(height, width)` of a frame: the crop's, twice as high for stacked and late (the
+    /// static frame above the dynamic one).
     fn frame_dims(&self) -> (usize, usize) {
         (
-            usize::from(self.roi.size.height),
+            usize::from(self.roi.size.height) * self.config.frames(),
             usize::from(self.roi.size.width),
         )
     }
@@ -272,13 +282,14 @@ impl Representation {
         events: PyReadonlyArray1<'py, u8>,
         times: PyReadonlyArray1<'py, i64>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let len = self.state()?.feature_len();
+        let len = self.state()?.feature_len(0);
         let (n, out) = self.sampled(py, &events, &times, len, |fx| fx.features(0))?;
         let out = Array2::from_shape_vec((n, len), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))
     }
 
-    /// Binary frames at each of `times`: uint8 `(N, height, width)`, 0 or 1.
+    /// Binary frames at each of `times`: uint8 `(N, height, width)`, 0 or 1 (stacked and late:
+    /// `(N, 2 * height, width)`, the static frame above the dynamic one).
     fn frames<'py>(
         &self,
         py: Python<'py>,
@@ -300,10 +311,13 @@ impl Representation {
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         if self.config.static_part().is_none() {
             return Err(error::value(
-                "a dynamic representation has no potentials (static and combined have)",
+                "a dynamic representation has no potentials (every kind with a static part has)",
             ));
         }
-        let (h, w) = self.frame_dims();
+        let (h, w) = (
+            usize::from(self.roi.size.height),
+            usize::from(self.roi.size.width),
+        );
         let (n, out) = self.sampled(py, &events, &times, h * w, |fx| {
             fx.potentials(0).unwrap_or_default()
         })?;
@@ -357,14 +371,10 @@ impl Representation {
         serde_json::to_string(&self.config).map_err(error::value)
     }
 
-    /// `static`, `dynamic` or `combined`.
+    /// `static`, `dynamic`, `combined`, `stacked` or `late`.
     #[getter]
     fn kind(&self) -> &'static str {
-        match self.config {
-            ReprConfig::Static(_) => "static",
-            ReprConfig::Dynamic(_) => "dynamic",
-            ReprConfig::Combined { .. } => "combined",
-        }
+        self.config.kind_name()
     }
 
     /// The cache key naming the config (as in evtac's feature caches).
@@ -404,10 +414,10 @@ impl Representation {
             .transpose()
     }
 
-    /// Features per sample (900 on the paper's 240x240 crop).
+    /// Features per sample (900 on the paper's 240x240 crop, 1800 for stacked and late).
     #[getter]
     fn feature_len(&self) -> PyResult<usize> {
-        Ok(self.state()?.feature_len())
+        Ok(self.state()?.feature_len(0))
     }
 }
 

@@ -89,3 +89,28 @@ def test_errors(tmp_path, model_dir):
         evtac.Estimator(model, (200, 200))
     with pytest.raises(ValueError, match="240x240 crop"):
         evtac.Model.untrained(1, evtac.Representation(roi=(160, 160)))
+
+
+@pytest.mark.parametrize("kind", ["combined", "stacked", "late"])
+def test_torch_module_loads_the_bundle_and_predicts_what_evtac_does(torch, tmp_path, recording,
+                                                                    kind):
+    """`evtac.torch.load_module` builds the module of each network (late fusion's branches and
+    head by their saved names, strictly) and its forward pass is evtac's prediction."""
+    import evtac.torch
+
+    d = tmp_path / kind
+    evtac.Model.untrained(5, evtac.Representation(kind, tau_ms=800)).save(d)
+    model = evtac.Model.load(d)
+    rep = model.representation(sensor=recording.resolution)
+    assert rep.kind == kind
+    t = recording.events["t"]
+    x = rep.features(recording.events, np.arange(t[0], t[-1], 20_000))
+    assert x.shape[1] == (900 if kind == "combined" else 1800)
+    assert np.count_nonzero(x[:, :900]) > 0
+    net = evtac.torch.load_module(d)
+    assert isinstance(net, evtac.torch.LateFusion if kind == "late" else evtac.torch.Mlp)
+    with torch.no_grad():
+        got = net(torch.from_numpy(x)).numpy()
+    np.testing.assert_allclose(got, model.predict(x), rtol=1e-4, atol=1e-4)
+    with pytest.raises(ValueError, match="shape"):
+        model.predict(np.zeros((2, 1800 if kind == "combined" else 900), np.float32))

@@ -98,7 +98,7 @@ fn samples() -> Vec<i64> {
 fn pass(config: &ReprConfig, events: &[Event], samples: &[i64], lat: &mut Vec<u64>) -> f32 {
     let mut fx =
         FeatureExtractor::new(std::slice::from_ref(config), FRAME, None).expect("valid config");
-    let mut features = vec![0.0f32; fx.feature_len()];
+    let mut features = vec![0.0f32; fx.feature_len(0)];
     let mut start = 0;
     let mut sum = 0.0;
     lat.clear();

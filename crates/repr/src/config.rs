@@ -286,10 +286,18 @@ impl DynamicConfig {
     }
 }
 
-/// One representation: static, dynamic, or their pixel-wise OR.
+/// One representation: static, dynamic, their pixel-wise OR (the paper's three), or both side
+/// by side for a network that learns the fusion (evtac's step beyond the OR, the paper's future
+/// work).
 ///
 /// Serialized with a `kind` tag, e.g. `{"kind": "dynamic", "window_ms": 640.0,
 /// "count_threshold": 0}`.
+///
+/// `Stacked` and `Late` have the same features (the static part's pooled frame followed by the
+/// dynamic part's: [`ReprConfig::frames`] is 2, so 1800 features on the paper's crop); they
+/// differ in the network that reads them (a dense first layer over all 1800, or one 900-input
+/// branch per part concatenated before the head: `evtac_learn::Architecture`), so they share
+/// one [`ReprConfig::cache_key`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ReprConfig {
@@ -299,6 +307,21 @@ pub enum ReprConfig {
     Dynamic(DynamicConfig),
     /// OR of a static and a dynamic binary frame, both built in the same pass.
     Combined {
+        /// The static part.
+        static_part: StaticConfig,
+        /// The dynamic part.
+        dynamic_part: DynamicConfig,
+    },
+    /// Both binary frames pooled side by side (static first), for one dense network over both.
+    Stacked {
+        /// The static part.
+        static_part: StaticConfig,
+        /// The dynamic part.
+        dynamic_part: DynamicConfig,
+    },
+    /// The same features as [`ReprConfig::Stacked`], for a network with one branch per part
+    /// whose hidden layers are concatenated before the head (late fusion).
+    Late {
         /// The static part.
         static_part: StaticConfig,
         /// The dynamic part.
@@ -320,7 +343,10 @@ impl ReprConfig {
     /// The static part, if any.
     pub fn static_part(&self) -> Option<&StaticConfig> {
         match self {
-            Self::Static(s) | Self::Combined { static_part: s, .. } => Some(s),
+            Self::Static(s)
+            | Self::Combined { static_part: s, .. }
+            | Self::Stacked { static_part: s, .. }
+            | Self::Late { static_part: s, .. } => Some(s),
             Self::Dynamic(_) => None,
         }
     }
@@ -331,8 +357,35 @@ impl ReprConfig {
             Self::Dynamic(d)
             | Self::Combined {
                 dynamic_part: d, ..
+            }
+            | Self::Stacked {
+                dynamic_part: d, ..
+            }
+            | Self::Late {
+                dynamic_part: d, ..
             } => Some(d),
             Self::Static(_) => None,
+        }
+    }
+
+    /// How many pooled frames the features hold side by side: 2 for [`ReprConfig::Stacked`]
+    /// and [`ReprConfig::Late`] (static, then dynamic), 1 otherwise.
+    pub fn frames(&self) -> usize {
+        match self {
+            Self::Stacked { .. } | Self::Late { .. } => 2,
+            Self::Static(_) | Self::Dynamic(_) | Self::Combined { .. } => 1,
+        }
+    }
+
+    /// The kind's name as the `kind` tag and the CLI's `--repr` spell it (`static`, `dynamic`,
+    /// `combined`, `stacked`, `late`).
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Self::Static(_) => "static",
+            Self::Dynamic(_) => "dynamic",
+            Self::Combined { .. } => "combined",
+            Self::Stacked { .. } => "stacked",
+            Self::Late { .. } => "late",
         }
     }
 
@@ -359,6 +412,15 @@ impl ReprConfig {
                 static_part,
                 dynamic_part,
             } => format!("v1_combined_{}+{}", static_part.key(), dynamic_part.key()),
+            // One key for both: the features are the same, only the network differs.
+            Self::Stacked {
+                static_part,
+                dynamic_part,
+            }
+            | Self::Late {
+                static_part,
+                dynamic_part,
+            } => format!("v1_stacked_{}+{}", static_part.key(), dynamic_part.key()),
         }
     }
 }
@@ -395,6 +457,27 @@ mod tests {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || "._-+".contains(c))
         );
+    }
+
+    #[test]
+    fn stacked_and_late_share_their_features_key_and_have_two_frames() {
+        let (static_part, dynamic_part) = (StaticConfig::default(), DynamicConfig::default());
+        let stacked = ReprConfig::Stacked {
+            static_part,
+            dynamic_part,
+        };
+        let late = ReprConfig::Late {
+            static_part,
+            dynamic_part,
+        };
+        assert_eq!(stacked.cache_key(), late.cache_key());
+        assert_ne!(stacked.cache_key(), ReprConfig::default().cache_key());
+        assert_eq!((stacked.frames(), late.frames()), (2, 2));
+        assert_eq!(ReprConfig::default().frames(), 1);
+        assert_eq!((stacked.kind_name(), late.kind_name()), ("stacked", "late"));
+        let json = serde_json::to_string(&late).unwrap();
+        assert!(json.contains("\"kind\":\"late\""), "{json}");
+        assert_eq!(serde_json::from_str::<ReprConfig>(&json).unwrap(), late);
     }
 
     #[test]

@@ -108,6 +108,10 @@ enum Kind {
     Static(usize),
     Dynamic(usize),
     Combined(usize, usize),
+    /// Both planes side by side (`Stacked` and `Late` configs): one [`Pool8`] over a frame twice
+    /// as high, the static plane in the top half and the dynamic one below, so the pooled
+    /// features are the static part's cells then the dynamic part's, in one slice.
+    Stacked(usize, usize),
 }
 
 struct Output {
@@ -296,21 +300,26 @@ impl FeatureExtractor {
                 plane
             });
             let kind = match (splane, dplane) {
+                (Some(s), Some(d)) if config.frames() == 2 => Kind::Stacked(s, d),
                 (Some(s), Some(d)) => Kind::Combined(s, d),
                 (Some(s), None) => Kind::Static(s),
                 (None, Some(d)) => Kind::Dynamic(d),
                 (None, None) => unreachable!("a ReprConfig has a static or a dynamic part"),
             };
+            let pooled = match kind {
+                Kind::Stacked(..) => stacked_frame(frame)?,
+                Kind::Static(_) | Kind::Dynamic(_) | Kind::Combined(..) => frame,
+            };
             fx.outputs.push(Output {
                 kind,
-                pool: Pool8::new(frame)?,
+                pool: Pool8::new(pooled)?,
             });
         }
         for plane in &mut fx.splanes {
             plane.lazy = !fx.accs[plane.acc].params.synchronous_decay
                 && plane.outputs.iter().all(|&o| match fx.outputs[o].kind {
                     Kind::Combined(_, d) => fx.dplanes[d].count_threshold == 0,
-                    Kind::Static(_) | Kind::Dynamic(_) => false,
+                    Kind::Static(_) | Kind::Dynamic(_) | Kind::Stacked(..) => false,
                 });
         }
         fx.refresh_static_planes(false);
@@ -337,9 +346,13 @@ impl FeatureExtractor {
         self.resolution
     }
 
-    /// Number of features per output: `(width / 8) * (height / 8)` (900 for 240x240).
-    pub fn feature_len(&self) -> usize {
-        self.outputs[0].pool.features().len()
+    /// Number of features of output `i`: `(width / 8) * (height / 8)` per pooled frame (900
+    /// for 240x240), times [`ReprConfig::frames`] (1800 for stacked and late configs).
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn feature_len(&self, i: usize) -> usize {
+        self.outputs[i].pool.features().len()
     }
 
     /// The latest sample time given to [`Self::advance_to`], if any.
@@ -630,7 +643,9 @@ impl FeatureExtractor {
     }
 
     /// The pooled features of output `i` at the latest sample time: `(width / 8) * (height / 8)`
-    /// values, row-major over 8x8 cells, each the fraction of set pixels in its cell.
+    /// values, row-major over 8x8 cells, each the fraction of set pixels in its cell; for
+    /// stacked and late configs ([`ReprConfig::frames`] 2) the static part's cells followed by
+    /// the dynamic part's, twice as many.
     ///
     /// # Panics
     /// When `i >= self.len()`.
@@ -638,7 +653,9 @@ impl FeatureExtractor {
         self.outputs[i].pool.features()
     }
 
-    /// The binary frame (0/1 per pixel, row-major) of output `i` at the latest sample time.
+    /// The binary frame (0/1 per pixel, row-major) of output `i` at the latest sample time; for
+    /// stacked and late configs the static part's frame above the dynamic part's (twice the
+    /// height).
     ///
     /// # Panics
     /// When `i >= self.len()`.
@@ -654,7 +671,7 @@ impl FeatureExtractor {
     /// When `i >= self.len()`.
     pub fn potentials(&self, i: usize) -> Option<&[f32]> {
         match self.outputs[i].kind {
-            Kind::Static(s) | Kind::Combined(s, _) => {
+            Kind::Static(s) | Kind::Combined(s, _) | Kind::Stacked(s, _) => {
                 let slot = &self.accs[self.splanes[s].acc];
                 (!slot.deferred).then(|| slot.acc.potentials())
             }
@@ -668,7 +685,7 @@ impl FeatureExtractor {
     /// When `i >= self.len()`.
     pub fn counts(&self, i: usize) -> Option<&[u32]> {
         match self.outputs[i].kind {
-            Kind::Dynamic(d) | Kind::Combined(_, d) => {
+            Kind::Dynamic(d) | Kind::Combined(_, d) | Kind::Stacked(_, d) => {
                 Some(self.windows[self.dplanes[d].window].window.counts())
             }
             Kind::Static(_) => None,
@@ -724,8 +741,8 @@ impl FeatureExtractor {
     }
 }
 
-/// Features of every config at every sample time: one `samples.len() x feature_len` row-major
-/// buffer per config. A convenience over [`FeatureExtractor::run`].
+/// Features of every config at every sample time: one `samples.len() x feature_len(i)`
+/// row-major buffer per config. A convenience over [`FeatureExtractor::run`].
 pub fn extract_features(
     configs: &[ReprConfig],
     frame: Resolution,
@@ -735,7 +752,7 @@ pub fn extract_features(
 ) -> Result<Vec<Vec<f32>>, ReprError> {
     let mut fx = FeatureExtractor::new(configs, frame, mask)?;
     let mut out: Vec<Vec<f32>> = (0..configs.len())
-        .map(|_| Vec::with_capacity(samples.len() * fx.feature_len()))
+        .map(|i| Vec::with_capacity(samples.len() * fx.feature_len(i)))
         .collect();
     fx.run(events, samples, |_, fx| {
         for (i, o) in out.iter_mut().enumerate() {
@@ -912,6 +929,25 @@ fn propagate(
                 out.pool
                     .set(p, splanes[s].bits[p] != 0 || dplanes[d].bits[p] != 0);
             }
+            // Either plane may have flipped; `set` leaves the other half as it is.
+            Kind::Stacked(s, d) => {
+                let below = out.pool.frame().len() / 2;
+                out.pool.set(p, splanes[s].bits[p] != 0);
+                out.pool.set(below + p, dplanes[d].bits[p] != 0);
+            }
         }
     }
+}
+
+/// The frame a stacked output pools: the crop twice as high (the static part above the
+/// dynamic part), so that 8x8 cells never straddle the two.
+fn stacked_frame(frame: Resolution) -> Result<Resolution, ReprError> {
+    let height = frame
+        .height
+        .checked_mul(2)
+        .ok_or(ReprError::FrameNotPoolable {
+            width: frame.width,
+            height: frame.height,
+        })?;
+    Ok(Resolution::new(frame.width, height))
 }

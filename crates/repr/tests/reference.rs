@@ -82,6 +82,23 @@ fn configs() -> Vec<ReprConfig> {
                 ..d
             },
         },
+        // Both parts side by side: the static plane is shared with a combined output above,
+        // which must then keep it per event rather than lazily.
+        ReprConfig::Stacked {
+            static_part: s,
+            dynamic_part: d,
+        },
+        ReprConfig::Late {
+            static_part: StaticConfig {
+                synchronous_decay: true,
+                threshold: 0.5,
+                ..s
+            },
+            dynamic_part: DynamicConfig {
+                count_threshold: 1,
+                ..d
+            },
+        },
     ]
 }
 
@@ -190,13 +207,24 @@ fn reference(configs: &[ReprConfig], mask: &Mask, events: &[Event], samples: &[i
                 }
                 dynamic_frame(d, &counts)
             });
-            let frame = match (static_bits, dynamic_bits) {
-                (Some(s), Some(d)) => or_frames(&s, &d),
-                (Some(s), None) => s,
-                (None, Some(d)) => d,
+            let (frame, features) = match (static_bits, dynamic_bits) {
+                // Stacked and late: each part pooled on its own, static first; the frame is
+                // the static one above the dynamic one.
+                (Some(s), Some(d)) if config.frames() == 2 => {
+                    let features = [pool8(RES, &s).unwrap(), pool8(RES, &d).unwrap()].concat();
+                    ([s, d].concat(), features)
+                }
+                (Some(s), Some(d)) => {
+                    let frame = or_frames(&s, &d);
+                    let features = pool8(RES, &frame).unwrap();
+                    (frame, features)
+                }
+                (Some(f), None) | (None, Some(f)) => {
+                    let features = pool8(RES, &f).unwrap();
+                    (f, features)
+                }
                 (None, None) => unreachable!(),
             };
-            let features = pool8(RES, &frame).unwrap();
             out[i].push((frame, features));
         }
         applied = end;

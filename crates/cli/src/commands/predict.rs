@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use evtac_learn::{INPUTS, ModelBundle};
+use evtac_learn::ModelBundle;
 use ndarray::{Array2, ArrayD};
 use ndarray_npy::ReadNpyError;
 
@@ -13,7 +13,8 @@ pub struct Args {
     /// Model bundle folder written by `evtac train` (model.safetensors, config.json, ...).
     #[arg(long)]
     pub model: PathBuf,
-    /// Features as an N x 900 float32 NPY (one pooled 30 x 30 representation per row).
+    /// Features as an N x 900 float32 NPY (one pooled 30 x 30 representation per row; N x 1800
+    /// for stacked and late models: the static frame's cells, then the dynamic frame's).
     #[arg(long)]
     pub features: PathBuf,
     /// Output NPY: N x 2 float32, pitch and roll in degrees.
@@ -27,7 +28,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let bundle = ModelBundle::load(&args.model)
         .with_context(|| format!("loading the model bundle {}", args.model.display()))?;
     let predictor = bundle.predictor()?;
-    let features = read_features(&args.features)?;
+    let features = read_features(&args.features, predictor.inputs())?;
     let predictions = predictor.predict(&features)?;
     let out = Array2::from_shape_vec(
         (predictions.len(), 2),
@@ -38,9 +39,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Reads an N x 900 float32 NPY into a flat row-major buffer, with errors naming the file and
-/// what its header says.
-fn read_features(path: &std::path::Path) -> anyhow::Result<Vec<f32>> {
+/// Reads an N x `inputs` float32 NPY into a flat row-major buffer, with errors naming the file
+/// and what its header says.
+fn read_features(path: &std::path::Path, inputs: usize) -> anyhow::Result<Vec<f32>> {
     let array: ArrayD<f32> = match ndarray_npy::read_npy(path) {
         Ok(a) => a,
         Err(ReadNpyError::WrongDescriptor(descr)) => bail!(
@@ -50,9 +51,9 @@ fn read_features(path: &std::path::Path) -> anyhow::Result<Vec<f32>> {
         Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
     };
     let shape = array.shape().to_vec();
-    if shape.len() != 2 || shape[1] != INPUTS {
+    if shape.len() != 2 || shape[1] != inputs {
         bail!(
-            "{}: features must have shape (N, {INPUTS}), the file has {shape:?}",
+            "{}: features must have shape (N, {inputs}), the file has {shape:?} (the model reads {inputs} features per sample)",
             path.display()
         );
     }

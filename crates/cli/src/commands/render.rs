@@ -104,7 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(window) = args.window_ms {
         dynamic_cfg.window_ms = window;
     }
-    let reprs = evtac_experiments::exp1::representations(
+    let reprs = evtac_experiments::exp1::paper_representations(
         ReprConfig::Static(static_cfg),
         ReprConfig::Dynamic(dynamic_cfg),
     );

@@ -1,4 +1,4 @@
-//! `evtac represent`: static, dynamic or combined binary frames, potentials or pooled features of
+//! `evtac represent`: static, dynamic, combined, stacked or late binary frames, potentials or pooled features of
 //! a recording at the sample times listed in a text file, written as NPY.
 //!
 //! Events are cropped to the ROI (default: the centered 240x240 crop of the paper) and fed once,
@@ -26,6 +26,11 @@ pub enum Repr {
     Dynamic,
     /// Pixel-wise OR of the static and dynamic binary frames.
     Combined,
+    /// The static and dynamic frames side by side (learned fusion's input): frames N x 2H x W,
+    /// static above dynamic; features 2 x 900 per sample, static's first.
+    Stacked,
+    /// The same features as `stacked` (late fusion's network reads them differently).
+    Late,
 }
 
 /// What to write.
@@ -33,9 +38,10 @@ pub enum Repr {
 pub enum What {
     /// Binary frames: uint8 N x H x W, 0 or 1.
     Frames,
-    /// 8x8 mean-pooled features: float32 N x (H/8 * W/8), 900 for 240x240.
+    /// 8x8 mean-pooled features: float32 N x (H/8 * W/8), 900 for 240x240 (1800 for stacked and
+    /// late).
     Features,
-    /// The static accumulator's potentials: float32 N x H x W (static and combined only).
+    /// The static accumulator's potentials: float32 N x H x W (every kind with a static part).
     Potential,
 }
 
@@ -197,6 +203,14 @@ impl Args {
                 static_part: self.static_config(),
                 dynamic_part: self.dynamic_config(),
             },
+            Repr::Stacked => ReprConfig::Stacked {
+                static_part: self.static_config(),
+                dynamic_part: self.dynamic_config(),
+            },
+            Repr::Late => ReprConfig::Late {
+                static_part: self.static_config(),
+                dynamic_part: self.dynamic_config(),
+            },
         }
     }
 }
@@ -206,7 +220,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let config = args.config();
     config.validate()?;
     if args.what == What::Potential && config.static_part().is_none() {
-        bail!("--what potential needs --repr static or combined (dynamic has no potential)");
+        bail!("--what potential needs a static part: --repr static, combined, stacked or late");
     }
     let samples = read_samples(&args.samples)?;
 
@@ -228,9 +242,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         usize::from(frame.height),
         usize::from(frame.width),
     );
+    // Stacked and late frames are the static frame above the dynamic one.
+    let frame_h = h * config.frames();
     let per_sample = match args.what {
-        What::Features => fx.feature_len(),
-        What::Frames | What::Potential => h * w,
+        What::Features => fx.feature_len(0),
+        What::Frames => frame_h * w,
+        What::Potential => h * w,
     };
     let mut bytes = Vec::new();
     let mut floats = Vec::new();
@@ -259,7 +276,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
     let out = &args.output;
     let written = match args.what {
-        What::Frames => ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, h, w), bytes)?),
+        What::Frames => {
+            ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, frame_h, w), bytes)?)
+        }
         What::Potential => ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?),
         What::Features => {
             ndarray_npy::write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)

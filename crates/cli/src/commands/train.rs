@@ -21,12 +21,19 @@ pub enum ReprKind {
     Dynamic,
     /// Pixel-wise OR of the static and dynamic frames.
     Combined,
+    /// Both frames pooled side by side (1800 features) into one dense network (learned
+    /// fusion).
+    Stacked,
+    /// Both frames pooled side by side into a network with one 900-128 branch per frame,
+    /// concatenated before the head (learned late fusion).
+    Late,
 }
 
 /// Representation settings shared by `train` and `tune`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReprArgs {
-    /// Representation: static, dynamic or combined.
+    /// Representation: static, dynamic, combined (the paper's three), stacked or late (learned
+    /// fusions of the static and dynamic frames).
     #[arg(long, value_enum)]
     pub repr: ReprKind,
     /// Static decay constant tau in ms (the default is the paper's choice).
@@ -71,6 +78,14 @@ impl ReprArgs {
             ReprKind::Static => ReprConfig::Static(s),
             ReprKind::Dynamic => ReprConfig::Dynamic(d),
             ReprKind::Combined => ReprConfig::Combined {
+                static_part: s,
+                dynamic_part: d,
+            },
+            ReprKind::Stacked => ReprConfig::Stacked {
+                static_part: s,
+                dynamic_part: d,
+            },
+            ReprKind::Late => ReprConfig::Late {
                 static_part: s,
                 dynamic_part: d,
             },

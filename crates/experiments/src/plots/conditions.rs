@@ -43,7 +43,7 @@ where
         false,
     );
     let mut chart = xy_chart(area, (xr, yr), caption, (desc, "test MAE (deg)"), path)?;
-    for name in ["Static", "Dynamic", "Combined"] {
+    for name in crate::exp1::NAMES {
         let color = repr_color(name);
         let mut pts: Vec<&Marker> = markers.iter().filter(|p| p.name == name).collect();
         pts.sort_by(|a, b| a.x.total_cmp(&b.x));

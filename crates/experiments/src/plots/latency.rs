@@ -16,9 +16,10 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// diamond, on a log time axis, with the interval itself (dashed) and the paper's 10 ms bound.
 pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
     let e = draw_err(path);
-    let root = canvas(path, (1500, 520), !cells.is_empty())?;
-    let names = ["Static", "Dynamic", "Combined"];
-    let areas = root.split_evenly((1, 3));
+    let names = crate::exp1::in_order(cells.iter().map(|c| c.name.as_str()));
+    let width = 500 * names.len().max(1) as u32;
+    let root = canvas(path, (width, 520), !cells.is_empty())?;
+    let areas = root.split_evenly((1, names.len().max(1)));
     let mut intervals: Vec<u32> = cells.iter().map(|c| c.interval_ms).collect();
     intervals.sort_unstable();
     intervals.dedup();

@@ -6,9 +6,14 @@ use crate::results::Exp2Cell;
 /// Motion- and stop-phase MAE (mean ± std over seeds) per representation and training setting.
 pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) -> Result<(), Error> {
     let e = draw_err(path);
-    let root = canvas(path, (1300, 520), !cells.is_empty())?;
+    let names = crate::exp1::in_order(cells.iter().map(|c| c.name.as_str()));
+    let root = canvas(
+        path,
+        (400 + 300 * names.len() as u32, 520),
+        !cells.is_empty(),
+    )?;
     let halves = root.split_evenly((1, 2));
-    let names = ["Static", "Dynamic", "Combined"];
+    let slots = names.len().max(1) as f64;
     for (pi, (area, phase)) in halves
         .iter()
         .zip(["Motion phase", "Stop phase"])
@@ -31,15 +36,15 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(65)
-            .build_cartesian_2d(0.0f64..3.0, 0.0..top.max(1e-3))
+            .build_cartesian_2d(0.0f64..slots, 0.0..top.max(1e-3))
             .map_err(&e)?;
         chart
             .configure_mesh()
             .disable_x_mesh()
-            .x_labels(7)
+            .x_labels(2 * names.len() + 1)
             .x_label_formatter(&|x| {
                 let i = (x - 0.5).round();
-                if (x - 0.5 - i).abs() < 1e-6 && (0.0..3.0).contains(&i) {
+                if (x - 0.5 - i).abs() < 1e-6 && (0.0..slots).contains(&i) {
                     names[i as usize].to_string()
                 } else {
                     String::new()

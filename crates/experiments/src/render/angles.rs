@@ -44,7 +44,8 @@ impl Angles {
         let config = model.repr_config();
         let mut fx = FeatureExtractor::new_with_masks(&[config], CROP, &[model.mask()])?;
         let mut estimates = Vec::with_capacity(t_us.len());
-        let mut batch: Vec<f32> = Vec::with_capacity(BATCH * evtac_learn::INPUTS);
+        let width = model.predictor.inputs();
+        let mut batch: Vec<f32> = Vec::with_capacity(BATCH * width);
         let mut failed = None;
         let mut flush = |batch: &mut Vec<f32>, estimates: &mut Vec<[f32; 2]>| {
             match model.predict(batch) {
@@ -60,7 +61,7 @@ impl Angles {
         };
         fx.run(events, &t_us, |_, fx| {
             batch.extend_from_slice(fx.features(0));
-            if batch.len() == BATCH * evtac_learn::INPUTS {
+            if batch.len() == BATCH * width {
                 flush(&mut batch, &mut estimates);
             }
         })?;
@@ -101,13 +102,14 @@ impl Angles {
     }
 }
 
-/// The name of `config`'s kind, as [`crate::exp1::representations`] names the three.
+/// The name of `config`'s kind, as [`crate::exp1::representations`] names them
+/// ([`crate::exp1::NAMES`]: `Static` for the kind `static`, ...).
 pub fn repr_name(config: &ReprConfig) -> &'static str {
-    match config {
-        ReprConfig::Static(_) => "Static",
-        ReprConfig::Dynamic(_) => "Dynamic",
-        ReprConfig::Combined { .. } => "Combined",
-    }
+    let kind = config.kind_name();
+    crate::exp1::NAMES
+        .into_iter()
+        .find(|name| name.eq_ignore_ascii_case(kind))
+        .unwrap_or(kind)
 }
 
 /// The estimate times of `timing`: each frame interval divided into the fewest equal steps of

@@ -17,12 +17,28 @@ use std::path::Path;
 /// The simulated sensor (DVXplorer).
 pub const SENSOR: Resolution = Resolution::new(640, 480);
 
-/// The three representations with the paper's settings.
-pub fn representations() -> [(&'static str, ReprConfig); 3] {
+/// The paper's three representations with its settings, then the two learned fusions of the
+/// same parts (stacked, late: 1800 features, their own networks).
+pub fn representations() -> [(&'static str, ReprConfig); 5] {
+    let (static_part, dynamic_part) = (StaticConfig::default(), DynamicConfig::default());
     [
-        ("static", ReprConfig::Static(StaticConfig::default())),
-        ("dynamic", ReprConfig::Dynamic(DynamicConfig::default())),
+        ("static", ReprConfig::Static(static_part)),
+        ("dynamic", ReprConfig::Dynamic(dynamic_part)),
         ("combined", ReprConfig::default()),
+        (
+            "stacked",
+            ReprConfig::Stacked {
+                static_part,
+                dynamic_part,
+            },
+        ),
+        (
+            "late",
+            ReprConfig::Late {
+                static_part,
+                dynamic_part,
+            },
+        ),
     ]
 }
 

@@ -190,11 +190,14 @@ def write(
 
 
 class Representation:
-    """A static, dynamic or combined representation, as ``evtac represent`` builds it.
+    """A static, dynamic, combined, stacked or late representation, as ``evtac represent`` builds
+    it.
 
     ``kind`` is ``"static"`` (exponential-decay accumulator, masked and thresholded),
-    ``"dynamic"`` (sliding-window event count, thresholded) or ``"combined"`` (their pixel-wise
-    OR). ``settings`` are the CLI's, with its defaults: static ``decay`` (``"exponential"``,
+    ``"dynamic"`` (sliding-window event count, thresholded), ``"combined"`` (their pixel-wise
+    OR), or one of evtac's learned fusions, ``"stacked"`` and ``"late"``: both frames pooled
+    side by side (1800 features, the static frame's first), for a network that learns how to
+    fuse them (a dense one, or one branch per frame). ``settings`` are the CLI's, with its defaults: static ``decay`` (``"exponential"``,
     ``"linear"``, ``"none"``), ``tau_ms`` (1000), ``eta`` (0.15), ``threshold`` (2),
     ``threshold_space`` (``"potential"``, ``"u8"``), ``comparison`` (``"gt"``, ``"ge"``),
     ``min_potential`` (0), ``max_potential`` (1), ``neutral_potential`` (0), ``polarity``
@@ -245,11 +248,13 @@ class Representation:
         return self
 
     def features(self, events: Any, times_us: Any) -> np.ndarray:
-        """Pooled features at each sample time: float32 ``(N, 900)`` on a 240x240 crop."""
+        """Pooled features at each sample time: float32 ``(N, 900)`` on a 240x240 crop
+        (``(N, 1800)`` for stacked and late)."""
         return self._inner.features(_event_bytes(events), _times(times_us))
 
     def frames(self, events: Any, times_us: Any) -> np.ndarray:
-        """Binary frames at each sample time: uint8 ``(N, height, width)``, 0 or 1."""
+        """Binary frames at each sample time: uint8 ``(N, height, width)``, 0 or 1 (stacked and
+        late: ``(N, 2 * height, width)``, the static frame above the dynamic one)."""
         return self._inner.frames(_event_bytes(events), _times(times_us))
 
     def potentials(self, events: Any, times_us: Any) -> np.ndarray:
@@ -274,7 +279,7 @@ class Representation:
 
     @property
     def kind(self) -> str:
-        """``"static"``, ``"dynamic"`` or ``"combined"``."""
+        """``"static"``, ``"dynamic"``, ``"combined"``, ``"stacked"`` or ``"late"``."""
         return self._inner.kind
 
     @property
