@@ -111,7 +111,8 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         "- Experiment 1: Stacked (",
         "- Experiment 1: Late (",
         "against the best single representation, ",
-        "- Experiment 2 (",
+        "- Experiment 2, ",
+        "**In short:** at scale `tiny`, ",
     ] {
         assert!(report.contains(line), "no `{line}` in:\n{report}");
     }

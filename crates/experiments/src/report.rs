@@ -307,7 +307,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let s = ours.map(|e| e.test).unwrap_or_default();
         let theirs = match PAPER_TABLE.iter().find(|p| p.0 == name) {
             Some(&(_, po, pp, pr)) => format!("{} | {} | {}", paper(po), paper(pp), paper(pr)),
-            None => "not in the paper | | ".to_string(),
+            None => "not in the paper | - | -".to_string(),
         };
         let _ = writeln!(
             md,

@@ -97,6 +97,22 @@ impl Architecture {
         }
     }
 
+    /// The first layer's (units, inputs) blocks: which units read which inputs, every weight
+    /// outside them zero (one block for the MLPs; late fusion's two branches).
+    pub fn first_layer_blocks(self) -> &'static [(Range<usize>, Range<usize>)] {
+        const MLP: [(Range<usize>, Range<usize>); 1] = [(0..HIDDEN[0], 0..INPUTS)];
+        const STACKED: [(Range<usize>, Range<usize>); 1] = [(0..HIDDEN[0], 0..MAX_INPUTS)];
+        const LATE: [(Range<usize>, Range<usize>); 2] = [
+            (0..BRANCH, 0..INPUTS),
+            (BRANCH..HIDDEN[0], INPUTS..MAX_INPUTS),
+        ];
+        match self {
+            Self::Mlp => &MLP,
+            Self::Stacked => &STACKED,
+            Self::Late => &LATE,
+        }
+    }
+
     /// Whether first-layer weight (`unit`, `input`) is part of the network (late fusion's
     /// cross-branch weights are not: they are zero and stay zero).
     #[inline]
@@ -169,6 +185,11 @@ mod tests {
                     late.connects(unit, input),
                     late.first_layer_inputs(unit).contains(&input)
                 );
+                let block = late
+                    .first_layer_blocks()
+                    .iter()
+                    .any(|(units, inputs)| units.contains(&unit) && inputs.contains(&input));
+                assert_eq!(block, late.connects(unit, input));
                 assert!(Architecture::Stacked.connects(unit, input));
             }
         }

@@ -212,16 +212,27 @@ pub(crate) fn step(
 
     // Forward.
     let [h1, h2, h3, out] = &mut scratch.h;
+    // Each block of the first layer from its inputs only (late fusion: a branch per frame).
+    let blocks = net.architecture.first_layer_blocks();
     if scratch.index.len() as f64 > GROUPED_DENSITY * x.len() as f64 {
         for (x, h) in x.chunks(GROUP * inputs).zip(h1.chunks_mut(GROUP * H1)) {
             let rows = x.len() / inputs;
-            panels::grouped_forward(&l0.weights, &l0.bias, x, rows, h, true);
+            for block in blocks {
+                panels::grouped_forward(&l0.weights, &l0.bias, (x, rows), h, block.clone(), true);
+            }
         }
     } else {
         for (s, h) in h1.chunks_exact_mut(H1).enumerate() {
             let nz = scratch.row_start[s]..scratch.row_start[s + 1];
             let (index, value) = (&scratch.index[nz.clone()], &scratch.value[nz]);
-            panels::sparse_forward(&l0.weights, &l0.bias, inputs, index, value, h, true);
+            for (units, block_inputs) in blocks {
+                // The sample's entries in the block's inputs (`index` is ascending).
+                let from = index.partition_point(|&i| usize::from(i) < block_inputs.start);
+                let to = index.partition_point(|&i| usize::from(i) < block_inputs.end);
+                let entries = (&index[from..to], &value[from..to]);
+                let (w, b) = (&l0.weights, &l0.bias);
+                panels::sparse_forward(w, b, inputs, entries, h, units.clone(), true);
+            }
         }
     }
     for s in 0..n {
@@ -341,8 +352,9 @@ struct FirstLayer {
 /// were tried: no change).
 ///
 /// Late fusion's cross-branch rows (a block of one branch's units and an input of the other
-/// frame) get no gradient: their weights are zero, and AdamW with a zero gradient and zero
-/// moments keeps them exactly zero (decay of 0 is 0, the moments stay 0, the step is `0 / eps`).
+/// frame) are skipped: they get no gradient, and AdamW with a zero gradient and zero moments
+/// would keep their zero weights exactly zero anyway (decay of 0 is 0, the moments stay 0, the
+/// step is `0 / eps`), so skipping them changes no bit and halves late fusion's update.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 fn first_layer_rows(
     s: &StepScalars,
@@ -362,13 +374,12 @@ fn first_layer_rows(
     for (c, ((p, m), v)) in rows.enumerate() {
         let (b, i) = (c / fan_in, c % fan_in);
         let mut g = [0.0_f32; BLOCK];
-        // A block's units are all in one branch (`BRANCH` is a multiple of `BLOCK`).
-        let columns_of_row = if layer.architecture.connects(b * BLOCK, i) {
-            columns.start[i]..columns.start[i + 1]
-        } else {
-            0..0
-        };
-        for k in columns_of_row {
+        // A block's units are all in one branch (`BRANCH` is a multiple of `BLOCK`). A
+        // cross-branch row is zero with zero moments: AdamW would leave it so, skip it.
+        if !layer.architecture.connects(b * BLOCK, i) {
+            continue;
+        }
+        for k in columns.start[i]..columns.start[i + 1] {
             let (sample, xi) = (usize::from(columns.sample[k]), columns.value[k]);
             let d = &d1[sample * H1 + b * BLOCK..][..BLOCK];
             for (g, &dd) in g.iter_mut().zip(d) {

@@ -13,6 +13,8 @@
 //! trained or evaluated on one x86-64 machine is the same bytes as on any other (a cluster's
 //! nodes need not match).
 
+use std::ops::Range;
+
 use crate::model::{LAYER_SIZES, LAYERS, OUTPUTS};
 
 /// Width of the first hidden layer.
@@ -143,25 +145,30 @@ pub(crate) fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut 
 
 /// [`dense_forward`] of a paneled layer on an input given as its non-zero entries (`index`
 /// ascending, `value`): the same products in the same order, so the same bits, without
-/// visiting the zeros.
+/// visiting the zeros. Only the outputs `units` (whole blocks) are computed, from the entries
+/// given (late fusion passes each branch's units with its frame's entries; see
+/// [`crate::architecture`]).
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 pub(crate) fn sparse_forward(
     weights: &[f32],
     bias: &[f32],
     fan_in: usize,
-    index: &[u16],
-    value: &[f32],
+    (index, value): (&[u16], &[f32]),
     out: &mut [f32],
+    units: Range<usize>,
     relu: bool,
 ) {
-    debug_assert!(out.len().is_multiple_of(BLOCK));
-    out.copy_from_slice(bias);
-    for (out, panel) in out
-        .chunks_exact_mut(BLOCK)
-        .zip(weights.chunks_exact(fan_in * BLOCK))
+    debug_assert!(out.len().is_multiple_of(BLOCK) && units.start.is_multiple_of(BLOCK));
+    let panels = weights
+        .chunks_exact(fan_in * BLOCK)
+        .skip(units.start / BLOCK);
+    let outs = out[units.clone()].chunks_exact_mut(BLOCK);
+    for ((out, panel), bias) in outs
+        .zip(panels)
+        .zip(bias[units.clone()].chunks_exact(BLOCK))
     {
         let mut acc = [0.0_f32; BLOCK];
-        acc.copy_from_slice(out);
+        acc.copy_from_slice(bias);
         for (&i, &xi) in index.iter().zip(value) {
             let row = &panel[usize::from(i) * BLOCK..][..BLOCK];
             for (a, &w) in acc.iter_mut().zip(row) {
@@ -171,7 +178,7 @@ pub(crate) fn sparse_forward(
         out.copy_from_slice(&acc);
     }
     if relu {
-        for o in out.iter_mut() {
+        for o in out[units].iter_mut() {
             *o = o.max(0.0);
         }
     }
@@ -185,23 +192,30 @@ pub(crate) const GROUP: usize = 4;
 /// which is what bounds the first layer when most inputs are non-zero. Rows that every sample
 /// of the group has at zero are skipped; a zero of one sample where another is not adds
 /// `0 * w`, a zero. Fused multiply-adds, correctly rounded on every target (`f32::mul_add`).
+/// Only the outputs `units` (whole blocks) are computed, from the inputs `inputs` (late
+/// fusion's branches: see [`crate::architecture`]).
 #[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
 pub(crate) fn grouped_forward(
     weights: &[f32],
     bias: &[f32],
-    x: &[f32],
-    rows: usize,
+    (x, rows): (&[f32], usize),
     out: &mut [f32],
+    (units, inputs): (Range<usize>, Range<usize>),
     relu: bool,
 ) {
     let fan_out = bias.len();
     let fan_in = x.len() / rows;
+    let blocks = units.start / BLOCK..units.end / BLOCK;
     for (b, panel) in weights.chunks_exact(fan_in * BLOCK).enumerate() {
+        if !blocks.contains(&b) {
+            continue;
+        }
         let mut acc = [[0.0_f32; BLOCK]; GROUP];
         for a in acc.iter_mut() {
             a.copy_from_slice(&bias[b * BLOCK..][..BLOCK]);
         }
-        for (i, row) in panel.chunks_exact(BLOCK).enumerate() {
+        let panel_rows = panel.chunks_exact(BLOCK).enumerate();
+        for (i, row) in panel_rows.skip(inputs.start).take(inputs.len()) {
             let mut xs = [0.0_f32; GROUP];
             for (k, v) in xs.iter_mut().enumerate().take(rows) {
                 *v = x[k * fan_in + i];
@@ -220,8 +234,10 @@ pub(crate) fn grouped_forward(
         }
     }
     if relu {
-        for o in out[..rows * fan_out].iter_mut() {
-            *o = o.max(0.0);
+        for sample in out[..rows * fan_out].chunks_exact_mut(fan_out) {
+            for o in sample[units.clone()].iter_mut() {
+                *o = o.max(0.0);
+            }
         }
     }
 }
@@ -349,9 +365,9 @@ mod tests {
             &layer.weights,
             &layer.bias,
             fan_in,
-            &[0, 2, 4],
-            &[0.5, -1.25, 2.0],
+            (&[0, 2, 4], &[0.5, -1.25, 2.0]),
             &mut sparse,
+            0..fan_out,
             false,
         );
         assert_eq!(out, sparse);
@@ -359,7 +375,14 @@ mod tests {
         let second = [0.0, 1.0, 0.0, 0.0, -0.5];
         let mut grouped = vec![0.0; 2 * fan_out];
         let rows = [x, second].concat();
-        grouped_forward(&layer.weights, &layer.bias, &rows, 2, &mut grouped, false);
+        grouped_forward(
+            &layer.weights,
+            &layer.bias,
+            (&rows, 2),
+            &mut grouped,
+            (0..fan_out, 0..fan_in),
+            false,
+        );
         for (k, xs) in [x, second].iter().enumerate() {
             let mut want = vec![0.0; fan_out];
             layer.forward(xs, &mut want, false);

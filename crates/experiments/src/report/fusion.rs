@@ -12,6 +12,11 @@ use crate::exp1::FUSIONS;
 use crate::exp2::SETTINGS;
 use crate::results::{MeanStd, Results};
 
+/// Whether `fusion` beats `reference` (test MAE, lower is better) beyond the seeds' spread.
+fn beats(fusion: &MeanStd, reference: &MeanStd) -> bool {
+    reference.mean - fusion.mean > fusion.std.hypot(reference.std)
+}
+
 /// How `fusion` compares with `reference` (test MAE, lower is better).
 fn compare(fusion: &MeanStd, reference: &MeanStd) -> String {
     let diff = fusion.mean - reference.mean;
@@ -38,8 +43,9 @@ fn best_single<'a>(cells: &[(&'a str, MeanStd)]) -> Option<(&'a str, MeanStd)> {
         .copied()
 }
 
-/// One line per fusion against the best single representation among `cells`.
-fn against_best(md: &mut String, where_: &str, cells: &[(&str, MeanStd)]) {
+/// One line per fusion against the best single representation among `cells`; the wins
+/// (`where_`, fusion, by how many degrees) are added to `wins`.
+fn against_best(md: &mut String, where_: &str, cells: &[(&str, MeanStd)], wins: &mut Vec<String>) {
     let Some((best, best_stats)) = best_single(cells) else {
         return;
     };
@@ -47,6 +53,12 @@ fn against_best(md: &mut String, where_: &str, cells: &[(&str, MeanStd)]) {
         let Some((_, f)) = cells.iter().find(|(n, _)| *n == fusion) else {
             continue;
         };
+        if beats(f, &best_stats) {
+            wins.push(format!(
+                "{fusion} at {where_} (by {:.3} deg)",
+                best_stats.mean - f.mean
+            ));
+        }
         let _ = writeln!(
             md,
             "- {where_}: {fusion} ({}) against the best single representation, {best} ({}): \
@@ -74,12 +86,14 @@ pub(super) fn section(md: &mut String, r: &Results) {
          beyond the seeds' spread.\n",
         r.run.scale
     );
+    let mut lines = String::new();
+    let mut wins = Vec::new();
     let exp1: Vec<(&str, MeanStd)> = r
         .exp1
         .iter()
         .map(|e| (e.name.as_str(), e.test.overall))
         .collect();
-    against_best(md, "Experiment 1", &exp1);
+    against_best(&mut lines, "Experiment 1", &exp1, &mut wins);
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
@@ -90,7 +104,7 @@ pub(super) fn section(md: &mut String, r: &Results) {
             .filter(|p| p.level == level)
             .map(|p| (p.name.as_str(), p.test.overall))
             .collect();
-        against_best(md, &format!("Noise x{level}"), &cells);
+        against_best(&mut lines, &format!("noise x{level}"), &cells, &mut wins);
     }
     // Experiment 2 under the pause-inclusive setting: static's stop, dynamic's motion.
     let (key, label) = SETTINGS[SETTINGS.len() - 1];
@@ -99,8 +113,8 @@ pub(super) fn section(md: &mut String, r: &Results) {
         for fusion in FUSIONS {
             let Some(f) = cell(fusion) else { continue };
             let _ = writeln!(
-                md,
-                "- Experiment 2 ({label}): {fusion}'s stop phase ({}) against static's ({}): \
+                lines,
+                "- Experiment 2, {label}: {fusion}'s stop phase ({}) against static's ({}): \
                  {}; its motion phase ({}) against dynamic's ({}): {}.",
                 f.stop.overall.display(),
                 st.stop.overall.display(),
@@ -111,6 +125,22 @@ pub(super) fn section(md: &mut String, r: &Results) {
             );
         }
     }
+    let verdict = if wins.is_empty() {
+        format!(
+            "**In short:** at scale `{}`, no learned fusion beats the best single \
+             representation beyond the seeds' spread, at any noise level measured.",
+            r.run.scale
+        )
+    } else {
+        format!(
+            "**In short:** at scale `{}`, learned fusion beats the best single representation \
+             beyond the seeds' spread for {}; everywhere else it does not.",
+            r.run.scale,
+            wins.join(", ")
+        )
+    };
+    let _ = writeln!(md, "{verdict}\n");
+    md.push_str(&lines);
     let _ = writeln!(
         md,
         "\nOn evtac's simulator, so a statement about the method on simulated data; the latency \
@@ -140,8 +170,9 @@ mod tests {
             ("Late", ms(0.05, 0.0)),
         ];
         assert_eq!(best_single(&cells).map(|b| b.0), Some("Dynamic"));
-        let mut md = String::new();
-        against_best(&mut md, "Experiment 1", &cells);
+        let (mut md, mut wins) = (String::new(), Vec::new());
+        against_best(&mut md, "Experiment 1", &cells, &mut wins);
+        assert_eq!(wins, ["Late at Experiment 1 (by 0.050 deg)"]);
         assert!(
             md.contains("Late (0.050 ± 0.000) against the best single representation, Dynamic"),
             "{md}"
