@@ -253,7 +253,9 @@ impl<'a> FeatureCache<'a> {
         trials
             .par_iter()
             .try_for_each(|meta| -> Result<(), Error> {
+                // Configs that share a folder (stacked and late: the same features) once.
                 let missing: Vec<usize> = (0..configs.len())
+                    .filter(|&i| !dirs[..i].contains(&dirs[i]))
                     .filter(|&i| !dirs[i].join(format!("{}.npy", meta.trial)).is_file())
                     .collect();
                 reused.fetch_add(configs.len() - missing.len(), Ordering::Relaxed);

@@ -54,3 +54,46 @@ fn second_run_computes_no_features_and_loads_the_same() {
         "{l0:?} {l49:?}"
     );
 }
+
+/// Stacked and late share one folder of 1800-feature rows (computed once per trial), whose
+/// halves are the static and dynamic configs' own features.
+#[test]
+fn stacked_and_late_share_features_that_are_static_then_dynamic() {
+    use evtac_repr::ReprConfig;
+    let dir = tempfile::tempdir().unwrap();
+    simulate(dir.path(), Protocol::Exp1, 2);
+    let ds = Dataset::open(dir.path(), Inputs::FROM_FILES).unwrap();
+    let cache = FeatureCache::new(&ds).unwrap();
+    let trials: Vec<_> = ds.manifest.trials.iter().collect();
+    let (st, dy) = (
+        plan::static_config(1000.0, 2.0),
+        plan::dynamic_config(640.0, 0),
+    );
+    let (static_part, dynamic_part) = (*st.static_part().unwrap(), *dy.dynamic_part().unwrap());
+    let stacked = ReprConfig::Stacked {
+        static_part,
+        dynamic_part,
+    };
+    let late = ReprConfig::Late {
+        static_part,
+        dynamic_part,
+    };
+    let stats = cache
+        .ensure(&trials, &[stacked, late], Sampling::MOTION, &|| {})
+        .unwrap();
+    assert_eq!(stats.computed, 2, "one computation per trial for both");
+    let load = |c: &ReprConfig| {
+        cache
+            .load(&trials, c, Sampling::MOTION, &[Phase::Motion])
+            .unwrap()
+    };
+    let (both, s, d) = (load(&late), load(&st), load(&dy));
+    assert_eq!(both.set.width, 1800);
+    assert_eq!(both.set.features, load(&stacked).set.features);
+    assert_eq!(both.samples.len(), 2 * 50);
+    for k in 0..both.samples.len() {
+        assert_eq!(&both.set.row(k)[..900], s.set.row(k));
+        assert_eq!(&both.set.row(k)[900..], d.set.row(k));
+    }
+    assert_eq!(both.set.labels, s.set.labels);
+}

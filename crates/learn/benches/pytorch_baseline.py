@@ -5,7 +5,11 @@ wd 1e-4, betas 0.9/0.999, eps 1e-8), batch 32 and data shape (35,000 x 900, a qu
 features non-zero) as the Rust benches. Prints the epoch time and single-sample latency
 (median, P99, P99.9). Needs `torch` (CPU) in the venv; not used by tests.
 
-Usage: python pytorch_baseline.py [--epochs 2] [--threads 2]
+`--network stacked` and `--network late` train evtac's learned fusions on 35,000 x 1800 samples
+instead (a dense 1800-256-128-64-2 MLP, or two 900-128 branches concatenated before the
+256-128-64-2 head, as `evtac.torch.LateFusion`), for `epoch_35000x1800` in benches/training.rs.
+
+Usage: python pytorch_baseline.py [--epochs 2] [--threads 2] [--network mlp|stacked|late]
 """
 
 import argparse
@@ -15,6 +19,24 @@ import numpy as np
 import torch
 
 
+class LateFusion(torch.nn.Module):
+    """Two 900-128 branches (static frame, dynamic frame), concatenated, then the head."""
+
+    def __init__(self):
+        super().__init__()
+        self.static_branch = torch.nn.Linear(900, 128)
+        self.dynamic_branch = torch.nn.Linear(900, 128)
+        self.head = torch.nn.Sequential(
+            torch.nn.Linear(256, 128), torch.nn.ReLU(),
+            torch.nn.Linear(128, 64), torch.nn.ReLU(),
+            torch.nn.Linear(64, 2))
+
+    def forward(self, x):
+        s = torch.relu(self.static_branch(x[:, :900]))
+        d = torch.relu(self.dynamic_branch(x[:, 900:]))
+        return self.head(torch.cat([s, d], dim=1))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--epochs", type=int, default=2)
@@ -22,19 +44,21 @@ def main():
     parser.add_argument("--samples", type=int, default=35_000)
     parser.add_argument("--density", type=float, default=0.138,
                         help="fraction of non-zero features (its speed does not depend on it)")
+    parser.add_argument("--network", choices=["mlp", "stacked", "late"], default="mlp")
     args = parser.parse_args()
+    width = 900 if args.network == "mlp" else 1800
     torch.set_num_threads(args.threads)
     torch.set_flush_denormal(True)
     torch.manual_seed(0)
     rng = np.random.default_rng(1)
     n = args.samples
-    x = rng.random((n, 900), dtype=np.float32)
-    x[rng.random((n, 900)) >= args.density] = 0.0
+    x = rng.random((n, width), dtype=np.float32)
+    x[rng.random((n, width)) >= args.density] = 0.0
     y = rng.uniform(-20, 20, (n, 2)).astype(np.float32)
     x, y = torch.from_numpy(x), torch.from_numpy(y)
 
-    model = torch.nn.Sequential(
-        torch.nn.Linear(900, 256), torch.nn.ReLU(),
+    model = LateFusion() if args.network == "late" else torch.nn.Sequential(
+        torch.nn.Linear(width, 256), torch.nn.ReLU(),
         torch.nn.Linear(256, 128), torch.nn.ReLU(),
         torch.nn.Linear(128, 64), torch.nn.ReLU(),
         torch.nn.Linear(64, 2))
@@ -50,7 +74,7 @@ def main():
             loss = loss_fn(model(x[idx]), y[idx])
             loss.backward()
             opt.step()
-        print(f"pytorch epoch {epoch + 1} ({n} x 900, {args.threads} threads): "
+        print(f"pytorch {args.network} epoch {epoch + 1} ({n} x {width}, {args.threads} threads): "
               f"{time.perf_counter() - start:.2f} s")
 
     model.eval()
