@@ -638,7 +638,7 @@ impl<R: Read + Seek> AedatReader<R> {
     /// few seconds of a multi-gigabyte recording touches a few megabytes, and memory holds the
     /// table's entries for the range only. The table (about 60 bytes a packet decompressed) is
     /// decompressed block by block in passes over it, as the end-of-read check reads it
-    /// ([`table_check::plan`]), never whole; a table that check cannot vouch for is read whole
+    /// (`table_check::plan`), never whole; a table that check cannot vouch for is read whole
     /// as before, so that a damaged one gets the same reason. Without one, or when the table is
     /// unusable, the reader scans the file
     /// from its first packet; the returned [`RangeIndex`] says which happened and why, so that
