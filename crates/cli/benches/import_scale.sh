@@ -13,6 +13,8 @@
 # Without SESSION_DIRs it simulates Experiment 1 sessions of 16 trials (tiny, about 1.7
 # minutes) and 125 trials (small, about 16 minutes) into WORK_DIR. A SESSION_DIR is what
 # `evtac simulate --session` writes. EVTAC=path/to/evtac runs that binary instead of building.
+# MODES="trigger imu log-free" picks the imports (default: trigger log-free); `imu` reads the
+# IMU in passes for `--sync imu`, which should not grow with the session either.
 set -euo pipefail
 
 work=${1:-target/import-scale}
@@ -43,8 +45,8 @@ for session in "${sessions[@]}"; do
         rm -rf "$out"
         args=(import "$session/session.aedat4" --out "$out"
             --calibration "$session/calibration.json")
-        if [ "$mode" = trigger ]; then
-            args+=(--log "$session/robot_log.csv" --sync trigger)
+        if [ "$mode" = trigger ] || [ "$mode" = imu ]; then
+            args+=(--log "$session/robot_log.csv" --sync "$mode")
         else
             args+=(--depth-mm 2)
         fi

@@ -410,6 +410,15 @@ impl EventReader {
         }
     }
 
+    /// Hands out only the IMU samples from now on, where the format lets the reader pass the
+    /// rest undecoded, as [`Self::triggers_only`] does the triggers (a pass over a long
+    /// session's IMU then costs a read of the file).
+    pub fn imu_only(&mut self) {
+        if let Inner::Aedat(r) = &mut self.inner {
+            r.imu_only();
+        }
+    }
+
     /// The next chunk; `Ok(None)` at the end of the file (or, after
     /// [`select_range`](Self::select_range), of the range).
     pub fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {

@@ -689,3 +689,28 @@ fn streamed_table_check_rejects_what_the_whole_check_rejects_with_its_errors() {
         );
     }
 }
+
+/// A pass for the IMU only (`evtac import --sync imu`) hands out every IMU sample and nothing
+/// else, every compression, from a file and through `evtac_events::open`.
+#[test]
+fn an_imu_only_read_hands_out_the_imu_and_nothing_else() {
+    let res = Resolution::new(640, 480);
+    let (events, imu) = synthetic(20_000, res, 7);
+    let dir = tempfile::tempdir().unwrap();
+    for c in ALL {
+        let path = dir.path().join(format!("imu_{c}.aedat4"));
+        write_file(&path, c, &events, &imu, res);
+        let mut reader = AedatReader::open(&path).unwrap();
+        reader.imu_only();
+        let d = decode(reader).unwrap();
+        assert_eq!((d.events, d.imu.clone()), (Vec::new(), imu.clone()), "{c}");
+        let mut reader = evtac_events::open(&path).unwrap();
+        reader.imu_only();
+        let mut found = Vec::new();
+        while let Some(chunk) = reader.next_chunk().unwrap() {
+            assert!(chunk.events.is_empty() && chunk.triggers.is_empty(), "{c}");
+            found.extend_from_slice(chunk.imu);
+        }
+        assert_eq!(found, imu, "{c}");
+    }
+}

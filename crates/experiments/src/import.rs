@@ -10,7 +10,9 @@
 //! A session's trials are cut in one sequential pass over it, each chunk streamed into the
 //! trials it overlaps, each closed once every stream has passed its end (a trial whose data
 //! trails by more than `KEEP_OPEN_US`, a minute, is cut again by a time-range read), so no
-//! index is loaded per trial and every packet is read once. Everything is written into a
+//! index is loaded per trial and every packet is read once. With `--sync trigger` the
+//! triggers are read first, in a pass of their own ([`crate::sync`] says why one pass cannot
+//! do it in bounded memory). Everything is written into a
 //! temporary folder beside the output, checked with [`crate::check`] (a motion outside the
 //! recording, a session without IMU, a lead-in too short for the labels are errors naming the
 //! log's line), and renamed at the end: a failed import leaves nothing behind.

@@ -12,6 +12,20 @@
 //!   trigger, though the counts agree).
 //! - [`Sync::Imu`]: one offset, the one that best aligns the gyroscope's rate magnitude with the
 //!   rate the log commands ([`crate::imu_sync`]), reported with its residual.
+//!
+//! The triggers are read in a pass of their own before the cut, which therefore reads the
+//! session a second time; the pass decodes the trigger packets only (the event and IMU
+//! packets are read past, not decompressed). One pass cutting trials as their triggers arrive
+//! would need bounded memory it cannot have: a trial starts [`crate::import::DEFAULT_PRE_MS`]
+//! (1 s) before the onset its trigger marks, and a trigger reaches the file only when its
+//! packet is written, after the events it marks by as long as the recorder keeps the packet
+//! open: DV's by about 10 ms, evtac's own writer's by a whole trial and the gap after it (it
+//! closes a trigger packet when the next trigger comes), and AEDAT4 puts no bound on it (a
+//! recorder may hold the packet to the end of the file). Every stream would have to be held
+//! from the earliest instant a trial not yet announced could start until its trigger arrives:
+//! seconds of events for DV, a trial's worth for evtac's sessions, the whole session at worst.
+//! The pairing's checks also need the triggers first: a count that differs from the log's rows
+//! is known only at the end, and a single pass would have cut every trial by then.
 
 use crate::imu_sync::{ImuSyncError, imu_offset};
 use crate::robot_log::{LogError, RobotLog};
@@ -134,7 +148,8 @@ pub fn synchronise(session: &Path, log: RobotLog, sync: Sync) -> Result<Synced, 
 /// Each row's offset from the session's triggers of type `kind` (rows paired with triggers in
 /// the order of their onsets), in log order.
 fn trigger_offsets(session: &Path, log: &RobotLog, kind: i8) -> Result<Vec<i64>, SyncError> {
-    // A pass of its own before the cuts (which depend on it), decoding the triggers only.
+    // A pass of its own before the cuts (which depend on it; see the module docs for why not
+    // one pass), decoding the triggers only.
     let mut reader = evtac_events::open(session)?;
     reader.triggers_only();
     let mut triggers = Vec::new();

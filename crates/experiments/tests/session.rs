@@ -7,7 +7,7 @@ use evtac_events::Trigger;
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_experiments::check::check;
 use evtac_experiments::import::{ImportConfig, NoContact, import_session};
-use evtac_experiments::imu_sync::read_imu;
+use evtac_experiments::imu_sync::{imu_offset_whole, read_imu};
 use evtac_experiments::inputs::Inputs;
 use evtac_experiments::motions::{FindConfig, as_log, find_motions, find_motions_in};
 use evtac_experiments::robot_log::RobotLog;
@@ -202,6 +202,13 @@ fn a_session_synchronised_by_its_imu_recovers_the_offset_within_a_millisecond() 
     assert!((offset - record.clock_offset_us).abs() <= 1000);
     // The gyroscope's bias and the log's missing accelerations, nothing more.
     assert!(residual < 1.5, "{residual}");
+    // Found in passes over the IMU, holding none of it: the whole IMU's fit, bit for bit.
+    let log = RobotLog::read(&session.join("robot_log.csv"), 0).unwrap();
+    let whole = imu_offset_whole(&session.join("session.aedat4"), &log).unwrap();
+    assert_eq!(
+        (offset, residual.to_bits()),
+        (whole.offset_us, whole.residual_deg_s.to_bits())
+    );
     let out = import(dir.path(), &synced.log, "imported");
     let truths = Manifest {
         trials: record.trials.clone(),

@@ -64,8 +64,7 @@ impl CumulativeTrapezoid {
                     previous_us: t_us[i - 1],
                 });
             }
-            let dt = (t_us[i] - t_us[i - 1]) as f64 * 1e-6;
-            sum += 0.5 * (y[i] + y[i - 1]) * dt;
+            sum = step(sum, (t_us[i - 1], y[i - 1]), (t_us[i], y[i]));
             cumulative.push(sum);
         }
         Ok(Self {
@@ -92,16 +91,86 @@ impl CumulativeTrapezoid {
         }
         // The sample at or before t_us: t[i] <= t_us < t[i + 1].
         let i = self.t_us.partition_point(|&s| s <= t_us) - 1;
-        let span = (self.t_us[i + 1] - self.t_us[i]) as f64;
-        let frac = (t_us - self.t_us[i]) as f64 / span;
-        let y_t = self.y[i] + frac * (self.y[i + 1] - self.y[i]);
-        let dt = (t_us - self.t_us[i]) as f64 * 1e-6;
-        self.cumulative[i] + 0.5 * (self.y[i] + y_t) * dt
+        let (before, after) = ((self.t_us[i], self.y[i]), (self.t_us[i + 1], self.y[i + 1]));
+        interpolate(self.cumulative[i], before, after, t_us)
     }
 
     /// The integral from `from_us` to `to_us`.
     pub fn between(&self, from_us: i64, to_us: i64) -> f64 {
         self.at(to_us) - self.at(from_us)
+    }
+}
+
+/// The running integral `sum` at sample `(t0, y0)` carried to the next sample `(t1, y1)`: one
+/// step of the cumulative trapezoid rule.
+fn step(sum: f64, (t0, y0): (i64, f64), (t1, y1): (i64, f64)) -> f64 {
+    let dt = (t1 - t0) as f64 * 1e-6;
+    sum + 0.5 * (y1 + y0) * dt
+}
+
+/// The running integral at `t_us`, between the samples `(t0, y0)` (where it is `at0`) and
+/// `(t1, y1)`: the exact integral of the linear interpolant.
+fn interpolate(at0: f64, (t0, y0): (i64, f64), (t1, y1): (i64, f64), t_us: i64) -> f64 {
+    let span = (t1 - t0) as f64;
+    let frac = (t_us - t0) as f64 / span;
+    let y_t = y0 + frac * (y1 - y0);
+    let dt = (t_us - t0) as f64 * 1e-6;
+    at0 + 0.5 * (y0 + y_t) * dt
+}
+
+/// [`CumulativeTrapezoid`] built sample by sample, for a series too long to hold: it keeps the
+/// last sample and its running integral only, and answers [`CumulativeTrapezoid::at`] (the same
+/// value, bit for bit) for instants before the next sample, which is how a caller streaming a
+/// long series asks, in time order.
+///
+/// ```
+/// use evtac_labels::integration::{CumulativeTrapezoid, RunningTrapezoid};
+///
+/// let (t, y) = ([0, 1_000, 2_500], [1.0, 3.0, 2.0]);
+/// let whole = CumulativeTrapezoid::new(&t, &y).unwrap();
+/// let mut running = RunningTrapezoid::default();
+/// assert_eq!(running.at(-5, Some((t[0], y[0]))), whole.at(-5));
+/// running.push(t[0], y[0]);
+/// running.push(t[1], y[1]);
+/// assert_eq!(running.at(1_700, Some((t[2], y[2]))), whole.at(1_700));
+/// running.push(t[2], y[2]);
+/// assert_eq!(running.at(9_000, None), whole.at(9_000));
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RunningTrapezoid {
+    /// The first sample's time.
+    first: Option<i64>,
+    /// The last sample and the running integral there.
+    last: Option<((i64, f64), f64)>,
+}
+
+impl RunningTrapezoid {
+    /// Adds the next sample; its time must be after the last one's (the caller's series is
+    /// sorted and deduplicated, as [`CumulativeTrapezoid::new`] demands).
+    pub fn push(&mut self, t_us: i64, y: f64) {
+        let sum = match self.last {
+            Some((previous, sum)) => step(sum, previous, (t_us, y)),
+            None => 0.0,
+        };
+        self.first.get_or_insert(t_us);
+        self.last = Some(((t_us, y), sum));
+    }
+
+    /// The integral from the first sample to `t_us`, as [`CumulativeTrapezoid::at`] gives it
+    /// over the whole series, for `t_us` at or after the last sample pushed and before `next`,
+    /// the sample to come (`None` once the series has ended). With no sample yet, or none at
+    /// all, it is 0.
+    pub fn at(&self, t_us: i64, next: Option<(i64, f64)>) -> f64 {
+        let (Some(first), Some((last, sum))) = (self.first, self.last) else {
+            return 0.0;
+        };
+        if t_us <= first {
+            return 0.0;
+        }
+        match next {
+            Some(next) if t_us < next.0 => interpolate(sum, last, next, t_us),
+            _ => sum,
+        }
     }
 }
 
@@ -179,6 +248,29 @@ mod properties {
             for (k, &tk) in t.iter().enumerate() {
                 prop_assert!((integral.at(tk) - integral.at_samples()[k]).abs() < 1e-12);
             }
+        }
+
+        /// Built sample by sample and asked in time order (instants before, on, between and
+        /// after the samples), the running integral is the whole one, bit for bit.
+        #[test]
+        fn the_running_integral_is_the_whole_one_bit_for_bit(
+            (t, y) in series(),
+            mut at in prop::collection::vec(-3_000i64..300_000, 0..40),
+        ) {
+            let whole = CumulativeTrapezoid::new(&t, &y).unwrap();
+            at.extend(&t);
+            at.sort_unstable();
+            let mut running = RunningTrapezoid::default();
+            let (mut next, mut got) = (0, Vec::new());
+            for &x in &at {
+                while next < t.len() && t[next] <= x {
+                    running.push(t[next], y[next]);
+                    next += 1;
+                }
+                got.push(running.at(x, t.get(next).map(|&tn| (tn, y[next]))).to_bits());
+            }
+            let want: Vec<u64> = at.iter().map(|&x| whole.at(x).to_bits()).collect();
+            prop_assert_eq!(got, want);
         }
     }
 }

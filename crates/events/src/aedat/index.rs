@@ -22,7 +22,7 @@ use std::collections::VecDeque;
 use super::compression::MAX_PACKET_BYTES;
 use super::header::StreamKind;
 use super::packet::StreamState;
-use super::schema;
+use super::schema::{self, DataTableEntry};
 
 /// Most elements a packet can hold: every element takes at least 8 bytes of its decompressed
 /// flatbuffer (a timestamp), which is at most [`MAX_PACKET_BYTES`] long.
@@ -46,7 +46,7 @@ pub(crate) struct PlannedPacket {
 }
 
 /// The packets to read, in file order, and what is needed to report errors as a full read would.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, PartialEq, Eq)]
 pub(crate) struct Plan {
     /// Packets overlapping the range.
     pub packets: VecDeque<PlannedPacket>,
@@ -82,18 +82,61 @@ pub(crate) fn plan(
         return Err("missing file identifier \"FTAB\"".into());
     }
     let table = schema::size_prefixed_root_as_file_data_table(body).map_err(|e| e.to_string())?;
-    let mut out = Plan {
-        first_index: vec![0; streams.len()],
-        ..Plan::default()
-    };
-    // Per stream: elements seen so far, last timestamp, and whether a packet was selected.
-    let mut seen = vec![0u64; streams.len()];
-    let mut last_t = vec![i64::MIN; streams.len()];
-    let mut started = vec![false; streams.len()];
-    let mut cursor = data_start;
-    for (i, def) in table.table().into_iter().flatten().enumerate() {
-        let e = def.entry();
-        let header = cursor;
+    let mut planner = Planner::new(data_start, position, streams, from, to);
+    for def in table.table().into_iter().flatten() {
+        planner.entry(&def.entry())?;
+    }
+    planner.finish()
+}
+
+/// Plans a range read entry by entry, in the table's order: what [`plan`] does with each entry
+/// of a verified table, for a table read whole or streamed (`table_check::plan`), so that both
+/// give the same plan and the same error.
+pub(crate) struct Planner<'a> {
+    position: u64,
+    streams: &'a [StreamState],
+    from: i64,
+    to: i64,
+    out: Plan,
+    /// Per stream: elements seen so far, last timestamp, and whether a packet was selected.
+    seen: Vec<u64>,
+    last_t: Vec<i64>,
+    started: Vec<bool>,
+    /// Where the next packet starts, and the next entry's index.
+    cursor: u64,
+    index: usize,
+}
+
+impl<'a> Planner<'a> {
+    pub(crate) fn new(
+        data_start: u64,
+        position: u64,
+        streams: &'a [StreamState],
+        from: i64,
+        to: i64,
+    ) -> Self {
+        Self {
+            position,
+            streams,
+            from,
+            to,
+            out: Plan {
+                first_index: vec![0; streams.len()],
+                ..Plan::default()
+            },
+            seen: vec![0; streams.len()],
+            last_t: vec![i64::MIN; streams.len()],
+            started: vec![false; streams.len()],
+            cursor: data_start,
+            index: 0,
+        }
+    }
+
+    /// The next entry; the error says what is wrong with it.
+    pub(crate) fn entry(&mut self, e: &DataTableEntry) -> Result<(), String> {
+        let i = self.index;
+        self.index += 1;
+        let header = self.cursor;
         if e.byte_offset != header as i64 + 8 {
             return Err(format!(
                 "entry {i} puts a packet body at byte {}, but the packet before ends at byte \
@@ -102,13 +145,14 @@ pub(crate) fn plan(
             ));
         }
         let size = u64::try_from(e.size).map_err(|_| format!("entry {i} has size {}", e.size))?;
-        cursor = header + 8 + size;
-        if cursor > position {
+        self.cursor = header + 8 + size;
+        if self.cursor > self.position {
             return Err(format!(
                 "entry {i} (a packet of {size} bytes at byte {header}) runs past the table"
             ));
         }
-        let s = streams
+        let s = self
+            .streams
             .iter()
             .position(|s| s.id == e.stream_id)
             .ok_or_else(|| format!("entry {i} names undeclared stream {}", e.stream_id))?;
@@ -121,27 +165,27 @@ pub(crate) fn plan(
                     e.num_elements
                 )
             })?;
-        out.total += 1;
+        self.out.total += 1;
         if elements == 0 {
-            continue;
+            return Ok(());
         }
-        if e.timestamp_start > e.timestamp_end || e.timestamp_start < last_t[s] {
+        if e.timestamp_start > e.timestamp_end || e.timestamp_start < self.last_t[s] {
             return Err(format!(
                 "entry {i} (stream {}) spans {} .. {} us after a packet ending at {} us",
-                e.stream_id, e.timestamp_start, e.timestamp_end, last_t[s]
+                e.stream_id, e.timestamp_start, e.timestamp_end, self.last_t[s]
             ));
         }
-        last_t[s] = e.timestamp_end;
+        self.last_t[s] = e.timestamp_end;
         let decoded = matches!(
-            streams[s].kind,
+            self.streams[s].kind,
             StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
         );
-        if decoded && e.timestamp_end >= from && e.timestamp_start < to {
-            if !started[s] {
-                started[s] = true;
-                out.first_index[s] = seen[s];
+        if decoded && e.timestamp_end >= self.from && e.timestamp_start < self.to {
+            if !self.started[s] {
+                self.started[s] = true;
+                self.out.first_index[s] = self.seen[s];
             }
-            out.packets.push_back(PlannedPacket {
+            self.out.packets.push_back(PlannedPacket {
                 offset: header,
                 stream_id: e.stream_id,
                 size,
@@ -150,12 +194,18 @@ pub(crate) fn plan(
                 t_end: e.timestamp_end,
             });
         }
-        seen[s] = seen[s].saturating_add(elements);
+        self.seen[s] = self.seen[s].saturating_add(elements);
+        Ok(())
     }
-    if cursor != position {
-        return Err(format!(
-            "its entries end at byte {cursor}, but the table starts at byte {position}"
-        ));
+
+    /// The plan, once every entry is in.
+    pub(crate) fn finish(self) -> Result<Plan, String> {
+        if self.cursor != self.position {
+            return Err(format!(
+                "its entries end at byte {}, but the table starts at byte {}",
+                self.cursor, self.position
+            ));
+        }
+        Ok(self.out)
     }
-    Ok(out)
 }

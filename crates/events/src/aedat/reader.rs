@@ -9,7 +9,7 @@ use std::path::Path;
 use super::compression::{Decompressor, MAX_PACKET_BYTES};
 use super::error::{AedatError, Result};
 use super::header::{AedatHeader, Compression, MAGIC, StreamKind};
-use super::index::{self, Plan, PlannedPacket};
+use super::index::{self, Plan, PlannedPacket, Planner};
 use super::packet::{self, StreamState};
 use super::table_check::{self, ENTRIES_PER_PASS, Verdict};
 use crate::range::{RangeIndex, ScanReason, retain_within};
@@ -94,8 +94,8 @@ pub struct AedatReader<R> {
     data_start: u64,
     /// Where the packets end: the data table, when there is one.
     table_end: Option<u64>,
-    /// Decode trigger packets only ([`Self::triggers_only`]).
-    triggers_only: bool,
+    /// Decode this stream kind only ([`Self::triggers_only`], [`Self::imu_only`]).
+    only: Option<StreamKind>,
     /// Whether to verify the data table on reaching it (not when a range read already found it
     /// unusable and said so).
     check_table: bool,
@@ -109,6 +109,9 @@ pub struct AedatReader<R> {
     triggers: Vec<Trigger>,
     /// The selected time range, if any.
     range: Option<RangeRead<R>>,
+    /// Whether a range read plans from the data table streamed ([`table_check::plan`]) before
+    /// falling back to the whole table (off in tests comparing the two).
+    stream_table: bool,
     /// Set at the end of the data or after an error: the reader then yields nothing more.
     finished: bool,
 }
@@ -226,7 +229,8 @@ impl<R: Read> AedatReader<R> {
             decompressor: Decompressor::new(header.compression),
             table_end: header.data_table_position,
             check_table: true,
-            triggers_only: false,
+            only: None,
+            stream_table: true,
             rewind: None,
             header,
             offset: offset + 4 + size,
@@ -274,7 +278,13 @@ impl<R: Read> AedatReader<R> {
     /// frames, undecoded (their data is not checked either), so that finding a long
     /// recording's triggers decompresses nothing else.
     pub fn triggers_only(&mut self) {
-        self.triggers_only = true;
+        self.only = Some(StreamKind::Triggers);
+    }
+
+    /// From now on, decodes IMU packets only (as [`Self::triggers_only`] does triggers), so
+    /// that a pass over a long recording's IMU decompresses nothing else.
+    pub fn imu_only(&mut self) {
+        self.only = Some(StreamKind::Imu);
     }
 
     /// Decodes the next packet of events, IMU samples or triggers (frame packets and unknown
@@ -540,8 +550,8 @@ impl<R: Read> AedatReader<R> {
         }
         let state = &mut self.streams[index];
         // A range read's plan lists the packets it needs: those are all decoded.
-        let decoded = if self.triggers_only && planned.is_none() {
-            matches!(state.kind, StreamKind::Triggers)
+        let decoded = if let Some(only) = self.only.as_ref().filter(|_| planned.is_none()) {
+            state.kind == *only
         } else {
             matches!(
                 state.kind,
@@ -626,8 +636,11 @@ impl<R: Read + Seek> AedatReader<R> {
     ///
     /// With a data table, only the packets it lists as overlapping the range are read: reading a
     /// few seconds of a multi-gigabyte recording touches a few megabytes, and memory holds the
-    /// table's entries for the range only (the table itself, about 60 bytes a packet, is read
-    /// once and its memory given back). Without one, or when the table is unusable, the reader scans the file
+    /// table's entries for the range only. The table (about 60 bytes a packet decompressed) is
+    /// decompressed block by block in passes over it, as the end-of-read check reads it
+    /// (`table_check::plan`), never whole; a table that check cannot vouch for is read whole
+    /// as before, so that a damaged one gets the same reason. Without one, or when the table is
+    /// unusable, the reader scans the file
     /// from its first packet; the returned [`RangeIndex`] says which happened and why, so that
     /// the caller can warn once. The read starts over from the first packet whatever was read
     /// before.
@@ -721,6 +734,25 @@ impl<R: Read + Seek> AedatReader<R> {
                 self.data_start
             )));
         }
+        // Streamed, holding the entries in the range only, when the table is one the streamed
+        // check vouches for; whole otherwise, so that a damaged table gets the error it got.
+        if self.stream_table {
+            let planner = Planner::new(self.data_start, position, &self.streams, from, to);
+            let (compression, per_pass) = (self.header.compression, ENTRIES_PER_PASS);
+            let seek = seek_to::<R>;
+            if let Some(plan) = table_check::plan(
+                &mut self.reader,
+                seek,
+                position,
+                compression,
+                per_pass,
+                planner,
+            ) {
+                // Where the reader is after the passes is not known: the next read seeks.
+                self.offset = len;
+                return Ok(plan);
+            }
+        }
         seek_to(&mut self.reader, position).map_err(io(position))?;
         let input = self.decompressor.input();
         (&mut self.reader)
@@ -763,6 +795,107 @@ impl<R: Read> Iterator for Events<R> {
                 }
                 Ok(None) => return None,
                 Err(e) => return Some(Err(e)),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{AedatWriter, WriterConfig};
+    use super::*;
+    use std::io::Cursor;
+
+    /// A file of events, IMU and triggers in many packets, with its data table.
+    fn file(compression: Compression) -> Vec<u8> {
+        let config = WriterConfig {
+            compression,
+            ..WriterConfig::new(Resolution::new(64, 48), "cam")
+        };
+        let mut w = AedatWriter::new_seekable(Cursor::new(Vec::new()), config).unwrap();
+        for k in 0..40i64 {
+            let events: Vec<Event> = (0..700)
+                .map(|i| Event {
+                    t: k * 10_000 + i * 13,
+                    x: (i % 64) as u16,
+                    y: (k % 48) as u16,
+                    polarity: i % 3 == 0,
+                })
+                .collect();
+            w.write_events(&events).unwrap();
+            let imu: Vec<ImuSample> = (0..8)
+                .map(|i| ImuSample {
+                    t: k * 10_000 + i * 1250,
+                    ..ImuSample::default()
+                })
+                .collect();
+            w.write_imu(&imu).unwrap();
+            if k % 5 == 0 {
+                w.write_triggers(&[Trigger {
+                    t: k * 10_000 + 7,
+                    ..Trigger::default()
+                }])
+                .unwrap();
+            }
+        }
+        w.finish().unwrap().into_inner()
+    }
+
+    /// A range read of `bytes`, planned streamed or from the whole table: how, and what it read.
+    fn range(bytes: &[u8], (from, to): (i64, i64), streamed: bool) -> String {
+        let mut reader = match AedatReader::new(Cursor::new(bytes)) {
+            Ok(reader) => reader,
+            Err(e) => return format!("open: {e}"),
+        };
+        reader.stream_table = streamed;
+        let how = match reader.select_range(from, to) {
+            Ok(how) => how,
+            Err(e) => return format!("select: {e}"),
+        };
+        let mut read = Vec::new();
+        loop {
+            match reader.next_chunk() {
+                Ok(Some(c)) => read.push(format!("{c:?}")),
+                Ok(None) => break,
+                Err(e) => {
+                    read.push(format!("error: {e}"));
+                    break;
+                }
+            }
+        }
+        format!("{how:?}\n{}", read.join("\n"))
+    }
+
+    /// A range read planned from the streamed table reads what one planned from the whole
+    /// table reads, for many ranges, and says the same of a table damaged at any byte (the
+    /// same `RangeIndex`, the same reason, the same elements and errors).
+    #[test]
+    fn streamed_plans_read_what_whole_plans_read() {
+        let ranges = [
+            (-10, 0),
+            (0, 1),
+            (9_999, 10_001),
+            (57_000, 123_456),
+            (199_993, 200_000),
+            (390_000, 500_000),
+            (i64::MIN, i64::MAX),
+        ];
+        for c in [Compression::None, Compression::Lz4, Compression::Zstd] {
+            let good = file(c);
+            for &r in &ranges {
+                let whole = range(&good, r, false);
+                assert!(whole.starts_with("DataTable"), "{c} {r:?}: {whole}");
+                assert_eq!(range(&good, r, true), whole, "{c} {r:?}");
+            }
+            let reader = AedatReader::new(Cursor::new(&good)).unwrap();
+            let position = reader.header().data_table_position.unwrap() as usize;
+            for at in position..good.len() {
+                let flip = if at % 2 == 0 { 0x01u8 } else { 0xff };
+                let mut bad = good.clone();
+                bad[at] ^= flip;
+                let r = ranges[at % ranges.len()];
+                let whole = range(&bad, r, false);
+                assert_eq!(range(&bad, r, true), whole, "{c}: byte {at} ^ {flip:#x}");
             }
         }
     }

@@ -12,6 +12,11 @@
 //! before an entry named it is read in one more pass; DV and evtac write one vtable for all
 //! entries, so that pass is rarely needed.
 //!
+//! A range read plans its packets in the same passes ([`plan`]): each followed entry's table's
+//! first bytes are kept with it, and once the pass has its vtables the entries go to the range
+//! read's [`Planner`] in the table's order, so that planning holds a pass's entries and the
+//! selected ones rather than the table.
+//!
 //! The streamed check is sound, not complete: it says [`Verdict::Valid`] only when every check
 //! the verifier makes passes, and anything it cannot vouch for (a damaged table, an unusual
 //! layout, an input it cannot stream) is [`Verdict::Unsure`]. The caller then verifies the whole
@@ -24,7 +29,10 @@ use std::ops::ControlFlow;
 
 use super::compression::MAX_PACKET_BYTES;
 use super::header::Compression;
-use super::schema::{FILE_DATA_TABLE_IDENTIFIER, FileDataDefinition, FileDataTable};
+use super::index::{Plan, Planner};
+use super::schema::{
+    DataTableEntry, FILE_DATA_TABLE_IDENTIFIER, FbPacketHeader, FileDataDefinition, FileDataTable,
+};
 use super::table_stream::{Streamed, stream};
 
 /// Entries followed per pass: their pending reads and positions take about 60 bytes each
@@ -44,6 +52,11 @@ const MAX_APPARENT_SIZE: u64 = 1 << 31;
 
 /// Bytes read of a vtable: its length, the table's size and the five fields' offsets.
 const VTABLE_READ: u64 = 14;
+
+/// Bytes read of an entry's table when planning a range read: its fields lie within the first
+/// 48 bytes as builders lay them out (a soffset, four 8-byte scalars and an 8-byte struct, with
+/// padding); an entry whose fields lie further is planned from the whole table.
+const TABLE_READ: u64 = 64;
 
 /// What the streamed check found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,15 +86,62 @@ pub(crate) fn check<R: Read>(
             Streamed::Stopped => Some(streamed),
         }
     };
-    check_passes(&mut pass, per_pass).map_or(Verdict::Unsure, Verdict::Valid)
+    check_passes(&mut pass, per_pass, None).map_or(Verdict::Unsure, Verdict::Valid)
+}
+
+/// Plans a range read from the data table at `position` of `reader` as [`check`] checks it, in
+/// passes of `per_pass` entries, handing each entry to `planner` in the table's order: the
+/// plan, or the planner's first error, when the whole verifier would accept the table (so that
+/// planning it whole would give the same); `None` when that is not known, and the caller plans
+/// from the whole table. Holds `per_pass` entries' positions and first bytes, and the entries
+/// the planner selects.
+pub(crate) fn plan<R: Read>(
+    reader: &mut R,
+    seek: fn(&mut R, u64) -> std::io::Result<()>,
+    position: u64,
+    compression: Compression,
+    per_pass: usize,
+    planner: Planner,
+) -> Option<Result<Plan, String>> {
+    let mut pass = |sink: &mut dyn FnMut(&[u8]) -> ControlFlow<()>| -> Option<Streamed> {
+        seek(reader, position).ok()?;
+        let mut input = (&mut *reader).take(MAX_PACKET_BYTES);
+        stream(&mut input, compression, sink)
+    };
+    plan_passes(&mut pass, per_pass, planner)
+}
+
+/// [`plan`], over passes made by `pass`.
+fn plan_passes(
+    pass: &mut Pass,
+    per_pass: usize,
+    mut planner: Planner,
+) -> Option<Result<Plan, String>> {
+    let mut error = None;
+    let mut visit = |entry: &DataTableEntry| {
+        if error.is_none() {
+            error = planner.entry(entry).err();
+        }
+    };
+    check_passes(pass, per_pass, Some(&mut visit))?;
+    Some(match error {
+        Some(e) => Err(e),
+        None => planner.finish(),
+    })
 }
 
 /// A pass over the decompressed table: the stream's pieces go to the sink; `Whole` carries the
 /// compressed length.
 type Pass<'a> = dyn FnMut(&mut dyn FnMut(&[u8]) -> ControlFlow<()>) -> Option<Streamed> + 'a;
 
-/// The check, over passes made by `pass`; the compressed length when the table is valid.
-fn check_passes(pass: &mut Pass, per_pass: usize) -> Option<u64> {
+/// The check, over passes made by `pass`; the compressed length when the table is valid. With
+/// `visit`, each entry's values go to it in the table's order (`None` for an entry whose fields
+/// lie past the bytes read of its table).
+fn check_passes(
+    pass: &mut Pass,
+    per_pass: usize,
+    mut visit: Option<&mut dyn FnMut(&DataTableEntry)>,
+) -> Option<u64> {
     let mut head = Vec::with_capacity(HEAD);
     pass(&mut |piece| {
         let take = piece.len().min(HEAD - head.len());
@@ -102,7 +162,7 @@ fn check_passes(pass: &mut Pass, per_pass: usize) -> Option<u64> {
     // At least one pass, which also checks that the stream decompresses and holds the body.
     let compressed = loop {
         let last = root.entries.min(first + per_pass as u64);
-        let mut walk = Walk::new(&root, first, last, &vtables);
+        let mut walk = Walk::new(&root, first, last, &vtables, visit.is_some());
         let Streamed::Whole(length) = pass(&mut |piece| walk.piece(piece))? else {
             return None;
         };
@@ -111,6 +171,7 @@ fn check_passes(pass: &mut Pass, per_pass: usize) -> Option<u64> {
         }
         let Walk {
             tables,
+            captured,
             found,
             behind,
             ..
@@ -128,8 +189,16 @@ fn check_passes(pass: &mut Pass, per_pass: usize) -> Option<u64> {
         if vtables.len() > MAX_VTABLES {
             return None;
         }
-        for (table, vtable) in tables {
-            totals.entry(&root, table, (vtable, vtables.get(&vtable)?))?;
+        for (table, vt) in tables {
+            totals.entry(&root, table, (vt, vtables.get(&vt)?))?;
+        }
+        if let Some(visit) = visit.as_mut() {
+            // In the table's order: a builder writes the entries' tables backwards.
+            let mut captured = captured;
+            captured.sort_unstable_by_key(|c| c.0);
+            for (_, vt, bytes, read) in &captured {
+                visit(&entry_of(vtables.get(vt)?, &bytes[..usize::from(*read)])?);
+            }
         }
         first = last;
         if first >= root.entries {
@@ -250,6 +319,34 @@ impl Vtable {
     }
 }
 
+/// An entry's values from its vtable and the first bytes of its table, as
+/// `FileDataDefinition::entry` reads them (a field left out is 0); `None` when a field lies
+/// past `table`.
+fn entry_of(vtable: &Vtable, table: &[u8]) -> Option<DataTableEntry> {
+    let len = vtable.u16_at(0)?;
+    let field = |slot: u16, size: usize| -> Option<Option<&[u8]>> {
+        if slot >= len {
+            return Some(None);
+        }
+        match usize::from(vtable.u16_at(usize::from(slot))?) {
+            0 => Some(None),
+            at => table.get(at..at + size).map(Some),
+        }
+    };
+    let eight = |b: Option<&[u8]>| b.and_then(|b| b.first_chunk::<8>()).copied();
+    let int = |slot| Some(eight(field(slot, 8)?).map_or(0, i64::from_le_bytes));
+    let header =
+        FbPacketHeader(eight(field(FileDataDefinition::VT_PACKETINFO, 8)?).unwrap_or_default());
+    Some(DataTableEntry {
+        byte_offset: int(FileDataDefinition::VT_BYTEOFFSET)?,
+        stream_id: header.stream_id(),
+        size: header.size(),
+        num_elements: int(FileDataDefinition::VT_NUMELEMENTS)?,
+        timestamp_start: int(FileDataDefinition::VT_TIMESTAMPSTART)?,
+        timestamp_end: int(FileDataDefinition::VT_TIMESTAMPEND)?,
+    })
+}
+
 /// The verifier's running totals.
 struct Totals {
     apparent: u64,
@@ -299,8 +396,8 @@ impl Totals {
 enum Want {
     /// Entry `i`'s offset (4 bytes).
     Entry(u64),
-    /// A table's soffset (4 bytes).
-    Table,
+    /// Entry `i`'s table's soffset (4 bytes, or its first bytes when capturing).
+    Table(u64),
     /// A vtable's first bytes.
     Vtable,
 }
@@ -322,6 +419,10 @@ struct Walk<'a> {
     total: u64,
     /// Each followed entry's table and vtable positions.
     tables: Vec<(u64, u64)>,
+    /// With `capture`, each followed entry's table's first bytes (and how many were read).
+    capture: bool,
+    /// Entry, vtable position, bytes, bytes read; in the stream's order (a builder writes tables backwards).
+    captured: Vec<(u64, u64, [u8; TABLE_READ as usize], u8)>,
     /// Vtables read in this pass.
     found: HashMap<u64, Vtable>,
     /// Vtables asked for in this pass (read, pending or behind), so each is asked for once.
@@ -332,11 +433,18 @@ struct Walk<'a> {
 }
 
 /// Longest read, bytes: what a window keeps of the previous piece.
-const LONGEST_READ: usize = VTABLE_READ as usize;
+const LONGEST_READ: usize = TABLE_READ as usize;
 
 impl<'a> Walk<'a> {
-    fn new(root: &'a Root, first: u64, last: u64, known: &'a HashMap<u64, Vtable>) -> Self {
+    fn new(
+        root: &'a Root,
+        first: u64,
+        last: u64,
+        known: &'a HashMap<u64, Vtable>,
+        capture: bool,
+    ) -> Self {
         let mut walk = Self::empty(root, last, Some(known));
+        walk.capture = capture;
         if first < last {
             walk.want(root.start + 4 * first, Want::Entry(first));
         }
@@ -363,6 +471,8 @@ impl<'a> Walk<'a> {
             window_at: 0,
             total: 0,
             tables: Vec::new(),
+            capture: false,
+            captured: Vec::new(),
             found: HashMap::new(),
             wanted: HashSet::new(),
             behind: Vec::new(),
@@ -379,6 +489,10 @@ impl<'a> Walk<'a> {
     fn size(&self, pos: u64, want: Want) -> u64 {
         match want {
             Want::Vtable => VTABLE_READ.min(self.root.body.saturating_sub(pos)),
+            // At least the soffset, as without capturing (the check of its bounds follows).
+            Want::Table(_) if self.capture => {
+                TABLE_READ.min(self.root.body.saturating_sub(pos)).max(4)
+            }
             _ => 4,
         }
     }
@@ -428,17 +542,22 @@ impl<'a> Walk<'a> {
                     self.failed = true;
                     return;
                 }
-                self.want(table, Want::Table);
+                self.want(table, Want::Table(i));
                 if i + 1 < self.last {
                     self.want(pos + 4, Want::Entry(i + 1));
                 }
             }
-            Want::Table => {
+            Want::Table(i) => {
                 let Some(vtable) = vtable_of(pos, word(bytes) as i32, self.root.body) else {
                     self.failed = true;
                     return;
                 };
                 self.tables.push((pos, vtable));
+                if self.capture {
+                    let mut table = [0u8; TABLE_READ as usize];
+                    table[..bytes.len()].copy_from_slice(bytes);
+                    self.captured.push((i, vtable, table, bytes.len() as u8));
+                }
                 let known = self.known.is_some_and(|k| k.contains_key(&vtable));
                 if !known && !self.wanted.contains(&vtable) {
                     if self.wanted.len() + self.behind.len() > MAX_VTABLES {
@@ -464,6 +583,8 @@ impl<'a> Walk<'a> {
 #[cfg(test)]
 mod tests {
     use super::super::compression::{Compressor, Decompressor};
+    use super::super::header::StreamKind;
+    use super::super::packet::StreamState;
     use super::super::packet::check_data_table;
     use super::super::schema::{DataTableEntry, build_file_data_table};
     use super::*;
@@ -518,7 +639,7 @@ mod tests {
                 stopped => stopped,
             })
         };
-        check_passes(&mut pass, per_pass).map_or(Verdict::Unsure, Verdict::Valid)
+        check_passes(&mut pass, per_pass, None).map_or(Verdict::Unsure, Verdict::Valid)
     }
 
     #[test]
@@ -599,6 +720,112 @@ mod tests {
                 "{c}: {valid} valid, {unsure} unsure"
             );
         }
+    }
+
+    /// The packets of [`table`]'s entries fill `92 .. 92 + 64 n` (each body 8 bytes after
+    /// its header) in streams 0 (events) and 1 (IMU).
+    fn streams() -> Vec<StreamState> {
+        let state = |id, kind| StreamState {
+            id,
+            kind,
+            resolution: None,
+            count: 0,
+            last_t: i64::MIN,
+        };
+        vec![state(0, StreamKind::Events), state(1, StreamKind::Imu)]
+    }
+
+    /// The streamed plan of `compressed` for `[from, to)`, its stream cut into pieces.
+    fn plan_streamed(
+        compressed: &[u8],
+        c: Compression,
+        (per_pass, piece): (usize, usize),
+        position: u64,
+        (from, to): (i64, i64),
+    ) -> Option<Result<Plan, String>> {
+        let streams = streams();
+        let planner = Planner::new(92, position, &streams, from, to);
+        let mut pass = |sink: &mut dyn FnMut(&[u8]) -> ControlFlow<()>| {
+            let mut input = compressed;
+            stream(&mut input, c, &mut |p| {
+                p.chunks(piece).try_for_each(&mut *sink)
+            })
+        };
+        plan_passes(&mut pass, per_pass, planner)
+    }
+
+    /// The whole table's plan (what the reader falls back to).
+    fn plan_whole(
+        compressed: &[u8],
+        c: Compression,
+        position: u64,
+        (from, to): (i64, i64),
+    ) -> Result<Plan, String> {
+        let mut d = Decompressor::new(c);
+        d.input().extend_from_slice(compressed);
+        let payload = d.decompress().map_err(|e| e.to_string())?;
+        super::super::index::plan(payload, 92, position, &streams(), from, to)
+    }
+
+    /// Planned in passes of any size from a stream in pieces of any size, a range read selects
+    /// the packets the whole table selects, for ranges before, inside, across and after the
+    /// entries (and a table that ends elsewhere gets the same error).
+    #[test]
+    fn the_streamed_plan_is_the_whole_plan_for_every_range() {
+        let n = 300;
+        let ranges: Vec<(i64, i64)> = [(-50, 0), (0, 1), (999, 1000), (12_345, 12_346)]
+            .into_iter()
+            .chain((0..40).map(|k| (k * 7919 % 300_000, k * 7919 % 300_000 + k * 977 + 1)))
+            .chain([(290_000, 400_000), (300_000, 301_000), (i64::MIN, i64::MAX)])
+            .collect();
+        for c in ALL {
+            let compressed = compress(&table(n), c);
+            for position in [92 + 64 * n as u64, 92 + 64 * n as u64 + 8] {
+                for &range in &ranges {
+                    let whole = plan_whole(&compressed, c, position, range);
+                    for setup in [(1, 3), (7, 5), (ENTRIES_PER_PASS, 64 << 10)] {
+                        let streamed = plan_streamed(&compressed, c, setup, position, range);
+                        assert_eq!(streamed.as_ref(), Some(&whole), "{c} {range:?} {setup:?}");
+                    }
+                }
+                // The selection is not empty for every range.
+                let all = plan_whole(&compressed, c, position, (i64::MIN, i64::MAX));
+                assert!(all.is_err() || all.unwrap().packets.len() == 200, "{c}");
+            }
+        }
+    }
+
+    /// Every byte of a table damaged (three ways): the streamed plan, when it gives one, is the
+    /// whole table's plan or error; otherwise the reader plans from the whole table.
+    #[test]
+    fn a_damaged_table_gets_the_whole_plans_result() {
+        let good = table(12);
+        let position = 92 + 64 * 12;
+        let (mut planned, mut errors) = (0, 0);
+        for c in ALL {
+            for at in 0..good.len() {
+                for flip in [0x01u8, 0x80, 0xff] {
+                    let mut bad = good.clone();
+                    bad[at] ^= flip;
+                    let compressed = compress(&bad, c);
+                    for range in [(0, 5_000), (3_500, 3_501), (i64::MIN, i64::MAX)] {
+                        let whole = plan_whole(&compressed, c, position, range);
+                        if let Some(streamed) =
+                            plan_streamed(&compressed, c, (5, 3), position, range)
+                        {
+                            assert_eq!(streamed, whole, "{c}: byte {at} ^ {flip:#x}, {range:?}");
+                            planned += 1;
+                            errors += usize::from(streamed.is_err());
+                        }
+                    }
+                }
+            }
+        }
+        // Streamed plans of damaged tables, some of them the planner's errors.
+        assert!(
+            planned > errors && errors > 0,
+            "{planned} planned, {errors} errors"
+        );
     }
 
     /// Damage to the compressed bytes, and a table cut short anywhere: never valid unless the
