@@ -153,7 +153,13 @@ pub fn train_all(
         jobs,
         |j| j.dir.clone(),
         |j| training::train_job(cache, splits, &j.spec, &j.dir, |_| {}).map(|_| ()),
-        || progress.advance(1),
+        |skipped| {
+            if skipped {
+                progress.skipped(1)
+            } else {
+                progress.advance(1)
+            }
+        },
     )
 }
 

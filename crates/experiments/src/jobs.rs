@@ -31,6 +31,11 @@ pub trait Progress: Sync {
     fn advance(&self, n: u64) {
         let _ = n;
     }
+    /// `n` units of the current stage were found done by an earlier run and skipped: they count
+    /// as done, but took no time, so an ETA must not learn its pace from them.
+    fn skipped(&self, n: u64) {
+        self.advance(n);
+    }
     /// A one-line status message (e.g. the latest epoch's loss).
     fn message(&self, text: &str) {
         let _ = text;
@@ -78,25 +83,22 @@ pub fn tmp_path(path: &Path) -> PathBuf {
 }
 
 /// Runs `work` on every item in parallel (rayon), skipping those whose `dir(item)` is done, and
-/// calling `progress` after each item (finished or skipped). Returns the first error, after the
-/// other items finished (their work is kept for a resumed run).
+/// calling `progress(skipped)` after each item (`true` when it was done already). Returns the
+/// first error, after the other items finished (their work is kept for a resumed run).
 pub fn run_all<T, E, D, W, P>(items: &[T], dir: D, work: W, progress: P) -> Result<(), E>
 where
     T: Sync,
     E: Send,
     D: Fn(&T) -> PathBuf + Sync,
     W: Fn(&T) -> Result<(), E> + Sync,
-    P: Fn() + Sync,
+    P: Fn(bool) + Sync,
 {
     let errors: Vec<E> = items
         .par_iter()
         .filter_map(|item| {
-            let result = if is_done(&dir(item)) {
-                Ok(())
-            } else {
-                work(item)
-            };
-            progress();
+            let skipped = is_done(&dir(item));
+            let result = if skipped { Ok(()) } else { work(item) };
+            progress(skipped);
             result.err()
         })
         .collect();
@@ -150,12 +152,12 @@ mod tests {
                 std::fs::create_dir_all(job_dir(&i)).unwrap();
                 mark_done(&job_dir(&i)).map_err(|e| e.to_string())
             },
-            || {},
+            |skipped| assert!(!skipped),
         );
         assert_eq!(result, Err("job 5 failed".to_string()));
         assert_eq!(ran.load(Ordering::SeqCst), 8);
         // Resumed run: only job 5 runs again.
-        let ran_again = AtomicUsize::new(0);
+        let (ran_again, skipped_again) = (AtomicUsize::new(0), AtomicUsize::new(0));
         let result: Result<(), String> = run_all(
             &items,
             job_dir,
@@ -165,10 +167,16 @@ mod tests {
                 std::fs::create_dir_all(job_dir(&i)).unwrap();
                 mark_done(&job_dir(&i)).map_err(|e| e.to_string())
             },
-            || {},
+            |skipped| {
+                if skipped {
+                    skipped_again.fetch_add(1, Ordering::SeqCst);
+                }
+            },
         );
         assert!(result.is_ok());
         assert_eq!(ran_again.load(Ordering::SeqCst), 1);
+        // The seven finished ones are reported as skipped, for the ETA to leave them out.
+        assert_eq!(skipped_again.load(Ordering::SeqCst), 7);
     }
 
     #[test]

@@ -119,7 +119,13 @@ pub fn tune(
             )
             .map(|_| ())
         },
-        || progress.advance(1),
+        |skipped| {
+            if skipped {
+                progress.skipped(1)
+            } else {
+                progress.advance(1)
+            }
+        },
     )?;
     let mut runs = Vec::new();
     for p in &points {

@@ -79,6 +79,9 @@ struct Overall<'a> {
     costs: CostModel,
     /// Milliseconds of estimated cost per unit of the current stage.
     per_unit: Mutex<f64>,
+    /// Milliseconds of estimated cost found done by an earlier run: on the bar, but left out of
+    /// the pace the plain-line ETA learns.
+    skipped_ms: std::sync::atomic::AtomicU64,
     /// The plain-line log, when stderr is not a terminal.
     log: Option<Mutex<StageLog>>,
 }
@@ -105,6 +108,14 @@ impl StageLog {
             );
         }
     }
+}
+
+/// Seconds left of a run that has done `done` of `total` units of cost in `elapsed_s` seconds,
+/// `skipped` of them found done by an earlier run (in no time: a resumed run that learned its
+/// pace from them would promise to finish in minutes). `None` before any work was timed.
+fn seconds_left(elapsed_s: f64, done: u64, skipped: u64, total: u64) -> Option<f64> {
+    let worked = done.saturating_sub(skipped);
+    (worked > 0).then(|| elapsed_s * total.saturating_sub(done) as f64 / worked as f64)
 }
 
 /// `h:mm:ss` of a duration.
@@ -141,6 +152,7 @@ impl<'a> Overall<'a> {
             overall,
             costs,
             per_unit: Mutex::new(0.0),
+            skipped_ms: std::sync::atomic::AtomicU64::new(0),
             log,
         }
     }
@@ -148,11 +160,11 @@ impl<'a> Overall<'a> {
     /// The overall ETA from the cost done so far and the time it took.
     fn eta(&self, elapsed: std::time::Duration) -> String {
         let (done, total) = (self.overall.position(), self.overall.length().unwrap_or(1));
-        if done == 0 {
-            return "unknown".into();
+        let skipped = self.skipped_ms.load(std::sync::atomic::Ordering::Relaxed);
+        match seconds_left(elapsed.as_secs_f64(), done, skipped, total) {
+            Some(left) => clock(std::time::Duration::from_secs_f64(left)),
+            None => "unknown".into(),
         }
-        let left = elapsed.as_secs_f64() * (total.saturating_sub(done)) as f64 / done as f64;
-        clock(std::time::Duration::from_secs_f64(left))
     }
 
     fn finish(&self) {
@@ -210,6 +222,14 @@ impl Progress for Overall<'_> {
                 log.last_line = Instant::now();
             }
         }
+    }
+    fn skipped(&self, n: u64) {
+        if let Ok(per_unit) = self.per_unit.lock() {
+            let cost = (*per_unit * n as f64).round() as u64;
+            self.skipped_ms
+                .fetch_add(cost, std::sync::atomic::Ordering::Relaxed);
+        }
+        self.advance(n);
     }
     fn message(&self, text: &str) {
         self.bars.message(text);
@@ -343,4 +363,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::seconds_left;
+
+    #[test]
+    fn the_eta_learns_its_pace_from_work_done_here_only() {
+        // Nothing timed yet, or only work an earlier run finished: no pace to go by.
+        assert_eq!(seconds_left(5.0, 0, 0, 100), None);
+        assert_eq!(seconds_left(5.0, 60, 60, 100), None);
+        // 20 units in 10 s, 80 left: 40 s.
+        assert_eq!(seconds_left(10.0, 20, 0, 100), Some(40.0));
+        // A resumed run: 60 units were found done, 10 more took 10 s; 30 left take 30 s, not
+        // the 4.3 s a pace over all 70 would promise.
+        assert_eq!(seconds_left(10.0, 70, 60, 100), Some(30.0));
+        assert_eq!(seconds_left(10.0, 100, 60, 100), Some(0.0));
+    }
 }
