@@ -153,26 +153,29 @@ fn magnitude(w: [f64; 3], bias: [f64; 3]) -> f64 {
 /// The offset in `[lo, hi]` where `f` is largest: a scan at `step`, then scans ten times finer
 /// around the best, down to [`FINEST_STEP_US`].
 fn search(f: &dyn Fn(i64) -> f64, lo: i64, hi: i64, step: i64) -> i64 {
-    let best_of = |from: i64, to: i64, step: i64| -> i64 {
-        let mut best = (f64::NEG_INFINITY, from);
-        let mut o = from;
-        while o <= to {
-            let c = f(o);
-            if c > best.0 {
-                best = (c, o);
-            }
-            o += step;
-        }
-        best.1
-    };
-    let mut step = step.max(FINEST_STEP_US);
-    let mut best = best_of(lo, hi, step);
-    while step > FINEST_STEP_US {
-        let finer = (step / 10).max(FINEST_STEP_US);
-        best = best_of((best - 2 * step).max(lo), (best + 2 * step).min(hi), finer);
-        step = finer;
+    let steps = steps(step);
+    let mut best = lo;
+    for i in 0..steps.len() {
+        let (from, to, step) = scan(&steps, i, best, (lo, hi));
+        best = best_of(from, grid(from, to, step), f);
     }
     best
+}
+
+/// Scan `i` of [`search`] (`from`, `to`, `step`), after the best `best` of scan `i - 1`: the
+/// whole of `[lo, hi]` at the coarsest step, then two of the previous steps either side of
+/// the best at the next one.
+fn scan(steps: &[i64], i: usize, best: i64, (lo, hi): (i64, i64)) -> (i64, i64, i64) {
+    if i == 0 {
+        (lo, hi, steps[0])
+    } else {
+        let wide = steps[i - 1];
+        (
+            (best - 2 * wide).max(lo),
+            (best + 2 * wide).min(hi),
+            steps[i],
+        )
+    }
 }
 
 /// Every IMU sample of the recording at `path`, in time order, one per timestamp (a sample
@@ -208,6 +211,70 @@ pub(crate) fn in_order(
         }
     }
     true
+}
+
+/// Where the fits may look: the offsets that keep the log inside the IMU's span, and the
+/// log's own span (robot clock, us).
+struct Bounds {
+    lo: i64,
+    hi: i64,
+    log_from: i64,
+    log_to: i64,
+}
+
+/// The [`Bounds`] of `log`'s `pieces` against the IMU `span` of `session`, or why there are
+/// none (no IMU to speak of, an empty log, a log longer than the IMU).
+fn bounds(
+    session: &Path,
+    log: &RobotLog,
+    pieces: &[Piece],
+    span: &Span,
+) -> Result<Bounds, ImuSyncError> {
+    let (Some(first), Some(last)) = (span.first, span.last) else {
+        return Err(no_imu(session, 0));
+    };
+    let (Some(log_from), Some(log_to)) = (
+        pieces.iter().map(|p| p.0).min(),
+        pieces.iter().map(|p| p.1).max(),
+    ) else {
+        return Err(no_imu(session, span.samples));
+    };
+    if span.samples < 2 {
+        return Err(no_imu(session, span.samples));
+    }
+    let (lo, hi) = (first - log_from, last - log_to);
+    if lo > hi {
+        return Err(ImuSyncError::TooLong {
+            log: log.path.clone(),
+            session: session.to_path_buf(),
+            log_s: (log_to - log_from) as f64 * 1e-6,
+            imu_s: (last - first) as f64 * 1e-6,
+        });
+    }
+    Ok(Bounds {
+        lo,
+        hi,
+        log_from,
+        log_to,
+    })
+}
+
+/// Each row's window for the search without the gyroscope's bias, the motion found at
+/// offset `rough`: its bias taken where the labels take it, up to [`REFINE_US`] past its end.
+fn rows(log: &RobotLog, rough: i64) -> Vec<Row> {
+    let still = LabelConfig::default();
+    log.rows
+        .iter()
+        .map(|(_, t)| {
+            let onset = t.motion_start_us + rough;
+            Row {
+                bias_from: onset - still.still_lead_in_us(),
+                bias_to: onset - still.bias_margin_us,
+                end: t.motion_end_us + rough + REFINE_US,
+                pieces: commanded_row(t),
+            }
+        })
+        .collect()
 }
 
 /// Finds the offset of `log` (on the robot's clock) that best aligns its commanded rate with the
@@ -646,19 +713,7 @@ fn search_in_passes(
     step: i64,
 ) -> Result<i64, Stop> {
     let steps = steps(step);
-    // The scan at level `i` after the best `best` of the level before.
-    let scan = |i: usize, best: i64| -> (i64, i64, i64) {
-        if i == 0 {
-            (lo, hi, steps[0])
-        } else {
-            let wide = steps[i - 1];
-            (
-                (best - 2 * wide).max(lo),
-                (best + 2 * wide).min(hi),
-                steps[i],
-            )
-        }
-    };
+    let scan = |i: usize, best: i64| scan(&steps, i, best, (lo, hi));
     let (mut best, mut i) = (lo, 0);
     while i < steps.len() {
         let (from, to, step) = scan(i, best);
@@ -699,28 +754,13 @@ fn search_in_passes(
 fn imu_offset_in_passes(session: &Path, log: &RobotLog) -> Result<ImuFit, Stop> {
     let mut span = Span::default();
     pass(session, &mut [&mut span])?;
-    let (Some(first), Some(last)) = (span.first, span.last) else {
-        return Err(Stop::Failed(no_imu(session, 0)));
-    };
     let pieces = commanded(log);
-    let (Some(log_from), Some(log_to)) = (
-        pieces.iter().map(|p| p.0).min(),
-        pieces.iter().map(|p| p.1).max(),
-    ) else {
-        return Err(Stop::Failed(no_imu(session, span.samples)));
-    };
-    if span.samples < 2 {
-        return Err(Stop::Failed(no_imu(session, span.samples)));
-    }
-    let (lo, hi) = (first - log_from, last - log_to);
-    if lo > hi {
-        return Err(Stop::Failed(ImuSyncError::TooLong {
-            log: log.path.clone(),
-            session: session.to_path_buf(),
-            log_s: (log_to - log_from) as f64 * 1e-6,
-            imu_s: (last - first) as f64 * 1e-6,
-        }));
-    }
+    let Bounds {
+        lo,
+        hi,
+        log_from,
+        log_to,
+    } = bounds(session, log, &pieces, &span)?;
     let mut correlation = |offsets: Vec<i64>| -> Result<HashMap<i64, f64>, Stop> {
         let mut c = Correlation::new(rate, &pieces, offsets);
         pass(session, &mut [&mut c])?;
@@ -729,20 +769,7 @@ fn imu_offset_in_passes(session: &Path, log: &RobotLog) -> Result<ImuFit, Stop> 
     let step = COARSE_STEP_US.max((hi - lo) / MAX_COARSE_STEPS);
     let rough = search_in_passes(&mut correlation, lo, hi, step)?;
     // Again without each motion's gyroscope bias, taken where the labels take it.
-    let still = LabelConfig::default();
-    let rows: Vec<Row> = log
-        .rows
-        .iter()
-        .map(|(_, t)| {
-            let onset = t.motion_start_us + rough;
-            Row {
-                bias_from: onset - still.still_lead_in_us(),
-                bias_to: onset - still.bias_margin_us,
-                end: t.motion_end_us + rough + REFINE_US,
-                pieces: commanded_row(t),
-            }
-        })
-        .collect();
+    let rows = rows(log, rough);
     let mut unbiased = |offsets: Vec<i64>| -> Result<HashMap<i64, f64>, Stop> {
         let mut u = Unbiased::new(&rows, offsets);
         pass(session, &mut [&mut u])?;
@@ -791,28 +818,18 @@ pub fn imu_offset_whole(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyn
         .iter()
         .map(|s| (s.t, magnitude(s.gyroscope.map(f64::from), [0.0; 3])))
         .collect();
-    let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
-        return Err(no_imu(session, 0));
+    let span = Span {
+        first: samples.first().map(|s| s.0),
+        last: samples.last().map(|s| s.0),
+        samples: samples.len(),
     };
     let pieces = commanded(log);
-    let (Some(log_from), Some(log_to)) = (
-        pieces.iter().map(|p| p.0).min(),
-        pieces.iter().map(|p| p.1).max(),
-    ) else {
-        return Err(no_imu(session, samples.len()));
-    };
-    if samples.len() < 2 {
-        return Err(no_imu(session, samples.len()));
-    }
-    let (lo, hi) = (first.0 - log_from, last.0 - log_to);
-    if lo > hi {
-        return Err(ImuSyncError::TooLong {
-            log: log.path.clone(),
-            session: session.to_path_buf(),
-            log_s: (log_to - log_from) as f64 * 1e-6,
-            imu_s: (last.0 - first.0) as f64 * 1e-6,
-        });
-    }
+    let Bounds {
+        lo,
+        hi,
+        log_from,
+        log_to,
+    } = bounds(session, log, &pieces, &span)?;
     let rate = Integral::new(&samples);
     let correlation = |o: i64| -> f64 {
         pieces
@@ -823,17 +840,12 @@ pub fn imu_offset_whole(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyn
     let step = COARSE_STEP_US.max((hi - lo) / MAX_COARSE_STEPS);
     let rough = search(&correlation, lo, hi, step);
     // Again without each motion's gyroscope bias, taken where the labels take it.
-    let still = LabelConfig::default();
-    let rows: Vec<(Integral, Vec<Piece>)> = log
-        .rows
-        .iter()
-        .map(|(_, t)| {
-            let onset = t.motion_start_us + rough;
-            let bias_from = onset - still.still_lead_in_us();
-            let bias_to = onset - still.bias_margin_us;
-            let around = &samples_3d[samples_3d.partition_point(|s| s.t < bias_from)
-                ..samples_3d.partition_point(|s| s.t <= t.motion_end_us + rough + REFINE_US)];
-            let rest: Vec<_> = around.iter().filter(|s| s.t <= bias_to).collect();
+    let rows: Vec<(Integral, Vec<Piece>)> = rows(log, rough)
+        .into_iter()
+        .map(|row| {
+            let around = &samples_3d[samples_3d.partition_point(|s| s.t < row.bias_from)
+                ..samples_3d.partition_point(|s| s.t <= row.end)];
+            let rest: Vec<_> = around.iter().filter(|s| s.t <= row.bias_to).collect();
             let bias: [f64; 3] = std::array::from_fn(|i| {
                 rest.iter().map(|s| f64::from(s.gyroscope[i])).sum::<f64>()
                     / rest.len().max(1) as f64
@@ -842,7 +854,7 @@ pub fn imu_offset_whole(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyn
                 .iter()
                 .map(|s| (s.t, magnitude(s.gyroscope.map(f64::from), bias)))
                 .collect();
-            (Integral::new(&magnitudes), commanded_row(t))
+            (Integral::new(&magnitudes), row.pieces)
         })
         .collect();
     let unbiased = |o: i64| -> f64 {
