@@ -48,6 +48,8 @@ pub mod bundle;
 pub mod cell_layer;
 pub mod data;
 pub mod ftz;
+#[cfg(target_arch = "x86_64")]
+mod grouped_tile;
 pub mod metrics;
 pub mod model;
 mod panels;

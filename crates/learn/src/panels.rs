@@ -8,10 +8,14 @@
 //! contiguous panel streams past.
 //!
 //! Every kernel adds its products in a fixed order (input order, then sample order) with
-//! separate multiplies and adds (no FMA). The kernels are compiled for AVX-512 and AVX2 besides
-//! the baseline and picked at run time, and all three give bit-identical results: a model
-//! trained or evaluated on one x86-64 machine is the same bytes as on any other (a cluster's
-//! nodes need not match).
+//! separate multiplies and adds (no FMA; training's grouped first layer is the one exception,
+//! fused on every target). The kernels are compiled for AVX-512 and AVX2 besides the baseline
+//! and picked at run time, and all three give bit-identical results: a model trained or
+//! evaluated on one x86-64 machine is the same bytes as on any other (a cluster's nodes need
+//! not match). Where a kernel serves several samples at once (the grouped forward, the input
+//! gradient) its AVX-512 form is written by hand in [`crate::grouped_tile`], with the same
+//! operations in the same order, because LLVM keeps the portable form's register tile in
+//! memory.
 
 use std::ops::Range;
 
@@ -24,7 +28,7 @@ const H1: usize = LAYER_SIZES[1];
 pub(crate) const BLOCK: usize = 64;
 
 /// Lanes of the partial sums in [`input_grad`]'s dot products (one AVX-512 register).
-const LANES: usize = 16;
+pub(crate) const LANES: usize = 16;
 
 /// One linear layer in the panel layout (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -143,6 +147,33 @@ pub(crate) fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut 
     }
 }
 
+/// [`dense_forward`] with ReLU of every row of `x` (`n x fan_in`) into `out` (`n x fan_out`),
+/// the same bits as one row at a time. Where the CPU has AVX-512F, a paneled layer takes
+/// [`GROUP`] rows at a time on [`crate::grouped_tile`] without fused multiply-adds: it reads
+/// each weight row once for the group, and where one sample has a zero that another has not it
+/// adds `0 * w`, which can only turn a `-0.0` sum into `+0.0`, a difference the ReLU erases.
+pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
+    let (fan_in, fan_out) = (layer.fan_in, layer.fan_out);
+    let groups = x
+        .chunks(GROUP * fan_in)
+        .zip(out.chunks_mut(GROUP * fan_out));
+    for (x, out) in groups {
+        #[cfg(target_arch = "x86_64")]
+        if x.len() == GROUP * fan_in
+            && fan_out.is_multiple_of(BLOCK)
+            && crate::grouped_tile::available()
+        {
+            let layer_weights = (&layer.weights[..], &layer.bias[..]);
+            tile_blocks::<false>(layer_weights, x, out, 0..fan_out, 0..fan_in);
+            relu_units(out, fan_out, 0..fan_out);
+            continue;
+        }
+        for (x, out) in x.chunks_exact(fan_in).zip(out.chunks_exact_mut(fan_out)) {
+            layer.forward(x, out, true);
+        }
+    }
+}
+
 /// [`dense_forward`] of a paneled layer on an input given as its non-zero entries (`index`
 /// ascending, `value`): the same products in the same order, so the same bits, without
 /// visiting the zeros. Only the outputs `units` (whole blocks) are computed, from the entries
@@ -194,8 +225,56 @@ pub(crate) const GROUP: usize = 4;
 /// `0 * w`, a zero. Fused multiply-adds, correctly rounded on every target (`f32::mul_add`).
 /// Only the outputs `units` (whole blocks) are computed, from the inputs `inputs` (late
 /// fusion's branches: see [`crate::architecture`]).
-#[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
+///
+/// Whole groups run on [`crate::grouped_tile`] where the CPU has AVX-512F (LLVM spills the
+/// portable kernel's accumulators to the stack; the tile keeps them in registers, same bits).
 pub(crate) fn grouped_forward(
+    weights: &[f32],
+    bias: &[f32],
+    (x, rows): (&[f32], usize),
+    out: &mut [f32],
+    (units, inputs): (Range<usize>, Range<usize>),
+    relu: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if rows == GROUP && crate::grouped_tile::available() {
+        let fan_out = bias.len();
+        tile_blocks::<true>((weights, bias), x, out, units.clone(), inputs);
+        if relu {
+            relu_units(&mut out[..rows * fan_out], fan_out, units);
+        }
+        return;
+    }
+    grouped_forward_portable(weights, bias, (x, rows), out, (units, inputs), relu);
+}
+
+/// The outputs `units` (whole blocks) of one whole group of samples (`x`, `GROUP x fan_in`)
+/// from the inputs `inputs`, on [`crate::grouped_tile::tile`], into `out` (rows `fan_out` wide,
+/// before any ReLU). The caller has checked [`crate::grouped_tile::available`].
+#[cfg(target_arch = "x86_64")]
+fn tile_blocks<const FUSED: bool>(
+    (weights, bias): (&[f32], &[f32]),
+    x: &[f32],
+    out: &mut [f32],
+    units: Range<usize>,
+    inputs: Range<usize>,
+) {
+    let (fan_in, fan_out) = (x.len() / GROUP, bias.len());
+    for b in units.start / BLOCK..units.end / BLOCK {
+        let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];
+        let block_bias = &bias[b * BLOCK..][..BLOCK];
+        // SAFETY: the caller checked that the CPU has AVX-512F.
+        let tile =
+            unsafe { crate::grouped_tile::tile::<FUSED>(panel, block_bias, x, inputs.clone()) };
+        for (k, sample) in tile.iter().enumerate() {
+            out[k * fan_out + b * BLOCK..][..BLOCK].copy_from_slice(sample);
+        }
+    }
+}
+
+/// [`grouped_forward`] in portable code (any group size, any CPU).
+#[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
+pub(crate) fn grouped_forward_portable(
     weights: &[f32],
     bias: &[f32],
     (x, rows): (&[f32], usize),
@@ -234,50 +313,69 @@ pub(crate) fn grouped_forward(
         }
     }
     if relu {
-        for sample in out[..rows * fan_out].chunks_exact_mut(fan_out) {
-            for o in sample[units.clone()].iter_mut() {
-                *o = o.max(0.0);
-            }
+        relu_units(&mut out[..rows * fan_out], fan_out, units);
+    }
+}
+
+/// ReLU on the outputs `units` of each sample's row (`fan_out` wide) of `out`.
+fn relu_units(out: &mut [f32], fan_out: usize, units: Range<usize>) {
+    for sample in out.chunks_exact_mut(fan_out) {
+        for o in sample[units.clone()].iter_mut() {
+            *o = o.max(0.0);
         }
     }
 }
 
-/// The gradient at a ReLU layer's input: `dx[i] = (W[i, :] . d)` where the layer's input `h[i]`
-/// (a ReLU output) is positive, else 0 (PyTorch's `threshold_backward`: no gradient where the
-/// ReLU was off, including exactly at 0).
+/// The gradient at a ReLU layer's input, sample by sample: `dx[s, i] = (W[i, :] . d[s, :])`
+/// where the layer's input `h[s, i]` (a ReLU output) is positive, else 0 (PyTorch's
+/// `threshold_backward`: no gradient where the ReLU was off, including exactly at 0). `h` and
+/// `dx` are `n x fan_in`, `d` is `n x fan_out`.
 ///
 /// Each dot product keeps [`LANES`] partial sums, adds them output by output in order, and
-/// reduces them in one fixed tree, so every target gives the same bits.
+/// reduces them in one fixed tree, so every target gives the same bits. The loop runs input by
+/// input over the samples, so a weight row is fetched from L2 once for the batch and read from
+/// L1 by the other samples (one sample at a time, each streamed the whole weight).
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 pub(crate) fn input_grad(weights: &[f32], fan_out: usize, d: &[f32], h: &[f32], dx: &mut [f32]) {
-    let fan_in = h.len();
-    if fan_out.is_multiple_of(BLOCK) {
-        for (i, (&hi, dxi)) in h.iter().zip(dx.iter_mut()).enumerate() {
-            if hi <= 0.0 {
-                *dxi = 0.0;
-                continue;
+    let n = d.len() / fan_out;
+    let fan_in = h.len() / n.max(1);
+    for i in 0..fan_in {
+        // Whole groups first where the CPU has AVX-512F: four samples' dot products side by
+        // side ([`crate::grouped_tile::dot_tile`]), so the adds of one do not wait on the
+        // previous add of the same sum (a dot product alone is bound by the add's latency).
+        // Each sample's sum is the same sequence of operations either way.
+        let mut first = 0;
+        #[cfg(target_arch = "x86_64")]
+        if fan_out.is_multiple_of(BLOCK) && crate::grouped_tile::available() {
+            while first + GROUP <= n {
+                let ds = std::array::from_fn(|k| &d[(first + k) * fan_out..][..fan_out]);
+                // SAFETY: AVX-512F is available (checked just above).
+                let sums = unsafe { crate::grouped_tile::dot_tile(weights, fan_in, i, ds) };
+                for (k, &sum) in sums.iter().enumerate() {
+                    let at = (first + k) * fan_in + i;
+                    dx[at] = if h[at] <= 0.0 { 0.0 } else { sum };
+                }
+                first += GROUP;
             }
-            let mut acc = [0.0_f32; LANES];
-            for (b, db) in d.chunks_exact(BLOCK).enumerate() {
-                let row = &weights[(b * fan_in + i) * BLOCK..][..BLOCK];
-                for (w, dd) in row.chunks_exact(LANES).zip(db.chunks_exact(LANES)) {
-                    for l in 0..LANES {
-                        acc[l] += w[l] * dd[l];
+        }
+        for s in first..n {
+            let (hi, ds) = (h[s * fan_in + i], &d[s * fan_out..][..fan_out]);
+            dx[s * fan_in + i] = if hi <= 0.0 {
+                0.0
+            } else if fan_out.is_multiple_of(BLOCK) {
+                let mut acc = [0.0_f32; LANES];
+                for (b, db) in ds.chunks_exact(BLOCK).enumerate() {
+                    let row = &weights[(b * fan_in + i) * BLOCK..][..BLOCK];
+                    for (w, dd) in row.chunks_exact(LANES).zip(db.chunks_exact(LANES)) {
+                        for l in 0..LANES {
+                            acc[l] += w[l] * dd[l];
+                        }
                     }
                 }
-            }
-            *dxi = reduce(acc);
-        }
-    } else {
-        for ((&hi, dxi), row) in h
-            .iter()
-            .zip(dx.iter_mut())
-            .zip(weights.chunks_exact(fan_out))
-        {
-            *dxi = if hi > 0.0 {
-                row.iter().zip(d).fold(0.0, |s, (&w, &dd)| s + w * dd)
+                reduce(acc)
             } else {
-                0.0
+                let row = &weights[i * fan_out..][..fan_out];
+                row.iter().zip(ds).fold(0.0, |s, (&w, &dd)| s + w * dd)
             };
         }
     }
@@ -285,7 +383,7 @@ pub(crate) fn input_grad(weights: &[f32], fan_out: usize, d: &[f32], h: &[f32], 
 
 /// The sum of the lanes in a fixed pairwise order.
 #[inline(always)]
-fn reduce(mut acc: [f32; LANES]) -> f32 {
+pub(crate) fn reduce(mut acc: [f32; LANES]) -> f32 {
     let mut width = LANES;
     while width > 1 {
         width /= 2;
@@ -296,29 +394,40 @@ fn reduce(mut acc: [f32; LANES]) -> f32 {
     acc[0]
 }
 
-/// `grad_w += x (outer) d` for one sample: input `x` of the layer (zeros skipped), `d` the
-/// gradient at its output; `grad_w` in the panel layout of a `x.len() x d.len()` layer.
+/// `grad_w += x[s, :] (outer) d[s, :]` summed over the samples `s` in order: `x` the layer's
+/// input (`n x fan_in`, zeros skipped), `d` the gradient at its output (`n x fan_out`),
+/// `grad_w` in the panel layout of a `fan_in x fan_out` layer. Each gradient element receives
+/// the samples' products in sample order, the same bits as one sample at a time, but each row
+/// of the gradient is loaded and stored once for the batch rather than once per sample.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
-pub(crate) fn add_outer(grad_w: &mut [f32], x: &[f32], d: &[f32]) {
-    let (fan_in, fan_out) = (x.len(), d.len());
+pub(crate) fn add_outer(grad_w: &mut [f32], (x, fan_in): (&[f32], usize), d: &[f32]) {
+    let n = x.len() / fan_in;
+    let fan_out = d.len() / n.max(1);
     if fan_out.is_multiple_of(BLOCK) {
-        for (panel, db) in grad_w
-            .chunks_exact_mut(fan_in * BLOCK)
-            .zip(d.chunks_exact(BLOCK))
-        {
-            for (&xi, row) in x.iter().zip(panel.chunks_exact_mut(BLOCK)) {
-                if xi != 0.0 {
-                    for (g, &dd) in row.iter_mut().zip(db) {
-                        *g += xi * dd;
+        for (b, panel) in grad_w.chunks_exact_mut(fan_in * BLOCK).enumerate() {
+            for (i, row) in panel.chunks_exact_mut(BLOCK).enumerate() {
+                let mut g = [0.0_f32; BLOCK];
+                g.copy_from_slice(row);
+                for s in 0..n {
+                    let xi = x[s * fan_in + i];
+                    if xi != 0.0 {
+                        let ds = &d[s * fan_out + b * BLOCK..][..BLOCK];
+                        for (g, &dd) in g.iter_mut().zip(ds) {
+                            *g += xi * dd;
+                        }
                     }
                 }
+                row.copy_from_slice(&g);
             }
         }
     } else {
-        for (&xi, row) in x.iter().zip(grad_w.chunks_exact_mut(fan_out)) {
-            if xi != 0.0 {
-                for (g, &dd) in row.iter_mut().zip(d) {
-                    *g += xi * dd;
+        for (i, row) in grad_w.chunks_exact_mut(fan_out).enumerate() {
+            for s in 0..n {
+                let xi = x[s * fan_in + i];
+                if xi != 0.0 {
+                    for (g, &dd) in row.iter_mut().zip(&d[s * fan_out..][..fan_out]) {
+                        *g += xi * dd;
+                    }
                 }
             }
         }
@@ -419,7 +528,7 @@ mod tests {
             );
         }
         let mut grad = layer.zeros_like();
-        add_outer(&mut grad.weights, &x, &d);
+        add_outer(&mut grad.weights, (&x, fan_in), &d);
         let (gw, _) = grad.to_pytorch();
         for o in 0..fan_out {
             for i in 0..fan_in {

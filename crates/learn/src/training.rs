@@ -350,10 +350,7 @@ impl Trainer {
                 labels: 0,
             });
         }
-        Ok(features
-            .chunks_exact(inputs)
-            .map(|x| self.net.predict_one(x))
-            .collect())
+        Ok(self.net.predict(features))
     }
 
     /// The current weights in PyTorch layout.
