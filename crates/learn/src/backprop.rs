@@ -210,7 +210,7 @@ impl Scratch {
 /// per sample over its non-zeros ([`panels::sparse_forward`]). Measured (`benches/training.rs`):
 /// at 75 % non-zero (dynamic, combined) a step takes 274 us grouped against 372 us, at 14 %
 /// (static) 214 us against 184 us. The choice depends on the batch only, so it is reproducible.
-const GROUPED_DENSITY: f64 = 0.35;
+pub(crate) const GROUPED_DENSITY: f64 = 0.35;
 
 /// `sum += row` for each row of `rows` (`sum.len()` wide), in order: a bias gradient.
 fn sum_rows(sum: &mut [f32], rows: &[f32]) {
@@ -269,8 +269,15 @@ pub(crate) fn step(
     }
     // Layers 2 and 3 four samples at a time where the CPU allows (the same bits), the output
     // layer sample by sample.
-    panels::relu_forward_batch(l1, h1, h2);
-    panels::relu_forward_batch(l2, h2, h3);
+    for (a, b) in h1.chunks_exact(H1).zip(h2.chunks_exact_mut(l1.fan_out)) {
+        l1.forward(a, b, true);
+    }
+    for (a, b) in h2
+        .chunks_exact(l1.fan_out)
+        .zip(h3.chunks_exact_mut(l2.fan_out))
+    {
+        l2.forward(a, b, true);
+    }
     for (c, o) in h3
         .chunks_exact(l2.fan_out)
         .zip(out.chunks_exact_mut(OUTPUTS))

@@ -16,14 +16,15 @@
 //! AVX-512F; the portable kernels do the rest.
 
 use std::arch::x86_64::{
-    __m512, _mm_add_ps, _mm_add_ss, _mm_cvtss_f32, _mm_movehl_ps, _mm_shuffle_ps, _mm256_add_ps,
-    _mm256_castpd_ps, _mm256_castps256_ps128, _mm256_extractf128_ps, _mm512_add_ps,
-    _mm512_castpd512_pd256, _mm512_castps_pd, _mm512_extractf64x4_pd, _mm512_fmadd_ps,
-    _mm512_loadu_ps, _mm512_mul_ps, _mm512_set1_ps, _mm512_setzero_ps, _mm512_storeu_ps,
+    _mm512_add_ps, _mm512_fmadd_ps, _mm512_loadu_ps, _mm512_mul_ps, _mm512_set1_ps,
+    _mm512_setzero_ps, _mm512_storeu_ps,
 };
 use std::ops::Range;
 
-use crate::panels::{BLOCK, GROUP, LANES};
+use crate::panels::{BLOCK, GROUP};
+
+/// Floats in one AVX-512 register.
+const LANES: usize = 16;
 
 /// Registers per sample's row of a block.
 const VECTORS: usize = BLOCK / LANES;
@@ -88,61 +89,6 @@ pub(crate) unsafe fn tile<const FUSED: bool>(
     out
 }
 
-/// [`crate::panels::input_grad`]'s dot products `W[i, :] . d[k]` for [`GROUP`] samples side by
-/// side (`weights` paneled, `d[k]` a sample's output gradient, all `fan_out` wide, a multiple
-/// of [`BLOCK`]): lane `l` of sample `k` adds `w * d` output by output in order, as the
-/// portable kernel does, and the lanes are reduced in [`crate::panels::reduce`]'s tree (lane
-/// `l` plus lane `l + 8`, then `+ 4`, `+ 2`, `+ 1`), so each sum has the portable bits. Four
-/// independent sums keep the adds busy where one sum waits on its own previous add.
-///
-/// # Safety
-/// The CPU must support AVX-512F ([`available`]).
-#[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn dot_tile(
-    weights: &[f32],
-    fan_in: usize,
-    i: usize,
-    d: [&[f32]; GROUP],
-) -> [f32; GROUP] {
-    let fan_out = d[0].len();
-    assert!(
-        fan_out.is_multiple_of(BLOCK)
-            && d.iter().all(|d| d.len() == fan_out)
-            && i < fan_in
-            && weights.len() >= fan_in * fan_out
-    );
-    let mut acc = [_mm512_setzero_ps(); GROUP];
-    for b in 0..fan_out / BLOCK {
-        let row = &weights[(b * fan_in + i) * BLOCK..][..BLOCK];
-        for v in 0..VECTORS {
-            // SAFETY: `row` holds BLOCK floats and each `d[k]` fan_out (asserted), so the lanes
-            // v*16.. of the row and b*64 + v*16.. of each sample are in bounds.
-            let w = unsafe { _mm512_loadu_ps(row.as_ptr().add(v * LANES)) };
-            for (a, dk) in acc.iter_mut().zip(&d) {
-                let dd = unsafe { _mm512_loadu_ps(dk.as_ptr().add(b * BLOCK + v * LANES)) };
-                *a = _mm512_add_ps(*a, _mm512_mul_ps(w, dd));
-            }
-        }
-    }
-    acc.map(|a| reduce(a))
-}
-
-/// The sum of a register's lanes in [`crate::panels::reduce`]'s tree.
-#[target_feature(enable = "avx512f")]
-fn reduce(a: __m512) -> f32 {
-    // Lanes 0..8 plus lanes 8..16 (the upper half through a double-precision view: AVX-512F
-    // has no float32 256-bit extract without AVX-512DQ).
-    let high = _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(a)));
-    let low = _mm256_castpd_ps(_mm512_castpd512_pd256(_mm512_castps_pd(a)));
-    let eight = _mm256_add_ps(low, high);
-    let four = _mm_add_ps(
-        _mm256_castps256_ps128(eight),
-        _mm256_extractf128_ps::<1>(eight),
-    );
-    let two = _mm_add_ps(four, _mm_movehl_ps(four, four));
-    _mm_cvtss_f32(_mm_add_ss(two, _mm_shuffle_ps::<1>(two, two)))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,35 +112,6 @@ mod tests {
                 }
             })
             .collect()
-    }
-
-    #[test]
-    fn the_dot_tile_gives_the_portable_input_gradients_bits() {
-        if !available() {
-            eprintln!("no AVX-512F on this CPU: the tile never runs here");
-            return;
-        }
-        for (fan_in, fan_out) in [(256, 128), (128, 64)] {
-            let weights = floats(fan_in * fan_out, 6, 0.0);
-            let d = floats(GROUP * fan_out, 7, 0.1);
-            let ds: [&[f32]; GROUP] = std::array::from_fn(|k| &d[k * fan_out..][..fan_out]);
-            for i in [0, 1, fan_in / 2, fan_in - 1] {
-                // SAFETY: AVX-512F is available (checked above).
-                let got = unsafe { dot_tile(&weights, fan_in, i, ds) };
-                for (k, (got, dk)) in got.iter().zip(ds).enumerate() {
-                    // The portable kernel, one sample with only input i switched on.
-                    let mut h = vec![0.0; fan_in];
-                    h[i] = 1.0;
-                    let mut dx = vec![0.0; fan_in];
-                    crate::panels::input_grad(&weights, fan_out, dk, &h, &mut dx);
-                    assert_eq!(
-                        got.to_bits(),
-                        dx[i].to_bits(),
-                        "{fan_in}x{fan_out}, {i}, {k}"
-                    );
-                }
-            }
-        }
     }
 
     #[test]

@@ -28,7 +28,7 @@ const H1: usize = LAYER_SIZES[1];
 pub(crate) const BLOCK: usize = 64;
 
 /// Lanes of the partial sums in [`input_grad`]'s dot products (one AVX-512 register).
-pub(crate) const LANES: usize = 16;
+const LANES: usize = 16;
 
 /// One linear layer in the panel layout (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -149,7 +149,8 @@ pub(crate) fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut 
 
 /// [`dense_forward`] with ReLU of every row of `x` (`n x fan_in`) into `out` (`n x fan_out`),
 /// the same bits as one row at a time. Where the CPU has AVX-512F, a paneled layer takes
-/// [`GROUP`] rows at a time on [`crate::grouped_tile`] without fused multiply-adds: it reads
+/// [`GROUP`] rows at a time on [`crate::grouped_tile`] without fused multiply-adds if they are
+/// dense enough (as training's forward pass decides, [`crate::backprop::GROUPED_DENSITY`]): it reads
 /// each weight row once for the group, and where one sample has a zero that another has not it
 /// adds `0 * w`, which can only turn a `-0.0` sum into `+0.0`, a difference the ReLU erases.
 pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
@@ -161,6 +162,7 @@ pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
         if x.len() == GROUP * fan_in
             && fan_out.is_multiple_of(BLOCK)
+            && dense_enough(x)
             && crate::grouped_tile::available()
         {
             let layer_weights = (&layer.weights[..], &layer.bias[..]);
@@ -317,6 +319,12 @@ pub(crate) fn grouped_forward_portable(
     }
 }
 
+/// Whether more than [`crate::backprop::GROUPED_DENSITY`] of `x` is non-zero.
+fn dense_enough(x: &[f32]) -> bool {
+    let non_zero = x.iter().filter(|&&v| v != 0.0).count();
+    non_zero as f64 > crate::backprop::GROUPED_DENSITY * x.len() as f64
+}
+
 /// ReLU on the outputs `units` of each sample's row (`fan_out` wide) of `out`.
 fn relu_units(out: &mut [f32], fan_out: usize, units: Range<usize>) {
     for sample in out.chunks_exact_mut(fan_out) {
@@ -334,31 +342,14 @@ fn relu_units(out: &mut [f32], fan_out: usize, units: Range<usize>) {
 /// Each dot product keeps [`LANES`] partial sums, adds them output by output in order, and
 /// reduces them in one fixed tree, so every target gives the same bits. The loop runs input by
 /// input over the samples, so a weight row is fetched from L2 once for the batch and read from
-/// L1 by the other samples (one sample at a time, each streamed the whole weight).
+/// L1 by the other samples. (Four samples' sums side by side on AVX-512 were tried: they must
+/// compute the dot products the ReLU has switched off, about half, and measured slower.)
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 pub(crate) fn input_grad(weights: &[f32], fan_out: usize, d: &[f32], h: &[f32], dx: &mut [f32]) {
     let n = d.len() / fan_out;
     let fan_in = h.len() / n.max(1);
     for i in 0..fan_in {
-        // Whole groups first where the CPU has AVX-512F: four samples' dot products side by
-        // side ([`crate::grouped_tile::dot_tile`]), so the adds of one do not wait on the
-        // previous add of the same sum (a dot product alone is bound by the add's latency).
-        // Each sample's sum is the same sequence of operations either way.
-        let mut first = 0;
-        #[cfg(target_arch = "x86_64")]
-        if fan_out.is_multiple_of(BLOCK) && crate::grouped_tile::available() {
-            while first + GROUP <= n {
-                let ds = std::array::from_fn(|k| &d[(first + k) * fan_out..][..fan_out]);
-                // SAFETY: AVX-512F is available (checked just above).
-                let sums = unsafe { crate::grouped_tile::dot_tile(weights, fan_in, i, ds) };
-                for (k, &sum) in sums.iter().enumerate() {
-                    let at = (first + k) * fan_in + i;
-                    dx[at] = if h[at] <= 0.0 { 0.0 } else { sum };
-                }
-                first += GROUP;
-            }
-        }
-        for s in first..n {
+        for s in 0..n {
             let (hi, ds) = (h[s * fan_in + i], &d[s * fan_out..][..fan_out]);
             dx[s * fan_in + i] = if hi <= 0.0 {
                 0.0
@@ -383,7 +374,7 @@ pub(crate) fn input_grad(weights: &[f32], fan_out: usize, d: &[f32], h: &[f32], 
 
 /// The sum of the lanes in a fixed pairwise order.
 #[inline(always)]
-pub(crate) fn reduce(mut acc: [f32; LANES]) -> f32 {
+fn reduce(mut acc: [f32; LANES]) -> f32 {
     let mut width = LANES;
     while width > 1 {
         width /= 2;
