@@ -348,3 +348,51 @@ fn datasets_without_calibration_or_no_contact_are_refused_unless_opted_out() {
         );
     }
 }
+
+#[test]
+fn no_fusions_trains_the_papers_three_representations_only() {
+    // The tiny run's tuning is done: exporting the jobs that can run now lists Experiments 1
+    // and 2's, for every representation the plan compares.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("models")).unwrap();
+    let copied = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(tiny_run().join("models").join("tuning"))
+        .arg(out.join("models"))
+        .status()
+        .unwrap();
+    assert!(copied.success());
+    let data = tiny_run().join("data").display().to_string();
+    let out_s = out.display().to_string();
+    let export = |extra: &[&str]| {
+        let list = dir.path().join("jobs.txt");
+        let list_s = list.display().to_string();
+        let mut args = vec![
+            "reproduce",
+            "--scale",
+            "tiny",
+            "--seed",
+            "1",
+            "--data",
+            &data,
+        ];
+        args.extend(["--out", &out_s, "--export-jobs", &list_s]);
+        args.extend(extra);
+        run_ok(&args);
+        let jobs = std::fs::read_to_string(&list).unwrap();
+        let count = |repr: &str| {
+            let flag = format!("--repr {repr} ");
+            jobs.lines().filter(|l| l.contains(&flag)).count()
+        };
+        ["static", "dynamic", "combined", "stacked", "late"].map(count)
+    };
+    let all = export(&[]);
+    let paper = export(&["--no-fusions"]);
+    assert!(
+        all.iter().all(|&n| n > 0),
+        "jobs per representation: {all:?}"
+    );
+    assert_eq!(paper[..3], all[..3], "the paper's three keep their jobs");
+    assert_eq!(paper[3..], [0, 0], "no fusion is trained: {paper:?}");
+}

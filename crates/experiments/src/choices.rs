@@ -303,6 +303,17 @@ pub fn of_run(
             "`evtac reproduce --noise-levels`",
         ),
         row(
+            "Learned fusions",
+            if plan.fusions {
+                "stacked and late trained and reported beside the paper's three representations"
+                    .to_string()
+            } else {
+                "left out: the paper's three representations only".to_string()
+            },
+            "not in the paper: does a learned fusion beat the OR?",
+            "`evtac reproduce --no-fusions`",
+        ),
+        row(
             "Latency study",
             format!(
                 "intervals {} ms, up to {} test trials, the first seed's model of each \
@@ -360,6 +371,13 @@ mod tests {
             "uniform in {}..{} deg",
             sim.timeline.stop_range_deg[0], sim.timeline.stop_range_deg[1]
         )));
+        assert!(value(&c, "Learned fusions").starts_with("stacked and late"));
+        let paper_only = Plan {
+            fusions: false,
+            ..plan.clone()
+        };
+        let p = of_run(&paper_only, 7, Some(&sim), Some(&sim));
+        assert!(value(&p, "Learned fusions").starts_with("left out"));
         let recorded = of_run(&Plan::for_scale(Scale::Paper), 0, None, None);
         assert!(value(&recorded, "Tuning grids").contains("every combination"));
         assert!(value(&recorded, "Simulated sensor").starts_with("recorded data"));

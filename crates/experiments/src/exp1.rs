@@ -40,6 +40,20 @@ pub fn paper_representations(
     out
 }
 
+/// The representations a plan compares: [`representations`], less the learned fusions when
+/// the plan leaves them out ([`Plan::fusions`]).
+pub fn of_plan(
+    plan: &Plan,
+    static_cfg: ReprConfig,
+    dynamic_cfg: ReprConfig,
+) -> Vec<(&'static str, ReprConfig)> {
+    if plan.fusions {
+        representations(static_cfg, dynamic_cfg)
+    } else {
+        paper_representations(static_cfg, dynamic_cfg)
+    }
+}
+
 /// The representations compared, display name and config: the paper's three (static,
 /// dynamic, their OR) and the two learned fusions of the same tuned parts (`Stacked`: one dense
 /// network over both frames; `Late`: a branch per frame joined before the head), which are not

@@ -175,7 +175,8 @@ pub fn reproduce(
     stages.done("tuning (static)");
     let dt = tuning::tune(&cache1, &splits1, Kind::Dynamic, &run)?;
     stages.done("tuning (dynamic)");
-    let reprs = exp1::representations(chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
+    let (static_cfg, dynamic_cfg) = (chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
+    let reprs = exp1::of_plan(plan, static_cfg, dynamic_cfg);
 
     let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
     stages.done("experiment 1");
@@ -427,7 +428,7 @@ pub fn export_jobs(
         }
     }
     if let [s, d] = tuned[..] {
-        let reprs = exp1::representations(s, d);
+        let reprs = exp1::of_plan(plan, s, d);
         for j in exp1::jobs(&reprs, plan, seed, &models) {
             if !exp1::finished(&j.dir) {
                 lines.push(train_command(

@@ -49,6 +49,16 @@ pub struct Plan {
     /// together; 1 is Experiment 1 itself). Absent from older plans: none.
     #[serde(default)]
     pub noise_levels: Vec<f64>,
+    /// Whether evtac's learned fusions (`Stacked`, `Late`) are trained and reported beside the
+    /// paper's three representations (`evtac reproduce --no-fusions` leaves them out: the
+    /// paper's own plan, about half the training). Absent from older plans: they were.
+    #[serde(default = "fusions_by_default")]
+    pub fusions: bool,
+}
+
+/// [`Plan::fusions`] of plans written before it existed.
+fn fusions_by_default() -> bool {
+    true
 }
 
 /// The background-noise factors of every scale (`evtac reproduce --noise-levels`): without
@@ -77,6 +87,7 @@ impl Plan {
                 latency_trials: 150,
                 latency_intervals_ms: vec![1, 2, 5, 10],
                 noise_levels: NOISE_LEVELS.to_vec(),
+                fusions: true,
             },
             Scale::Small => Plan {
                 scale,
@@ -106,6 +117,17 @@ impl Plan {
                 latency_trials: 2,
                 ..Plan::for_scale(Scale::Paper)
             },
+        }
+    }
+
+    /// Representations trained per seed in Experiments 1 and 2 and the noise study: the
+    /// paper's three, and the two learned fusions unless left out.
+    pub fn representations(&self) -> usize {
+        let all = crate::exp1::NAMES.len();
+        if self.fusions {
+            all
+        } else {
+            all - crate::exp1::FUSIONS.len()
         }
     }
 

@@ -240,6 +240,8 @@ pub struct Reproduction {
     pub inputs: Inputs,
     /// `--noise-levels` as given, or `None` for the plan's default.
     pub noise_levels: Option<Vec<f64>>,
+    /// `--no-fusions`: the paper's three representations only.
+    pub no_fusions: bool,
 }
 
 impl Reproduction {
@@ -267,6 +269,9 @@ impl Reproduction {
                 let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
                 args.push(levels.join(","));
             }
+        }
+        if self.no_fusions {
+            args.push("--no-fusions".into());
         }
         jobs::command_line(&args)
     }

@@ -82,10 +82,6 @@ impl std::fmt::Display for Stage {
 
 /// Reference costs in seconds on the 2-core development machine, measured in `evtac reproduce
 /// --scale small` (7.7 min).
-/// Representations trained per seed in Experiments 1 and 2 and the noise study
-/// ([`crate::exp1::NAMES`]).
-const REPRS: usize = crate::exp1::NAMES.len();
-
 mod cost {
     /// Simulating one trial (52 s for 448 trials).
     pub const SIMULATE_TRIAL: f64 = 0.116;
@@ -198,6 +194,7 @@ impl CostModel {
     /// Expected seconds of the whole reproduction: every stage it will report.
     pub fn total_seconds(&self) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
+        let reprs = plan.representations();
         let c = |stage: Stage, units: usize| self.seconds(stage, units as u64);
         let tuning_trials = (counts.exp1 as f64 * cost::TUNING_SHARE).round() as usize;
         let mut sum = c(Stage::Simulating(Protocol::Exp1), counts.simulate)
@@ -209,12 +206,12 @@ impl CostModel {
                 Stage::Tuning(Kind::Static),
                 plan.static_grid().len() + plan.dynamic_grid().len(),
             )
-            + c(Stage::Exp1Training, REPRS * plan.seeds)
-            + c(Stage::Latency, REPRS * plan.latency_intervals_ms.len());
+            + c(Stage::Exp1Training, reprs * plan.seeds)
+            + c(Stage::Latency, reprs * plan.latency_intervals_ms.len());
         if counts.exp2 > 0 {
             sum += c(
                 Stage::Exp2Training,
-                crate::exp2::SETTINGS.len() * REPRS * plan.exp2_seeds,
+                crate::exp2::SETTINGS.len() * reprs * plan.exp2_seeds,
             );
         }
         // Every noise level but Experiment 1's own: a dataset, its features and the runs.
@@ -222,7 +219,7 @@ impl CostModel {
         sum += levels as f64
             * (c(Stage::NoiseSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::Noise), counts.exp1)
-                + c(Stage::NoiseTraining, REPRS * plan.seeds));
+                + c(Stage::NoiseTraining, reprs * plan.seeds));
         sum
     }
 }
@@ -254,7 +251,8 @@ mod tests {
             simulate: 80,
         };
         let model = CostModel::new(&plan, counts);
-        let training = model.seconds(Stage::Exp1Training, (REPRS * plan.seeds) as u64);
+        let reprs = plan.representations();
+        let training = model.seconds(Stage::Exp1Training, (reprs * plan.seeds) as u64);
         assert!(training > 0.0);
         let with_exp2 = CostModel::new(&plan, TrialCounts { exp2: 30, ..counts });
         assert!(with_exp2.total_seconds() > model.total_seconds());
@@ -267,10 +265,28 @@ mod tests {
         let noise = model.total_seconds() - without_noise;
         let per_level = model.seconds(Stage::NoiseSimulating, 60)
             + model.seconds(Stage::Features(FeatureSet::Noise), 60)
-            + model.seconds(Stage::NoiseTraining, (REPRS * plan.seeds) as u64);
+            + model.seconds(Stage::NoiseTraining, (reprs * plan.seeds) as u64);
         assert!(
             (noise - 2.0 * per_level).abs() < 1e-9,
             "{noise} vs 2 x {per_level}"
+        );
+        // Without the learned fusions: three representations' runs instead of five.
+        let paper_only = Plan {
+            fusions: false,
+            ..plan.clone()
+        };
+        assert_eq!(
+            (plan.representations(), paper_only.representations()),
+            (5, 3)
+        );
+        let fewer = CostModel::new(&paper_only, counts).total_seconds();
+        let per_repr = model.seconds(Stage::Exp1Training, plan.seeds as u64)
+            + model.seconds(Stage::Latency, plan.latency_intervals_ms.len() as u64)
+            + 2.0 * model.seconds(Stage::NoiseTraining, plan.seeds as u64);
+        let saved = model.total_seconds() - fewer;
+        assert!(
+            (saved - 2.0 * per_repr).abs() < 1e-6,
+            "{saved} vs 2 x {per_repr}"
         );
     }
 }

@@ -41,6 +41,11 @@ pub struct Args {
     /// Default: the plan's (0,1,3 at every scale). Needs simulated Experiment 1 data.
     #[arg(long, value_delimiter = ',', num_args = 0..)]
     pub noise_levels: Option<Vec<f64>>,
+    /// Leave out evtac's learned fusions (stacked, late): train and report the paper's three
+    /// representations only. With `--noise-levels` given empty, this is the paper's own plan
+    /// (195 training runs at `--scale paper` instead of 375).
+    #[arg(long)]
+    pub no_fusions: bool,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -249,6 +254,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         data: args.data.as_ref().map(absolute).transpose()?,
         inputs: args.inputs.inputs(),
         noise_levels: args.noise_levels.clone(),
+        no_fusions: args.no_fusions,
     };
     let slurm = Slurm {
         sbatch_args: args
@@ -283,6 +289,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         plan.noise_levels = levels.clone();
     }
+    plan.fusions = !args.no_fusions;
     anyhow::ensure!(
         args.slurm_args.is_none() || args.executor == Executor::Slurm,
         "--slurm-args is for --executor slurm"
