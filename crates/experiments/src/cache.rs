@@ -369,9 +369,14 @@ impl<'a> FeatureCache<'a> {
         };
         // Sized once: growing a paper-scale set (126 MB of features) by doubling copied it
         // and faulted in fresh pages several times over (perf: a fifth of a short run).
-        out.set.features.reserve_exact(parts.iter().map(|p| p.0.len()).sum());
-        out.set.labels.reserve_exact(parts.iter().map(|p| p.1.len()).sum());
-        out.samples.reserve_exact(parts.iter().map(|p| p.2.len()).sum());
+        out.set
+            .features
+            .reserve_exact(parts.iter().map(|p| p.0.len()).sum());
+        out.set
+            .labels
+            .reserve_exact(parts.iter().map(|p| p.1.len()).sum());
+        out.samples
+            .reserve_exact(parts.iter().map(|p| p.2.len()).sum());
         for (f, l, m) in parts {
             out.set.features.extend(f);
             out.set.labels.extend(l);

@@ -334,39 +334,42 @@ fn relu_units(out: &mut [f32], fan_out: usize, units: Range<usize>) {
     }
 }
 
-/// The gradient at a ReLU layer's input, sample by sample: `dx[s, i] = (W[i, :] . d[s, :])`
-/// where the layer's input `h[s, i]` (a ReLU output) is positive, else 0 (PyTorch's
-/// `threshold_backward`: no gradient where the ReLU was off, including exactly at 0). `h` and
-/// `dx` are `n x fan_in`, `d` is `n x fan_out`.
+/// The gradient at a ReLU layer's input: `dx[i] = (W[i, :] . d)` where the layer's input `h[i]`
+/// (a ReLU output) is positive, else 0 (PyTorch's `threshold_backward`: no gradient where the
+/// ReLU was off, including exactly at 0).
 ///
 /// Each dot product keeps [`LANES`] partial sums, adds them output by output in order, and
-/// reduces them in one fixed tree, so every target gives the same bits. The loop runs input by
-/// input over the samples, so a weight row is fetched from L2 once for the batch and read from
-/// L1 by the other samples. (Four samples' sums side by side on AVX-512 were tried: they must
-/// compute the dot products the ReLU has switched off, about half, and measured slower.)
+/// reduces them in one fixed tree, so every target gives the same bits.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
 pub(crate) fn input_grad(weights: &[f32], fan_out: usize, d: &[f32], h: &[f32], dx: &mut [f32]) {
-    let n = d.len() / fan_out;
-    let fan_in = h.len() / n.max(1);
-    for i in 0..fan_in {
-        for s in 0..n {
-            let (hi, ds) = (h[s * fan_in + i], &d[s * fan_out..][..fan_out]);
-            dx[s * fan_in + i] = if hi <= 0.0 {
-                0.0
-            } else if fan_out.is_multiple_of(BLOCK) {
-                let mut acc = [0.0_f32; LANES];
-                for (b, db) in ds.chunks_exact(BLOCK).enumerate() {
-                    let row = &weights[(b * fan_in + i) * BLOCK..][..BLOCK];
-                    for (w, dd) in row.chunks_exact(LANES).zip(db.chunks_exact(LANES)) {
-                        for l in 0..LANES {
-                            acc[l] += w[l] * dd[l];
-                        }
+    let fan_in = h.len();
+    if fan_out.is_multiple_of(BLOCK) {
+        for (i, (&hi, dxi)) in h.iter().zip(dx.iter_mut()).enumerate() {
+            if hi <= 0.0 {
+                *dxi = 0.0;
+                continue;
+            }
+            let mut acc = [0.0_f32; LANES];
+            for (b, db) in d.chunks_exact(BLOCK).enumerate() {
+                let row = &weights[(b * fan_in + i) * BLOCK..][..BLOCK];
+                for (w, dd) in row.chunks_exact(LANES).zip(db.chunks_exact(LANES)) {
+                    for l in 0..LANES {
+                        acc[l] += w[l] * dd[l];
                     }
                 }
-                reduce(acc)
+            }
+            *dxi = reduce(acc);
+        }
+    } else {
+        for ((&hi, dxi), row) in h
+            .iter()
+            .zip(dx.iter_mut())
+            .zip(weights.chunks_exact(fan_out))
+        {
+            *dxi = if hi > 0.0 {
+                row.iter().zip(d).fold(0.0, |s, (&w, &dd)| s + w * dd)
             } else {
-                let row = &weights[i * fan_out..][..fan_out];
-                row.iter().zip(ds).fold(0.0, |s, (&w, &dd)| s + w * dd)
+                0.0
             };
         }
     }
@@ -385,40 +388,29 @@ fn reduce(mut acc: [f32; LANES]) -> f32 {
     acc[0]
 }
 
-/// `grad_w += x[s, :] (outer) d[s, :]` summed over the samples `s` in order: `x` the layer's
-/// input (`n x fan_in`, zeros skipped), `d` the gradient at its output (`n x fan_out`),
-/// `grad_w` in the panel layout of a `fan_in x fan_out` layer. Each gradient element receives
-/// the samples' products in sample order, the same bits as one sample at a time, but each row
-/// of the gradient is loaded and stored once for the batch rather than once per sample.
+/// `grad_w += x (outer) d` for one sample: input `x` of the layer (zeros skipped), `d` the
+/// gradient at its output; `grad_w` in the panel layout of a `x.len() x d.len()` layer.
 #[multiversion::multiversion(targets("x86_64+avx512f", "x86_64+avx2"))]
-pub(crate) fn add_outer(grad_w: &mut [f32], (x, fan_in): (&[f32], usize), d: &[f32]) {
-    let n = x.len() / fan_in;
-    let fan_out = d.len() / n.max(1);
+pub(crate) fn add_outer(grad_w: &mut [f32], x: &[f32], d: &[f32]) {
+    let (fan_in, fan_out) = (x.len(), d.len());
     if fan_out.is_multiple_of(BLOCK) {
-        for (b, panel) in grad_w.chunks_exact_mut(fan_in * BLOCK).enumerate() {
-            for (i, row) in panel.chunks_exact_mut(BLOCK).enumerate() {
-                let mut g = [0.0_f32; BLOCK];
-                g.copy_from_slice(row);
-                for s in 0..n {
-                    let xi = x[s * fan_in + i];
-                    if xi != 0.0 {
-                        let ds = &d[s * fan_out + b * BLOCK..][..BLOCK];
-                        for (g, &dd) in g.iter_mut().zip(ds) {
-                            *g += xi * dd;
-                        }
+        for (panel, db) in grad_w
+            .chunks_exact_mut(fan_in * BLOCK)
+            .zip(d.chunks_exact(BLOCK))
+        {
+            for (&xi, row) in x.iter().zip(panel.chunks_exact_mut(BLOCK)) {
+                if xi != 0.0 {
+                    for (g, &dd) in row.iter_mut().zip(db) {
+                        *g += xi * dd;
                     }
                 }
-                row.copy_from_slice(&g);
             }
         }
     } else {
-        for (i, row) in grad_w.chunks_exact_mut(fan_out).enumerate() {
-            for s in 0..n {
-                let xi = x[s * fan_in + i];
-                if xi != 0.0 {
-                    for (g, &dd) in row.iter_mut().zip(&d[s * fan_out..][..fan_out]) {
-                        *g += xi * dd;
-                    }
+        for (&xi, row) in x.iter().zip(grad_w.chunks_exact_mut(fan_out)) {
+            if xi != 0.0 {
+                for (g, &dd) in row.iter_mut().zip(d) {
+                    *g += xi * dd;
                 }
             }
         }
@@ -519,7 +511,7 @@ mod tests {
             );
         }
         let mut grad = layer.zeros_like();
-        add_outer(&mut grad.weights, (&x, fan_in), &d);
+        add_outer(&mut grad.weights, &x, &d);
         let (gw, _) = grad.to_pytorch();
         for o in 0..fan_out {
             for i in 0..fan_in {
