@@ -396,3 +396,57 @@ fn no_fusions_trains_the_papers_three_representations_only() {
     assert_eq!(paper[..3], all[..3], "the paper's three keep their jobs");
     assert_eq!(paper[3..], [0, 0], "no fusion is trained: {paper:?}");
 }
+
+#[test]
+fn a_resumed_reproductions_report_tables_every_invocations_stages() {
+    // `tiny_run` ran twice: the second invocation resumed the first.
+    let out = tiny_run();
+    let run = &results(out)["run"];
+    let history = run["stage_history"]
+        .as_array()
+        .expect("stage_history")
+        .clone();
+    let stages_of = |invocation: u64| -> Vec<String> {
+        history
+            .iter()
+            .filter(|r| r["invocation"] == invocation)
+            .map(|r| r["stage"].as_str().expect("stage").to_string())
+            .collect()
+    };
+    let (first, second) = (stages_of(1), stages_of(2));
+    assert_eq!(
+        first.first().map(String::as_str),
+        Some("simulation"),
+        "{first:?}"
+    );
+    for stage in ["tuning (static)", "experiment 1", "latency", "report"] {
+        assert!(
+            first.iter().any(|s| s == stage),
+            "no `{stage}` in {first:?}"
+        );
+    }
+    // The second wrote results.json during its report stage: its stages up to the latency.
+    for stage in ["simulation", "experiment 1", "latency"] {
+        assert!(
+            second.iter().any(|s| s == stage),
+            "no `{stage}` in {second:?}"
+        );
+    }
+    let csv = std::fs::read_to_string(out.join("stage-times.csv")).unwrap();
+    assert!(csv.starts_with("invocation,stage,seconds\n"));
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("2,")).next_back(),
+        csv.lines().last(),
+        "the second invocation's report row ends the log"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("produced by 2 invocations") && report.contains("| 1 | simulation |"),
+        "the report does not table both invocations"
+    );
+    let total: f64 = history.iter().map(|r| r["seconds"].as_f64().unwrap()).sum();
+    assert!(
+        report.contains(&format!("| | total | {total:.1} |")),
+        "the report's total is not the invocations' sum ({total:.1})"
+    );
+}

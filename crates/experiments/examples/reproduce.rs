@@ -32,7 +32,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     eprintln!("simulated in {:.1} s", started.elapsed().as_secs_f64());
-    let results = reproduce(&Datasets::in_dir(&data), &plan, seed, &out, &Quiet)?;
+    let log = evtac_experiments::stage_log::StageLog::open(&out)?;
+    let results = reproduce(&Datasets::in_dir(&data), &plan, seed, &out, &log, &Quiet)?;
     for (stage, s) in &results.run.stage_seconds {
         eprintln!("{stage}: {s:.1} s");
     }

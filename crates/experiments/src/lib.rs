@@ -77,6 +77,7 @@ pub mod sensor_view;
 pub mod slurm;
 pub mod splits;
 pub mod stage;
+pub mod stage_log;
 pub mod sync;
 pub mod training;
 pub mod trial_folder;

@@ -13,6 +13,7 @@ use crate::results::{Results, RunInfo};
 use crate::sampling::Sampling;
 use crate::splits::Split;
 use crate::stage::Stage;
+use crate::stage_log::StageLog;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
 use crate::{
@@ -56,6 +57,9 @@ pub enum Error {
     /// The `done` marker of a simulated dataset could not be written.
     #[error(transparent)]
     Jobs(#[from] jobs::Error),
+    /// The log of stage times (`stage-times.csv`) could not be read or appended to.
+    #[error(transparent)]
+    StageLog(#[from] crate::stage_log::Error),
     /// A tuning run's chosen config could not be read back.
     #[error("the {0} tuning chose no readable config")]
     NoChoice(&'static str),
@@ -126,18 +130,23 @@ pub fn simulate_all(
     Ok(())
 }
 
+/// This invocation's stages as they finish: kept for the results, shown, and appended to the
+/// output folder's [`StageLog`].
 struct Stages<'a> {
     list: Vec<(String, f64)>,
     started: Instant,
     progress: &'a dyn Progress,
+    log: &'a StageLog,
 }
 
 impl Stages<'_> {
-    fn done(&mut self, name: &str) {
+    fn done(&mut self, name: &str) -> Result<(), Error> {
         let s = self.started.elapsed().as_secs_f64();
         self.list.push((name.to_string(), s));
         self.progress.message(&format!("{name}: {s:.1} s"));
+        self.log.record(name, s)?;
         self.started = Instant::now();
+        Ok(())
     }
 }
 
@@ -145,12 +154,15 @@ fn chosen(t: &crate::results::Tuning, kind: Kind) -> Result<ReprConfig, Error> {
     tuning::chosen(t).ok_or(Error::NoChoice(kind.name()))
 }
 
-/// Runs the whole protocol on `data` and writes the report into `out`.
+/// Runs the whole protocol on `data` and writes the report into `out`. Each stage's time is
+/// appended to `log` (the output folder's, opened by this invocation) as it finishes; the
+/// report tables every invocation's.
 pub fn reproduce(
     data: &Datasets,
     plan: &Plan,
     seed: u64,
     out: &Path,
+    log: &StageLog,
     progress: &dyn Progress,
 ) -> Result<Results, Error> {
     evtac_learn::flush_denormals();
@@ -158,6 +170,7 @@ pub fn reproduce(
         list: Vec::new(),
         started: Instant::now(),
         progress,
+        log,
     };
     let models = out.join("models");
     let ds1 = Dataset::open(&data.exp1, data.inputs)?;
@@ -172,17 +185,17 @@ pub fn reproduce(
         progress,
     };
     let st = tuning::tune(&cache1, &splits1, Kind::Static, &run)?;
-    stages.done("tuning (static)");
+    stages.done("tuning (static)")?;
     let dt = tuning::tune(&cache1, &splits1, Kind::Dynamic, &run)?;
-    stages.done("tuning (dynamic)");
+    stages.done("tuning (dynamic)")?;
     let (static_cfg, dynamic_cfg) = (chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
     let reprs = exp1::of_plan(plan, static_cfg, dynamic_cfg);
 
     let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
-    stages.done("experiment 1");
+    stages.done("experiment 1")?;
     let noise = noise::run(&ds1, &e1, &reprs, &run, out)?;
     if !noise.is_empty() {
-        stages.done("experiment 1 at other noise");
+        stages.done("experiment 1 at other noise")?;
     }
 
     let mut e2 = Vec::new();
@@ -211,7 +224,7 @@ pub fn reproduce(
             let refs: Vec<(&str, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
             example = Some(examples::example_trial(&cache2, meta, &refs)?);
         }
-        stages.done("experiment 2");
+        stages.done("experiment 2")?;
     }
 
     let exp1_models: Vec<(&str, Vec<Model>)> = reprs
@@ -243,7 +256,7 @@ pub fn reproduce(
         }
     }
     if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
-        stages.done("experiment 3");
+        stages.done("experiment 3")?;
     }
     let overlays = examples::overlays(&cache1, reprs[0].1, reprs[1].1)?;
     // The paper's Fig. 2 and the sensor's camera view, both on the first test trial.
@@ -280,7 +293,7 @@ pub fn reproduce(
             progress.advance(1);
         }
     }
-    stages.done("latency");
+    stages.done("latency")?;
 
     let mut results = Results {
         run: RunInfo {
@@ -288,6 +301,7 @@ pub fn reproduce(
             seed,
             plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
             stage_seconds: Vec::new(),
+            stage_history: Vec::new(),
             datasets,
             inputs: Some(data.inputs),
         },
@@ -311,9 +325,11 @@ pub fn reproduce(
         sensor,
     };
     results.run.stage_seconds = stages.list.clone();
+    results.run.stage_history = log.records();
     report::write(out, &results)?;
-    stages.done("report");
+    stages.done("report")?;
     results.run.stage_seconds = stages.list;
+    results.run.stage_history = log.records();
     Ok(results)
 }
 

@@ -4,7 +4,7 @@
 use crate::exp2::SETTINGS;
 use crate::io::IoError;
 use crate::plots;
-use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, SensorKind};
+use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -241,12 +241,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
              finish in minutes, so its standard deviations rest on few runs.\n"
         );
     }
-    let _ = writeln!(md, "| stage | seconds |\n| --- | ---: |");
-    for (stage, s) in &r.run.stage_seconds {
-        let _ = writeln!(md, "| {stage} | {s:.1} |");
-    }
-    let total: f64 = r.run.stage_seconds.iter().map(|s| s.1).sum();
-    let _ = writeln!(md, "| total | {total:.1} |\n");
+    stage_table(&mut md, &r.run);
 
     md.push_str(&crate::label_check::section(r.labels.as_ref()));
 
@@ -634,6 +629,49 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
 /// Statistics shown for a representation in Experiment 1, if present.
 pub fn exp1_stats<'a>(r: &'a Results, name: &str) -> Option<&'a MaeStats> {
     r.exp1.iter().find(|e| e.name == name).map(|e| &e.test)
+}
+
+/// The stage times: every invocation's that worked on the output folder (a resumed
+/// reproduction's report states what the whole took), or this invocation's in results written
+/// before the log was kept.
+fn stage_table(md: &mut String, run: &RunInfo) {
+    let history = &run.stage_history;
+    let invocations = history.iter().map(|r| r.invocation).max().unwrap_or(0);
+    if invocations > 1 {
+        let _ = writeln!(
+            md,
+            "This output folder was produced by {invocations} invocations, each resuming the one \
+             before it (finished jobs are skipped, so a later invocation's stage can be short); \
+             the total is their sum.\n"
+        );
+        let _ = writeln!(
+            md,
+            "| invocation | stage | seconds |\n| ---: | --- | ---: |"
+        );
+        for r in history {
+            let _ = writeln!(md, "| {} | {} | {:.1} |", r.invocation, r.stage, r.seconds);
+        }
+        let total: f64 = history.iter().map(|r| r.seconds).sum();
+        let _ = writeln!(md, "| | total | {total:.1} |\n");
+        return;
+    }
+    let rows: Vec<(&str, f64)> = if history.is_empty() {
+        run.stage_seconds
+            .iter()
+            .map(|(s, t)| (s.as_str(), *t))
+            .collect()
+    } else {
+        history
+            .iter()
+            .map(|r| (r.stage.as_str(), r.seconds))
+            .collect()
+    };
+    let _ = writeln!(md, "| stage | seconds |\n| --- | ---: |");
+    for (stage, s) in &rows {
+        let _ = writeln!(md, "| {stage} | {s:.1} |");
+    }
+    let total: f64 = rows.iter().map(|r| r.1).sum();
+    let _ = writeln!(md, "| total | {total:.1} |\n");
 }
 
 #[cfg(test)]

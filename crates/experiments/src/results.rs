@@ -227,8 +227,12 @@ pub struct RunInfo {
     pub seed: u64,
     /// The plan (grids, epochs, seeds) as run.
     pub plan: serde_json::Value,
-    /// Wall time per stage in seconds, in order.
+    /// Wall time per stage in seconds, in order: this invocation's.
     pub stage_seconds: Vec<(String, f64)>,
+    /// Every invocation's stages that worked on this output folder, the simulation included
+    /// (`stage-times.csv`; absent in results written before it was kept).
+    #[serde(default)]
+    pub stage_history: Vec<crate::stage_log::StageRecord>,
     /// Trials per dataset.
     pub datasets: Vec<(String, usize)>,
     /// Where every dataset's calibration and mask came from (absent in results written before

@@ -11,6 +11,7 @@ use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
 use evtac_experiments::slurm::{Reproduction, Slurm};
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
+use evtac_experiments::stage_log::StageLog;
 use evtac_sim::Scale;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -88,21 +89,21 @@ struct Overall<'a> {
     /// the pace the plain-line ETA learns.
     skipped_ms: std::sync::atomic::AtomicU64,
     /// The plain-line log, when stderr is not a terminal.
-    log: Option<Mutex<StageLog>>,
+    log: Option<Mutex<PlainLog>>,
 }
 
 /// How often a plain-line log reports progress within a stage.
 const LOG_EVERY: std::time::Duration = std::time::Duration::from_secs(60);
 
 /// What the plain-line log knows of the current stage.
-struct StageLog {
+struct PlainLog {
     started: Instant,
     stage: Option<(String, Instant, u64)>,
     done: u64,
     last_line: Instant,
 }
 
-impl StageLog {
+impl PlainLog {
     /// Ends the current stage's line, if any.
     fn end_stage(&mut self) {
         if let Some((name, since, _)) = self.stage.take() {
@@ -145,7 +146,7 @@ impl<'a> Overall<'a> {
                 clock(std::time::Duration::from_secs_f64(costs.total_seconds())),
                 LOG_EVERY.as_secs()
             );
-            Mutex::new(StageLog {
+            Mutex::new(PlainLog {
                 started: Instant::now(),
                 stage: None,
                 done: 0,
@@ -309,15 +310,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => TrialCounts::of_simulation(&sim_dir, args.scale, args.seed),
     };
     let bars = Overall::new(&bars, CostModel::new(&plan, counts));
+    // Every invocation's stage times go to OUT/stage-times.csv: a resumed run's report
+    // states what the whole reproduction took.
+    let log = StageLog::open(&args.out)?;
     let data_dir = match &args.data {
         Some(d) => d.clone(),
         None => {
             let d = sim_dir;
             pool.install(|| pipeline::simulate_all(&d, args.scale, args.seed, &bars))?;
-            bars.message(&format!(
-                "simulated datasets ready in {:.1} s",
-                started.elapsed().as_secs_f64()
-            ));
+            let seconds = started.elapsed().as_secs_f64();
+            bars.message(&format!("simulated datasets ready in {seconds:.1} s"));
+            log.record("simulation", seconds)?;
             d
         }
     };
@@ -352,7 +355,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let results =
-        pool.install(|| pipeline::reproduce(&data, &plan, args.seed, &args.out, &bars))?;
+        pool.install(|| pipeline::reproduce(&data, &plan, args.seed, &args.out, &log, &bars))?;
     bars.finish();
     println!("{}", args.out.join("report.md").display());
     for e in &results.exp1 {
