@@ -435,7 +435,7 @@ fn a_resumed_reproductions_report_tables_every_invocations_stages() {
     let csv = std::fs::read_to_string(out.join("stage-times.csv")).unwrap();
     assert!(csv.starts_with("invocation,stage,seconds\n"));
     assert_eq!(
-        csv.lines().filter(|l| l.starts_with("2,")).next_back(),
+        csv.lines().rfind(|l| l.starts_with("2,")),
         csv.lines().last(),
         "the second invocation's report row ends the log"
     );
