@@ -34,7 +34,17 @@ pub fn tiny_run() -> &'static Path {
         let exp1 = |out: &Path| results(out)["exp1"].clone();
         let noise = |out: &Path| results(out)["noise"].clone();
         let (first, first_noise) = (exp1(&out), noise(&out));
-        run_ok(&args);
+        let resumed = String::from_utf8_lossy(&run_ok(&args).stderr).into_owned();
+        // Its stages say what an earlier run had finished (features and training alike).
+        for line in [
+            "experiment 1 training: done in ",
+            " (10 of 10 found done by an earlier run)",
+        ] {
+            assert!(
+                resumed.contains(line),
+                "no `{line}` in the resumed log:\n{resumed}"
+            );
+        }
         assert_eq!(exp1(&out), first, "a resumed run changed Experiment 1");
         assert_eq!(
             noise(&out),

@@ -221,13 +221,14 @@ impl<'a> FeatureCache<'a> {
 
     /// Makes sure the features of every `config` exist for every trial: trials in parallel, each
     /// read once and run through one [`FeatureExtractor`] for all its missing configs.
-    /// `progress` is called once per trial.
+    /// `progress` is called once per trial, with `true` when every feature the trial needed was
+    /// cached already (no time spent: an ETA must not learn its pace from it).
     pub fn ensure(
         &self,
         trials: &[&TrialMeta],
         configs: &[ReprConfig],
         sampling: Sampling,
-        progress: &(dyn Fn() + Sync),
+        progress: &(dyn Fn(bool) + Sync),
     ) -> Result<CacheStats, Error> {
         let dirs: Vec<PathBuf> = configs
             .iter()
@@ -264,7 +265,7 @@ impl<'a> FeatureCache<'a> {
                     self.compute(meta, &samples, configs, &masks, &dirs, &missing)?;
                     computed.fetch_add(missing.len(), Ordering::Relaxed);
                 }
-                progress();
+                progress(missing.is_empty());
                 Ok(())
             })?;
         Ok(CacheStats {
@@ -323,7 +324,7 @@ impl<'a> FeatureCache<'a> {
         sampling: Sampling,
         phases: &[Phase],
     ) -> Result<LoadedSet, Error> {
-        self.ensure(trials, std::slice::from_ref(config), sampling, &|| {})?;
+        self.ensure(trials, std::slice::from_ref(config), sampling, &|_| {})?;
         let dir = self.config_dir(config, sampling)?;
         let parts: Vec<(Vec<f32>, Vec<f32>, Vec<SampleMeta>)> = trials
             .par_iter()

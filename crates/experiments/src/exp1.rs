@@ -167,13 +167,7 @@ pub fn train_all(
         jobs,
         |j| j.dir.clone(),
         |j| training::train_job(cache, splits, &j.spec, &j.dir, |_| {}).map(|_| ()),
-        |skipped| {
-            if skipped {
-                progress.skipped(1)
-            } else {
-                progress.advance(1)
-            }
-        },
+        |skipped| progress.finished(skipped),
     )
 }
 
@@ -200,7 +194,9 @@ pub fn features_then_training(
     )?;
     let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
     progress.stage(Stage::Features(features), all.len() as u64);
-    cache.ensure(&all, &configs, sampling, &|| progress.advance(1))?;
+    cache.ensure(&all, &configs, sampling, &|reused| {
+        progress.finished(reused)
+    })?;
     progress.stage(training, jobs.len() as u64);
     train_all(cache, splits, jobs, progress)
 }

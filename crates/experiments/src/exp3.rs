@@ -58,7 +58,9 @@ pub fn run(
         Axis::Depth => FeatureSet::Exp3Depth,
     };
     progress.stage(Stage::Features(set), trials.len() as u64);
-    cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
+    cache.ensure(&trials, &configs, Sampling::MOTION, &|reused| {
+        progress.finished(reused)
+    })?;
     let mut out = Vec::new();
     for (name, ms) in models {
         let Some(first) = ms.first() else { continue };

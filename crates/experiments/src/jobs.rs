@@ -36,6 +36,15 @@ pub trait Progress: Sync {
     fn skipped(&self, n: u64) {
         self.advance(n);
     }
+    /// One unit of the current stage is finished: found done by an earlier run when `skipped`
+    /// ([`Progress::skipped`]), else done now ([`Progress::advance`]).
+    fn finished(&self, skipped: bool) {
+        if skipped {
+            self.skipped(1)
+        } else {
+            self.advance(1)
+        }
+    }
     /// A one-line status message (e.g. the latest epoch's loss).
     fn message(&self, text: &str) {
         let _ = text;

@@ -104,7 +104,9 @@ pub fn tune(
         Stage::Features(FeatureSet::Tuning(kind)),
         trials.len() as u64,
     );
-    cache.ensure(&trials, &configs, Sampling::MOTION, &|| progress.advance(1))?;
+    cache.ensure(&trials, &configs, Sampling::MOTION, &|reused| {
+        progress.finished(reused)
+    })?;
     progress.stage(Stage::Tuning(kind), points.len() as u64);
     jobs::run_all(
         &points,
@@ -119,13 +121,7 @@ pub fn tune(
             )
             .map(|_| ())
         },
-        |skipped| {
-            if skipped {
-                progress.skipped(1)
-            } else {
-                progress.advance(1)
-            }
-        },
+        |skipped| progress.finished(skipped),
     )?;
     let mut runs = Vec::new();
     for p in &points {

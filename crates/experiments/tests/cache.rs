@@ -20,21 +20,26 @@ fn second_run_computes_no_features_and_loads_the_same() {
         plan::static_config(100.0, 0.0),
         plan::dynamic_config(640.0, 0),
     ];
+    // Each trial reports whether it was found cached whole (a resumed run's ETA skips those).
+    let calls = std::sync::Mutex::new(Vec::new());
+    let record = |reused: bool| calls.lock().unwrap().push(reused);
     let first = cache
-        .ensure(&trials, &configs, Sampling::MOTION, &|| {})
+        .ensure(&trials, &configs, Sampling::MOTION, &record)
         .unwrap();
     assert_eq!((first.computed, first.reused), (9, 0));
+    assert_eq!(std::mem::take(&mut *calls.lock().unwrap()), [false; 3]);
     let a = cache
         .load(&trials, &configs[0], Sampling::MOTION, &[Phase::Motion])
         .unwrap();
     let second = cache
-        .ensure(&trials, &configs, Sampling::MOTION, &|| {})
+        .ensure(&trials, &configs, Sampling::MOTION, &record)
         .unwrap();
     assert_eq!((second.computed, second.reused), (0, 9));
+    assert_eq!(std::mem::take(&mut *calls.lock().unwrap()), [true; 3]);
     // A fresh cache object (a new run) reuses the files too.
     let again = FeatureCache::new(&ds).unwrap();
     let third = again
-        .ensure(&trials, &configs, Sampling::MOTION, &|| {})
+        .ensure(&trials, &configs, Sampling::MOTION, &|_| {})
         .unwrap();
     assert_eq!(third.computed, 0);
     let b = again
@@ -79,7 +84,7 @@ fn stacked_and_late_share_features_that_are_static_then_dynamic() {
         dynamic_part,
     };
     let stats = cache
-        .ensure(&trials, &[stacked, late], Sampling::MOTION, &|| {})
+        .ensure(&trials, &[stacked, late], Sampling::MOTION, &|_| {})
         .unwrap();
     assert_eq!(stats.computed, 2, "one computation per trial for both");
     let load = |c: &ReprConfig| {

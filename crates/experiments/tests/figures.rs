@@ -29,7 +29,7 @@ fn the_fig2_sample_shows_the_cached_features_and_the_window_events() {
     assert_eq!((ex.width, ex.height, ex.window_ms), (240, 240, 640.0));
     let configs: Vec<_> = reprs.iter().map(|(_, c)| *c).collect();
     cache
-        .ensure(&[meta], &configs, Sampling::MOTION, &|| {})
+        .ensure(&[meta], &configs, Sampling::MOTION, &|_| {})
         .unwrap();
     for ((name, config), panel) in reprs.iter().zip(&ex.panels) {
         assert_eq!(panel.name, *name);

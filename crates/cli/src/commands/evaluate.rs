@@ -55,7 +55,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cache = FeatureCache::new(&ds)?;
     let bar = crate::progress::bar(trials.len() as u64, "features");
     let config = model.repr_config();
-    cache.ensure(&trials, std::slice::from_ref(&config), sampling, &|| {
+    cache.ensure(&trials, std::slice::from_ref(&config), sampling, &|_| {
         bar.inc(1)
     })?;
     bar.finish_and_clear();

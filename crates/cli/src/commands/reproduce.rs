@@ -100,15 +100,21 @@ struct PlainLog {
     started: Instant,
     stage: Option<(String, Instant, u64)>,
     done: u64,
+    /// Units of the current stage an earlier run had finished.
+    skipped: u64,
     last_line: Instant,
 }
 
 impl PlainLog {
     /// Ends the current stage's line, if any.
     fn end_stage(&mut self) {
-        if let Some((name, since, _)) = self.stage.take() {
+        if let Some((name, since, total)) = self.stage.take() {
+            let resumed = match self.skipped {
+                0 => String::new(),
+                n => format!(" ({n} of {total} found done by an earlier run)"),
+            };
             eprintln!(
-                "[{}] {name}: done in {:.1} s",
+                "[{}] {name}: done in {:.1} s{resumed}",
                 clock(self.started.elapsed()),
                 since.elapsed().as_secs_f64()
             );
@@ -150,6 +156,7 @@ impl<'a> Overall<'a> {
                 started: Instant::now(),
                 stage: None,
                 done: 0,
+                skipped: 0,
                 last_line: Instant::now(),
             })
         });
@@ -203,6 +210,7 @@ impl Progress for Overall<'_> {
             );
             log.stage = Some((stage.to_string(), Instant::now(), total));
             log.done = 0;
+            log.skipped = 0;
             log.last_line = Instant::now();
         }
     }
@@ -234,6 +242,11 @@ impl Progress for Overall<'_> {
             let cost = (*per_unit * n as f64).round() as u64;
             self.skipped_ms
                 .fetch_add(cost, std::sync::atomic::Ordering::Relaxed);
+        }
+        if let Some(log) = &self.log
+            && let Ok(mut log) = log.lock()
+        {
+            log.skipped += n;
         }
         self.advance(n);
     }

@@ -171,7 +171,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         crate::progress::bar(trials.len() as u64, "features")
     };
-    cache.ensure(&trials, std::slice::from_ref(&repr), sampling, &|| {
+    cache.ensure(&trials, std::slice::from_ref(&repr), sampling, &|_| {
         fbar.inc(1)
     })?;
     fbar.finish_and_clear();
