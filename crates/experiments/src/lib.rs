@@ -35,12 +35,16 @@
 //! use evtac_experiments::jobs::Quiet;
 //! use evtac_experiments::pipeline::{Datasets, reproduce};
 //! use evtac_experiments::plan::Plan;
+//! use evtac_experiments::stage_log::StageLog;
 //! use std::path::Path;
 //!
 //! // Datasets as `evtac simulate` writes them: data/exp1, data/exp2, data/exp3-speed, ...
 //! let data = Datasets::in_dir(Path::new("data"));
 //! let plan = Plan::for_scale(evtac_sim::Scale::Small);
-//! let results = reproduce(&data, &plan, 0, Path::new("out"), &Quiet)?;
+//! let out = Path::new("out");
+//! // Each stage's time is appended to out/stage-times.csv as it finishes.
+//! let log = StageLog::open(out)?;
+//! let results = reproduce(&data, &plan, 0, out, &log, &Quiet)?;
 //! println!("static test MAE {}", results.exp1[0].test.overall.display());
 //! # Ok::<(), evtac_experiments::pipeline::Error>(())
 //! ```
