@@ -100,7 +100,8 @@ impl StageLog {
             text.push_str(HEADER);
             text.push('\n');
         }
-        // Stage names are ours (no commas), so the row needs no quoting.
+        // A comma in a stage name would split its row: written as a semicolon instead of
+        // quoting (evtac's stage names have none).
         let stage = stage.replace(',', ";");
         text.push_str(&format!("{},{stage},{seconds:.3}\n", self.invocation));
         file.write_all(text.as_bytes()).map_err(&at)?;

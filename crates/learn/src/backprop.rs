@@ -73,35 +73,32 @@ impl Network {
         }
     }
 
-    /// (pitch, roll) for one sample.
+    /// (pitch, roll) for one sample, one layer at a time: the reference [`Network::predict`]
+    /// is tested against.
+    #[cfg(test)]
     pub fn predict_one(&self, x: &[f32]) -> [f32; OUTPUTS] {
         let mut h1 = [0.0_f32; H1];
         self.layers[0].forward(x, &mut h1, true);
         panels::after_first_layer(&self.layers, &h1)
     }
 
-    /// (pitch, roll) for every row of `x` (n x inputs, flat): [`Network::predict_one`]'s bits,
+    /// (pitch, roll) for every row of `x` (n x inputs, flat): one sample at a time's bits,
     /// the first layer computed for [`GROUP`] samples at a time
     /// ([`panels::relu_forward_batch`]: validation's forward pass, 7,500 samples an epoch at
     /// the paper's scale).
     pub fn predict(&self, x: &[f32]) -> Vec<[f32; OUTPUTS]> {
         let inputs = self.inputs();
         let mut out = Vec::with_capacity(x.len() / inputs);
-        let mut groups = x.chunks_exact(GROUP * inputs);
         let mut h1 = [0.0_f32; GROUP * H1];
-        for group in &mut groups {
-            panels::relu_forward_batch(&self.layers[0], group, &mut h1);
+        // The last group may be short: `relu_forward_batch` takes its rows one at a time.
+        for group in x.chunks(GROUP * inputs) {
+            let h1 = &mut h1[..group.len() / inputs * H1];
+            panels::relu_forward_batch(&self.layers[0], group, h1);
             for h1 in h1.chunks_exact(H1) {
                 let h1 = h1.try_into().expect("H1 wide");
                 out.push(panels::after_first_layer(&self.layers, h1));
             }
         }
-        out.extend(
-            groups
-                .remainder()
-                .chunks_exact(inputs)
-                .map(|x| self.predict_one(x)),
-        );
         out
     }
 }
