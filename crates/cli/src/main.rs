@@ -6,7 +6,9 @@
 
 mod commands;
 mod inputs;
+mod outputs;
 mod progress;
+mod streams;
 mod workers;
 
 /// mimalloc rather than glibc's malloc: burn allocates and frees megabyte tensors at every

@@ -3,6 +3,7 @@
 mod check;
 mod common;
 mod convert;
+mod data_loss;
 mod evaluate;
 mod import;
 mod info;

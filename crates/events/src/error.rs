@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use crate::aedat::AedatError;
+use crate::aedat::{AedatError, SelectionError};
 use crate::aedat_legacy::LegacyError;
 use crate::check::CheckError;
 use crate::csv::CsvError;
@@ -26,6 +26,15 @@ pub enum Error {
         path: PathBuf,
         /// The underlying error.
         error: std::io::Error,
+    },
+    /// The streams asked for are not in the file, or the file holds several and none was
+    /// chosen.
+    #[error("{}: {error}", path.display())]
+    Streams {
+        /// The file.
+        path: PathBuf,
+        /// Which kind, and the file's streams.
+        error: SelectionError,
     },
     /// Neither the first bytes nor the extension identify a format evtac reads.
     #[error("{}: unknown event file format ({reason})", path.display())]

@@ -9,7 +9,8 @@
 //! [`read_recording`] reads it whole; [`read_recording_range`] (or
 //! [`EventReader::select_range`]) reads only a time range `[from, to)`, through an AEDAT4 file's
 //! data table when it has one ([`RangeIndex`] says how the range was found); [`EventWriter`]
-//! writes AEDAT4 (events, IMU samples and triggers), CSV or NPY; [`Summary`] is what a
+//! writes AEDAT4 (events, IMU samples and triggers), CSV or NPY, whole or not at all
+//! ([`output`]); [`Summary`] is what a
 //! recording holds (counts, time spans, IMU rate), read in one streaming pass. Readers never
 //! panic on bad input: a truncated or corrupt file, a bad header, an event outside the declared
 //! resolution or a timestamp going backwards is an [`Error`] naming the file, the byte offset or
@@ -38,6 +39,7 @@ pub mod evt;
 pub mod layout;
 pub mod manifest;
 pub mod npy;
+pub mod output;
 mod range;
 mod recording;
 mod summary;
@@ -47,7 +49,7 @@ mod types;
 pub use error::Error;
 pub use range::{RangeIndex, ScanReason};
 pub use recording::{
-    Chunk, EventReader, EventWriter, Events, Format, Recording, open, read_recording,
+    Chunk, EventReader, EventWriter, Events, Format, Recording, open, open_with, read_recording,
     read_recording_range,
 };
 pub use summary::Summary;

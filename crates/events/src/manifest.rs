@@ -332,13 +332,10 @@ impl Manifest {
     pub fn write(&self, dataset_dir: impl AsRef<Path>) -> Result<(), ManifestError> {
         let text = self.to_csv()?;
         let path = Self::path(&dataset_dir);
-        let tmp = dataset_dir.as_ref().join(format!(".{FILE_NAME}.tmp"));
-        let io = |source| ManifestError::Io {
+        crate::output::write_atomic(&path, text.as_bytes()).map_err(|source| ManifestError::Io {
             path: path.clone(),
             source,
-        };
-        std::fs::write(&tmp, text).map_err(io)?;
-        std::fs::rename(&tmp, &path).map_err(io)
+        })
     }
 
     /// The trial named `trial`, if present.

@@ -15,12 +15,13 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read};
 use std::path::{Path, PathBuf};
 
-use crate::aedat::{AedatReader, AedatWriter, WriterConfig};
+use crate::aedat::{AedatReader, AedatWriter, StreamSelection, WriterConfig};
 use crate::aedat_legacy::{self, LegacyReader};
 use crate::check::EventCheck;
 use crate::csv::{CsvReader, CsvWriter};
 use crate::evt::{EvtReader, EvtVersion};
 use crate::npy::{NpyReader, NpyWriter};
+use crate::output::OutputFile;
 use crate::range::{RangeIndex, ScanReason, within};
 use crate::{Error, Event, ImuSample, Resolution, Trigger};
 
@@ -237,6 +238,16 @@ impl std::fmt::Debug for EventReader {
 /// # Ok::<(), evtac_events::Error>(())
 /// ```
 pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
+    open_with(path, &StreamSelection::default())
+}
+
+/// Opens the event file at `path` as [`open`] does, reading the streams `selection` picks from
+/// an AEDAT4 file with several (two cameras, say; see [`StreamSelection`]). A selection naming
+/// a stream is an error for the other formats, which hold one stream of each kind.
+pub fn open_with(
+    path: impl AsRef<Path>,
+    selection: &StreamSelection,
+) -> Result<EventReader, Error> {
     let path = path.as_ref();
     let format = Format::detect(path)?;
     let io = |error| Error::Io {
@@ -244,13 +255,37 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
         error,
     };
     let len = std::fs::metadata(path).map_err(io)?.len();
+    if format != Format::Aedat4 && *selection != StreamSelection::default() {
+        return Err(Error::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: format!(
+                "a stream was chosen, but only AEDAT4 files hold several streams and this is {}",
+                format.name()
+            ),
+        });
+    }
+    // The AEDAT4 event stream's size, which the reader checks events against.
+    let mut resolution = None;
     let (inner, source) = match format {
         Format::Aedat4 => {
-            let r = AedatReader::open(path).map_err(|error| Error::Aedat {
+            let mut r = AedatReader::open(path).map_err(|error| Error::Aedat {
                 path: path.to_path_buf(),
                 error,
             })?;
-            let name = r.source().map(str::to_string);
+            let chosen = selection
+                .resolve(r.header())
+                .map_err(|error| Error::Streams {
+                    path: path.to_path_buf(),
+                    error,
+                })?;
+            r.select_streams(&chosen);
+            let header = r.header();
+            let event_stream = chosen.events.and_then(|id| header.stream(id));
+            let name = match event_stream {
+                Some(s) => s.source.clone(),
+                None => r.source().map(str::to_string),
+            };
+            resolution = event_stream.and_then(|s| s.resolution);
             (Inner::Aedat(Box::new(r)), name)
         }
         Format::Aedat2 | Format::Aedat31 => {
@@ -284,10 +319,7 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
             (Inner::Npy(Box::new(r)), None)
         }
     };
-    let aedat_check = EventCheck::new(match &inner {
-        Inner::Aedat(r) => r.resolution(),
-        _ => None,
-    });
+    let aedat_check = EventCheck::new(resolution);
     Ok(EventReader {
         path: path.to_path_buf(),
         format,
@@ -652,14 +684,21 @@ pub fn read_recording_range(
     Ok((reader.into_recording()?, index))
 }
 
+/// The buffered temporary file every [`EventWriter`] sink writes to.
+type Sunk = BufWriter<OutputFile>;
+
 enum Sink {
-    Aedat(Box<AedatWriter<BufWriter<File>>>),
-    Csv(CsvWriter<BufWriter<File>>),
-    Npy(NpyWriter<BufWriter<File>>),
+    Aedat(Box<AedatWriter<Sunk>>),
+    Csv(CsvWriter<Sunk>),
+    Npy(NpyWriter<Sunk>),
 }
 
 /// Writes events (and, for AEDAT4, IMU samples and triggers) to a file whose extension picks the
 /// format: `.aedat4`, `.csv` or `.npy`.
+///
+/// The file is written under a temporary name beside `path` and appears under `path` only when
+/// [`finish`](Self::finish) succeeds ([`OutputFile`]); a writer dropped before, or a failed
+/// finish, leaves no output (and an earlier file of that name untouched).
 pub struct EventWriter {
     path: PathBuf,
     format: Format,
@@ -685,28 +724,32 @@ impl EventWriter {
     ) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let format = Format::for_writing(&path)?;
-        let sink = match format {
-            Format::Aedat4 => {
-                let resolution =
-                    resolution.ok_or_else(|| Error::MissingResolution { path: path.clone() })?;
+        let resolution = match (format, resolution) {
+            (Format::Aedat4, None) => return Err(Error::MissingResolution { path }),
+            (_, r) => r,
+        };
+        let file = OutputFile::buffered(&path).map_err(|error| Error::Io {
+            path: path.clone(),
+            error,
+        })?;
+        let sink = match (format, resolution) {
+            (Format::Aedat4, Some(resolution)) => {
                 let config = WriterConfig::new(resolution, source_name.unwrap_or("evtac"));
-                let w = AedatWriter::create(&path, config).map_err(|error| Error::Aedat {
+                let w = AedatWriter::new_seekable(file, config).map_err(|error| Error::Aedat {
                     path: path.clone(),
                     error,
                 })?;
                 Sink::Aedat(Box::new(w))
             }
-            Format::Csv => Sink::Csv(CsvWriter::create(&path).map_err(|error| Error::Csv {
+            (Format::Csv, _) => Sink::Csv(CsvWriter::new(file).map_err(|error| Error::Csv {
                 path: path.clone(),
                 error,
             })?),
-            Format::Npy => Sink::Npy(NpyWriter::create(&path).map_err(|error| Error::Npy {
+            (Format::Npy, _) => Sink::Npy(NpyWriter::new(file).map_err(|error| Error::Npy {
                 path: path.clone(),
                 error,
             })?),
-            Format::Aedat2 | Format::Aedat31 | Format::Evt2 | Format::Evt21 | Format::Evt3 => {
-                return Err(Error::NotWritable { path, format });
-            }
+            (format, _) => return Err(Error::NotWritable { path, format }),
         };
         Ok(Self { path, format, sink })
     }
@@ -769,22 +812,24 @@ impl EventWriter {
         }
     }
 
-    /// Finishes the file (buffered packets, NPY record count) and flushes it.
+    /// Finishes the file (buffered packets, data table, NPY record count), flushes it and
+    /// renames it to its final name.
     pub fn finish(self) -> Result<(), Error> {
         let path = self.path;
-        match self.sink {
-            Sink::Aedat(w) => w
-                .finish()
-                .map(drop)
-                .map_err(|error| Error::Aedat { path, error }),
-            Sink::Csv(w) => w
-                .finish()
-                .map(drop)
-                .map_err(|error| Error::Csv { path, error }),
-            Sink::Npy(w) => w
-                .finish()
-                .map(drop)
-                .map_err(|error| Error::Npy { path, error }),
-        }
+        let sunk = match self.sink {
+            Sink::Aedat(w) => w.finish().map_err(|error| Error::Aedat {
+                path: path.clone(),
+                error,
+            }),
+            Sink::Csv(w) => w.finish().map_err(|error| Error::Csv {
+                path: path.clone(),
+                error,
+            }),
+            Sink::Npy(w) => w.finish().map_err(|error| Error::Npy {
+                path: path.clone(),
+                error,
+            }),
+        }?;
+        OutputFile::commit_buffered(sunk).map_err(|error| Error::Io { path, error })
     }
 }

@@ -1,12 +1,46 @@
 //! What a recording holds, read in one streaming pass: format, sensor, event and IMU counts,
-//! time spans, IMU rate, triggers. `evtac info` prints it; `evtac check` compares its time spans
-//! with the motion windows of a dataset's manifest.
+//! time spans, IMU rate, triggers, and for AEDAT4 files every stream on its own. `evtac info`
+//! prints it; `evtac check` compares its time spans with the motion windows of a dataset's
+//! manifest.
+//!
+//! An AEDAT4 file is summarised stream by stream, every stream decoded; the top-level counts
+//! are those of the streams a [`StreamSelection`] picks, so a two-camera file is never reported
+//! as one camera. When it cannot pick (several cameras, none chosen) the top level is empty and
+//! [`Summary::selection`] says why.
 
 use std::path::Path;
 
 use serde::Serialize;
 
-use crate::{Error, EventReader};
+use crate::aedat::{AedatReader, StreamSelection};
+use crate::check::EventCheck;
+use crate::{Error, EventReader, Format};
+
+/// One stream of an AEDAT4 file (`evtac info` lists them all).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StreamSummary {
+    /// The stream id packets carry.
+    pub id: i32,
+    /// Its type identifier (`EVTS`, `IMUS`, `TRIG`, `FRME`, ...).
+    #[serde(rename = "type")]
+    pub type_identifier: String,
+    /// Its output name (`events`, `imu`, ...), when the file gives one.
+    pub name: Option<String>,
+    /// The camera it comes from, when the file says.
+    pub source: Option<String>,
+    /// Sensor width (event streams).
+    pub width: Option<u16>,
+    /// Sensor height (event streams).
+    pub height: Option<u16>,
+    /// Elements decoded (events, IMU samples or triggers; 0 for undecoded kinds).
+    pub count: u64,
+    /// ON events (event streams).
+    pub on_events: u64,
+    /// First element's timestamp (us).
+    pub first_t_us: Option<i64>,
+    /// Last element's timestamp (us).
+    pub last_t_us: Option<i64>,
+}
 
 /// A recording's summary (also `evtac info --json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -37,6 +71,13 @@ pub struct Summary {
     pub last_imu_t_us: Option<i64>,
     /// Number of triggers.
     pub triggers: u64,
+    /// Every stream of an AEDAT4 file (empty for the other formats, which hold one of each).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub streams: Vec<StreamSummary>,
+    /// Why the top-level counts are empty although the file has streams: several cameras and
+    /// none chosen (the streams' own rows still count everything).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub selection: Option<String>,
 }
 
 impl Summary {
@@ -57,6 +98,8 @@ impl Summary {
             first_imu_t_us: None,
             last_imu_t_us: None,
             triggers: 0,
+            streams: Vec::new(),
+            selection: None,
         };
         while let Some(chunk) = reader.next_chunk()? {
             if let (Some(first), Some(last)) = (chunk.events.first(), chunk.events.last()) {
@@ -73,18 +116,143 @@ impl Summary {
             s.triggers += chunk.triggers.len() as u64;
             on_position(reader.position());
         }
-        if let (Some(first), Some(last)) = (s.first_imu_t_us, s.last_imu_t_us)
+        s.set_imu_rate();
+        Ok(s)
+    }
+
+    fn set_imu_rate(&mut self) {
+        if let (Some(first), Some(last)) = (self.first_imu_t_us, self.last_imu_t_us)
             && last > first
         {
             // Samples per second over the span between the first and the last sample.
-            s.imu_rate_hz = Some((s.imu_samples - 1) as f64 / ((last - first) as f64 * 1e-6));
+            self.imu_rate_hz = Some((self.imu_samples - 1) as f64 / ((last - first) as f64 * 1e-6));
         }
-        Ok(s)
     }
 
     /// Opens the recording at `path` (any format evtac reads) and summarises it.
     pub fn of_file(path: impl AsRef<Path>) -> Result<Self, Error> {
-        Self::read(&mut crate::open(path)?, |_| {})
+        Self::of_file_with(path, &StreamSelection::default(), |_| {})
+    }
+
+    /// Summarises the recording at `path`, every stream of an AEDAT4 file on its own and the
+    /// streams `selection` picks at the top level; `on_position` sees the byte position as the
+    /// read goes.
+    pub fn of_file_with(
+        path: impl AsRef<Path>,
+        selection: &StreamSelection,
+        on_position: impl FnMut(u64),
+    ) -> Result<Self, Error> {
+        let path = path.as_ref();
+        if Format::detect(path)? == Format::Aedat4 {
+            Self::of_aedat(path, selection, on_position)
+        } else {
+            Self::read(&mut crate::open_with(path, selection)?, on_position)
+        }
+    }
+
+    fn of_aedat(
+        path: &Path,
+        selection: &StreamSelection,
+        mut on_position: impl FnMut(u64),
+    ) -> Result<Self, Error> {
+        let aedat = |error| Error::Aedat {
+            path: path.to_path_buf(),
+            error,
+        };
+        let mut reader = AedatReader::open(path).map_err(aedat)?;
+        let header = reader.header().clone();
+        let chosen = match selection.resolve(&header) {
+            Ok(chosen) => Ok(chosen),
+            // Naming a stream the file lacks is the user's mistake; not choosing among several
+            // cameras is not, for a summary: it lists them all.
+            Err(error) if *selection != StreamSelection::default() => {
+                return Err(Error::Streams {
+                    path: path.to_path_buf(),
+                    error,
+                });
+            }
+            Err(error) => Err(error.reason),
+        };
+        let mut rows: Vec<StreamSummary> = header
+            .streams
+            .iter()
+            .map(|info| StreamSummary {
+                id: info.id,
+                type_identifier: info.type_identifier.clone(),
+                name: info.name.clone(),
+                source: info.source.clone(),
+                width: info.resolution.map(|r| r.width),
+                height: info.resolution.map(|r| r.height),
+                count: 0,
+                on_events: 0,
+                first_t_us: None,
+                last_t_us: None,
+            })
+            .collect();
+        // Each event stream's events checked against its own sensor.
+        let mut checks: Vec<EventCheck> = header
+            .streams
+            .iter()
+            .map(|i| EventCheck::new(i.resolution))
+            .collect();
+        while let Some(chunk) = reader.next_chunk().map_err(aedat)? {
+            let Some(k) = header.streams.iter().position(|i| i.id == chunk.stream_id) else {
+                continue;
+            };
+            checks[k]
+                .check(chunk.events)
+                .map_err(|error| Error::Event {
+                    path: path.to_path_buf(),
+                    error,
+                })?;
+            let row = &mut rows[k];
+            // A packet holds one stream, so one kind: at most one of these is non-empty.
+            let (n, first, last) = match (chunk.events, chunk.imu, chunk.triggers) {
+                (e, _, _) if !e.is_empty() => {
+                    (e.len(), e.first().map(|e| e.t), e.last().map(|e| e.t))
+                }
+                (_, i, _) if !i.is_empty() => {
+                    (i.len(), i.first().map(|s| s.t), i.last().map(|s| s.t))
+                }
+                (_, _, t) => (t.len(), t.first().map(|t| t.t), t.last().map(|t| t.t)),
+            };
+            if let (Some(first), Some(last)) = (first, last) {
+                row.first_t_us.get_or_insert(first);
+                row.last_t_us = Some(last);
+            }
+            row.count += n as u64;
+            row.on_events += chunk.events.iter().filter(|e| e.polarity).count() as u64;
+            on_position(reader.offset());
+        }
+        let row_of = |id: Option<i32>| id.and_then(|id| rows.iter().find(|r| r.id == id));
+        let (events, imu, triggers, note) = match chosen {
+            Ok(c) => (row_of(c.events), row_of(c.imu), row_of(c.triggers), None),
+            Err(note) => (None, None, None, Some(note)),
+        };
+        let mut s = Summary {
+            format: Format::Aedat4.name().to_string(),
+            source: match (events, &note) {
+                (Some(r), _) => r.source.clone(),
+                (None, None) => header.source().map(str::to_string),
+                (None, Some(_)) => None,
+            },
+            width: events.and_then(|r| r.width),
+            height: events.and_then(|r| r.height),
+            events: events.map_or(0, |r| r.count),
+            on_events: events.map_or(0, |r| r.on_events),
+            first_t_us: events.and_then(|r| r.first_t_us),
+            last_t_us: events.and_then(|r| r.last_t_us),
+            imu_samples: imu.map_or(0, |r| r.count),
+            imu_rate_hz: None,
+            first_imu_t_us: imu.and_then(|r| r.first_t_us),
+            last_imu_t_us: imu.and_then(|r| r.last_t_us),
+            triggers: triggers.map_or(0, |r| r.count),
+            streams: Vec::new(),
+            selection: note,
+        };
+        s.set_imu_rate();
+        s.streams = rows;
+        Ok(s)
     }
 }
 

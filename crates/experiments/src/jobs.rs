@@ -75,9 +75,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent)?;
     }
-    let tmp = tmp_path(path);
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
+    evtac_events::output::write_atomic(path, bytes)
 }
 
 /// A sibling temporary path for `path` (same folder, so a rename is atomic), unique to this call:

@@ -172,7 +172,7 @@ impl LabelSeries {
         if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(parent).map_err(io)?;
         }
-        std::fs::write(path, self.to_csv()).map_err(io)
+        evtac_events::output::write_atomic(path, self.to_csv().as_bytes()).map_err(io)
     }
 
     /// Reads a labels or truth CSV from `path`.

@@ -36,7 +36,9 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
+use evtac_events::output::write_atomic;
 use ndarray::Array2;
+use ndarray_npy::WriteNpyExt;
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 use serde::{Deserialize, Serialize};
 
@@ -399,7 +401,7 @@ impl ModelBundle {
                 path: model_path.clone(),
                 message,
             })?;
-        std::fs::write(&model_path, bytes).map_err(io(&model_path))?;
+        write_atomic(&model_path, &bytes).map_err(io(&model_path))?;
 
         let config_path = dir.join(CONFIG_FILE);
         let mut json =
@@ -408,7 +410,7 @@ impl ModelBundle {
                 source,
             })?;
         json.push('\n');
-        std::fs::write(&config_path, json).map_err(io(&config_path))?;
+        write_atomic(&config_path, json.as_bytes()).map_err(io(&config_path))?;
 
         let mask_path = dir.join(MASK_FILE);
         match &self.mask {
@@ -417,10 +419,12 @@ impl ModelBundle {
                 let shape = (usize::from(size.height), usize::from(size.width));
                 let array = Array2::from_shape_vec(shape, mask.pixels().to_vec())
                     .expect("a mask holds height x width pixels");
-                ndarray_npy::write_npy(&mask_path, &array).map_err(|e| Error::Mask {
+                let mut bytes = Vec::new();
+                array.write_npy(&mut bytes).map_err(|e| Error::Mask {
                     path: mask_path.clone(),
                     message: e.to_string(),
-                })?
+                })?;
+                write_atomic(&mask_path, &bytes).map_err(io(&mask_path))?
             }
             None => match std::fs::remove_file(&mask_path) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
@@ -439,7 +443,7 @@ impl ModelBundle {
                 r.epoch, r.train_loss, r.val_mae, r.val_mae_pitch, r.val_mae_roll, r.seconds
             ));
         }
-        std::fs::write(&history_path, csv).map_err(io(&history_path))?;
+        write_atomic(&history_path, csv.as_bytes()).map_err(io(&history_path))?;
         Ok(())
     }
 

@@ -2,6 +2,7 @@
 //! chunks, what `evtac.open` returns) and `write`, through `evtac_events` as `evtac convert`
 //! uses it: every format the CLI reads, AEDAT4 / CSV / NPY written by the output's extension.
 
+use evtac_events::aedat::{StreamChoice, StreamSelection};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
@@ -18,7 +19,8 @@ pub fn events_error(err: evtac_events::Error) -> PyErr {
     match err {
         evtac_events::Error::NotWritable { .. }
         | evtac_events::Error::MissingResolution { .. }
-        | evtac_events::Error::ResolutionMismatch { .. } => error::value(err),
+        | evtac_events::Error::ResolutionMismatch { .. }
+        | evtac_events::Error::Streams { .. } => error::value(err),
         evtac_events::Error::Io { ref error, .. } => error::io(&err, error),
         _ => error::file(err),
     }
@@ -104,13 +106,22 @@ impl Packed {
     }
 }
 
-/// Opens `path`, declares `resolution` if given, and finds the crop of `roi` (centered).
+/// Opens `path` (its event stream `stream`, for AEDAT4 files with several), declares
+/// `resolution` if given, and finds the crop of `roi` (centered).
 fn open_cropped(
     path: &PathBuf,
     roi: Option<(u16, u16)>,
     resolution: Option<(u16, u16)>,
+    stream: Option<&str>,
 ) -> PyResult<(EventReader, Option<Roi>)> {
-    let mut reader = evtac_events::open(path).map_err(events_error)?;
+    let selection = StreamSelection {
+        events: stream
+            .map(str::parse::<StreamChoice>)
+            .transpose()
+            .map_err(|e| error::value(format!("stream: {e}")))?,
+        ..StreamSelection::default()
+    };
+    let mut reader = evtac_events::open_with(path, &selection).map_err(events_error)?;
     if let Some((w, h)) = resolution {
         reader
             .set_resolution(Resolution::new(w, h))
@@ -138,15 +149,16 @@ fn open_cropped(
 
 /// Reads the whole file at `path`, cropped to the centered `roi` if given.
 #[pyfunction]
-#[pyo3(signature = (path, roi = None, resolution = None))]
+#[pyo3(signature = (path, roi = None, resolution = None, stream = None))]
 pub fn read(
     py: Python<'_>,
     path: PathBuf,
     roi: Option<(u16, u16)>,
     resolution: Option<(u16, u16)>,
+    stream: Option<String>,
 ) -> PyResult<Recording> {
     let (packed, format, source) = py.detach(|| -> PyResult<_> {
-        let (reader, crop) = open_cropped(&path, roi, resolution)?;
+        let (reader, crop) = open_cropped(&path, roi, resolution, stream.as_deref())?;
         let rec = reader.into_recording().map_err(events_error)?;
         let (events, resolution) = match crop {
             Some(crop) => {
@@ -214,18 +226,20 @@ impl ReaderState {
 #[pymethods]
 impl Reader {
     #[new]
-    #[pyo3(signature = (path, roi = None, resolution = None, chunk_events = 65536))]
+    #[pyo3(signature = (path, roi = None, resolution = None, chunk_events = 65536, stream = None))]
     fn new(
         py: Python<'_>,
         path: PathBuf,
         roi: Option<(u16, u16)>,
         resolution: Option<(u16, u16)>,
         chunk_events: usize,
+        stream: Option<String>,
     ) -> PyResult<Self> {
         if chunk_events == 0 {
             return Err(error::value("chunk_events must be at least 1"));
         }
-        let (reader, crop) = py.detach(|| open_cropped(&path, roi, resolution))?;
+        let (reader, crop) =
+            py.detach(|| open_cropped(&path, roi, resolution, stream.as_deref()))?;
         Ok(Self {
             format: reader.format().name(),
             source: reader.source().map(str::to_string),

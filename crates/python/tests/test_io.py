@@ -137,3 +137,48 @@ def test_bad_arguments_are_value_errors(aedat, tmp_path):
         evtac.write(tmp_path / "e.npy", bad)
     with pytest.raises(ValueError, match="chunk_events"):
         evtac.open(aedat, chunk_events=0)
+
+
+def test_a_failed_write_leaves_no_file_and_an_earlier_one_untouched(aedat, tmp_path):
+    events = evtac.read(aedat).events[:100]
+    out = tmp_path / "e.npy"
+    out.write_bytes(b"earlier")
+    with pytest.raises(ValueError, match="backwards"):
+        evtac.write(out, events[::-1])
+    assert out.read_bytes() == b"earlier"
+    with pytest.raises(ValueError, match="backwards"):
+        evtac.write(tmp_path / "new.aedat4", events[::-1], resolution=(320, 240))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.npy"]
+
+
+def test_a_two_camera_file_is_read_one_camera_at_a_time(tmp_path):
+    dv = pytest.importorskip("dv_processing")
+
+    def config(name, size):
+        c = dv.io.MonoCameraWriter.Config(name)
+        c.addEventStream(size)
+        return c
+
+    path = tmp_path / "stereo.aedat4"
+    w = dv.io.StereoCameraWriter(str(path), config("L", (640, 480)), config("R", (346, 260)))
+    expected = {}
+    for name, writer, size, offset in (("L", w.left, (640, 480), 0), ("R", w.right, (346, 260), 2)):
+        s = dv.EventStore()
+        for i in range(1000):
+            s.push_back(1_000_000 + offset + 4 * i, i % size[0], i % size[1], i % 3 == 0)
+        writer.writeEvents(s)
+        expected[name] = (s.numpy(), size)
+    del w
+    with pytest.raises(ValueError, match="2 event streams"):
+        evtac.read(path)
+    for stream, name in (("L", "L"), (2, "R"), ("R/events", "R")):
+        rec = evtac.read(path, stream=stream)
+        e, size = expected[name]
+        assert rec.resolution == size and rec.source == name
+        np.testing.assert_array_equal(rec.events["t"], e["timestamp"])
+        np.testing.assert_array_equal(rec.events["x"], e["x"])
+        np.testing.assert_array_equal(rec.events["p"], e["polarity"])
+        chunks = list(evtac.open(path, stream=stream, chunk_events=300))
+        assert sum(len(c.events) for c in chunks) == 1000
+    with pytest.raises(ValueError, match="no event stream"):
+        evtac.read(path, stream=9)

@@ -2,6 +2,10 @@
 //! optionally cut to a time range, cropped to a centered region and with the IMU written to a
 //! CSV file. AEDAT4 outputs keep the IMU samples and triggers.
 //!
+//! An output that is the input (by path or through a link) is refused before anything is
+//! opened, and outputs appear only once complete ([`evtac_events::output`]): a conversion that
+//! fails half-way leaves no file that looks valid.
+//!
 //! A time range (`--from-us`, `--to-us`) is read through an AEDAT4 input's data table, so
 //! cutting a trial out of a long session reads only that trial's packets; when the table is
 //! missing or damaged the whole file is scanned, with one warning saying why.
@@ -10,6 +14,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use evtac_events::csv::ImuCsvWriter;
+use evtac_events::output::{OutputFile, refuse_input};
 use evtac_events::{EventWriter, Resolution, Roi};
 
 /// Arguments of `evtac convert`.
@@ -39,6 +44,8 @@ pub struct Args {
     /// range lies.
     #[arg(long, value_name = "US", allow_hyphen_values = true)]
     pub to_us: Option<i64>,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
 }
 
 /// What a conversion wrote.
@@ -68,7 +75,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Converts `args.input` to `args.output` as `evtac convert` does.
 pub fn convert(args: &Args) -> anyhow::Result<Counts> {
-    let mut reader = evtac_events::open(&args.input)?;
+    refuse_input(&args.output, &[&args.input])?;
+    if let Some(imu) = &args.imu {
+        refuse_input(imu, &[&args.input, &args.output])?;
+    }
+    let mut reader = evtac_events::open_with(&args.input, &args.streams.selection())?;
     if let Some(resolution) = args.resolution {
         reader.set_resolution(resolution)?;
     }
@@ -106,7 +117,11 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
     let mut writer = EventWriter::create(&args.output, Some(roi.size), reader.source())?;
     let mut imu_writer = match &args.imu {
         Some(path) => Some((
-            ImuCsvWriter::create(path).with_context(|| format!("creating {}", path.display()))?,
+            ImuCsvWriter::new(
+                OutputFile::buffered(path)
+                    .with_context(|| format!("creating {}", path.display()))?,
+            )
+            .with_context(|| format!("writing {}", path.display()))?,
             path,
         )),
         None => None,
@@ -134,8 +149,10 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
     let stores_triggers = writer.stores_triggers();
     writer.finish()?;
     if let Some((w, path)) = imu_writer {
-        w.finish()
+        let file = w
+            .finish()
             .with_context(|| format!("writing {}", path.display()))?;
+        OutputFile::commit_buffered(file).with_context(|| format!("writing {}", path.display()))?;
     }
     if counts.imu > 0 && !stores_imu && args.imu.is_none() {
         eprintln!(

@@ -333,8 +333,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     if !found.is_empty() {
         let review = summary.out.join(REVIEW_FILE);
-        std::fs::write(&review, motions::review_csv(&found))
-            .with_context(|| review.display().to_string())?;
+        crate::outputs::write_text(&review, &motions::review_csv(&found))?;
         println!("the motions as found, for review: {}", review.display());
     }
     if config.calibration.is_none() {

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use evtac_events::Summary;
+use evtac_events::aedat::StreamSelection;
 
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
@@ -13,13 +14,18 @@ pub struct Args {
     /// Print the summary as one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
 }
 
-/// Reads the whole file in chunks (with a byte progress bar on a terminal) and summarises it.
-pub fn summarise(path: &std::path::Path) -> anyhow::Result<Summary> {
-    let mut reader = evtac_events::open(path)?;
-    let bar = crate::progress::bytes(reader.file_len(), "reading");
-    let summary = Summary::read(&mut reader, |position| bar.set_position(position))?;
+/// Reads the whole file in chunks (with a byte progress bar on a terminal) and summarises it:
+/// every stream of an AEDAT4 file, and the chosen ones at the top level.
+pub fn summarise(path: &std::path::Path, streams: &StreamSelection) -> anyhow::Result<Summary> {
+    let len = std::fs::metadata(path)
+        .with_context(|| path.display().to_string())?
+        .len();
+    let bar = crate::progress::bytes(len, "reading");
+    let summary = Summary::of_file_with(path, streams, |position| bar.set_position(position))?;
     bar.finish_and_clear();
     Ok(summary)
 }
@@ -63,12 +69,35 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     if s.triggers > 0 {
         out += &format!("triggers:    {}\n", s.triggers);
     }
+    if let Some(why) = &s.selection {
+        out += &format!(
+            "note:        {why}; the counts above are empty, the streams below are whole\n"
+        );
+    }
+    if s.streams.len() > 1 {
+        out += "streams:\n";
+        for r in &s.streams {
+            let size = match (r.width, r.height) {
+                (Some(w), Some(h)) => format!(" {w}x{h}"),
+                _ => String::new(),
+            };
+            out += &format!(
+                "  id {}: {} `{}` from {}{size}: {} elements, {}\n",
+                r.id,
+                r.type_identifier,
+                r.name.as_deref().unwrap_or("-"),
+                r.source.as_deref().unwrap_or("-"),
+                r.count,
+                span(r.first_t_us, r.last_t_us),
+            );
+        }
+    }
     out
 }
 
 /// Runs `evtac info`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let summary = summarise(&args.file)?;
+    let summary = summarise(&args.file, &args.streams.selection())?;
     if args.json {
         let text = serde_json::to_string_pretty(&summary).context("serialising the summary")?;
         println!("{text}");

@@ -7,6 +7,7 @@
 
 use anyhow::Context;
 use evtac_events::Resolution;
+use evtac_events::output::{OutputFile, refuse_input};
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
@@ -139,11 +140,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("setting up the estimator for {}", args.model.display()))?;
 
     let to_stdout = args.output.is_none();
-    let mut out: Box<dyn Write> = match &args.output {
-        Some(path) => Box::new(std::io::BufWriter::new(
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
-        )),
-        None => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
+    // The file appears when the run ends without error (Ctrl-C included): a run that fails
+    // leaves no estimates file that looks complete.
+    let mut file = match &args.output {
+        Some(path) => {
+            if let SourceSpec::File(input) = &spec {
+                refuse_input(path, &[input])?;
+            }
+            Some(
+                OutputFile::buffered(path)
+                    .with_context(|| format!("creating {}", path.display()))?,
+            )
+        }
+        None => None,
+    };
+    let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let out: &mut dyn Write = match &mut file {
+        Some(f) => f,
+        None => &mut stdout,
     };
     writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
     let stop = stop_on_interrupt()?;
@@ -185,7 +199,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
     );
     let flushed = out.flush();
-    drop(out);
     let with_pace = |mut summary: Summary| {
         summary.paced = paced;
         summary
@@ -207,5 +220,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return Err(e).context("writing the estimates");
     }
     flushed.context("writing the estimates")?;
+    if let (Some(file), Some(path)) = (file, &args.output) {
+        OutputFile::commit_buffered(file).with_context(|| format!("writing {}", path.display()))?;
+    }
     Ok(())
 }

@@ -25,6 +25,7 @@ pub struct Args {
 /// Runs `evtac predict`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     evtac_learn::flush_denormals();
+    evtac_events::output::refuse_input(&args.output, &[&args.features])?;
     let bundle = ModelBundle::load(&args.model)
         .with_context(|| format!("loading the model bundle {}", args.model.display()))?;
     let predictor = bundle.predictor()?;
@@ -34,9 +35,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (predictions.len(), 2),
         predictions.iter().flatten().copied().collect(),
     )?;
-    ndarray_npy::write_npy(&args.output, &out)
-        .with_context(|| format!("writing {}", args.output.display()))?;
-    Ok(())
+    crate::outputs::write_npy(&args.output, &out)
 }
 
 /// Reads an N x `inputs` float32 NPY into a flat row-major buffer, with errors naming the file

@@ -168,8 +168,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             angles.labels = labels.as_ref().map(|s| angles.sample(s));
             angles.truth = truth.as_ref().map(|s| angles.sample(s));
             if let Some(path) = &args.estimates_csv {
-                std::fs::write(path, angles.estimates_csv())
-                    .with_context(|| format!("writing {}", path.display()))?;
+                crate::outputs::write_text(path, &angles.estimates_csv())?;
             }
             Some(angles)
         }

@@ -15,6 +15,8 @@ use evtac_repr::{
     ThresholdSpace,
 };
 use ndarray::{Array2, Array3};
+
+use crate::outputs::write_npy;
 use std::path::{Path, PathBuf};
 
 /// Which representation to build.
@@ -104,6 +106,8 @@ pub struct Args {
     /// Sensor resolution WIDTHxHEIGHT (needed when the file does not say; overrides it).
     #[arg(long)]
     pub resolution: Option<Resolution>,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
     /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
     #[arg(long)]
     pub roi: Option<String>,
@@ -219,12 +223,18 @@ impl Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let config = args.config();
     config.validate()?;
+    let inputs: Vec<&Path> = [&args.events, &args.samples]
+        .into_iter()
+        .chain(args.mask.as_ref())
+        .map(PathBuf::as_path)
+        .collect();
+    evtac_events::output::refuse_input(&args.output, &inputs)?;
     if args.what == What::Potential && config.static_part().is_none() {
         bail!("--what potential needs a static part: --repr static, combined, stacked or late");
     }
     let samples = read_samples(&args.samples)?;
 
-    let (sensor, events) = read_events(&args.events, args.resolution)?;
+    let (sensor, events) = read_events(&args.events, args.resolution, &args.streams)?;
     let roi = parse_roi(args.roi.as_deref(), sensor)?;
     let mut cropped = Vec::new();
     roi.crop_into(&events, &mut cropped);
@@ -275,16 +285,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
 
     let out = &args.output;
-    let written = match args.what {
-        What::Frames => {
-            ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, frame_h, w), bytes)?)
-        }
-        What::Potential => ndarray_npy::write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?),
-        What::Features => {
-            ndarray_npy::write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)
-        }
-    };
-    written.with_context(|| format!("writing {}", out.display()))?;
+    match args.what {
+        What::Frames => write_npy(out, &Array3::from_shape_vec((n, frame_h, w), bytes)?)?,
+        What::Potential => write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?)?,
+        What::Features => write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)?,
+    }
     eprintln!(
         "wrote {} samples of {} ({} events in the {} crop) to {}",
         n,
@@ -300,8 +305,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn read_events(
     path: &Path,
     resolution: Option<Resolution>,
+    streams: &crate::streams::StreamArgs,
 ) -> anyhow::Result<(Resolution, Vec<Event>)> {
-    let rec = evtac_events::read_recording(path)
+    let rec = evtac_events::open_with(path, &streams.selection())
+        .and_then(evtac_events::EventReader::into_recording)
         .with_context(|| format!("reading events from {}", path.display()))?;
     let sensor = resolution.or(rec.resolution).with_context(|| {
         format!(
@@ -383,7 +390,7 @@ fn read_mask(
     let Some(static_config) = config.static_part() else {
         bail!("--mask applies to the static part: it needs --repr static or combined");
     };
-    let (sensor, events) = read_events(path, args.resolution)
+    let (sensor, events) = read_events(path, args.resolution, &args.streams)
         .with_context(|| format!("reading the no-contact recording {}", path.display()))?;
     let roi = parse_roi(args.roi.as_deref(), sensor)?;
     let mut cropped = Vec::new();

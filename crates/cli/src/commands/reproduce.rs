@@ -357,7 +357,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if !text.is_empty() {
             text.push('\n');
         }
-        std::fs::write(file, text).with_context(|| format!("writing {}", file.display()))?;
+        crate::outputs::write_text(file, &text)?;
         bars.finish();
         eprintln!(
             "wrote {} training jobs to {}; run them (e.g. `parallel < {}`), then run this command again without --export-jobs",

@@ -35,7 +35,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let stats = measure(&args.recording, |bytes| bar.set_position(bytes))?;
     bar.finish_and_clear();
     if let Some(path) = &args.rates {
-        std::fs::write(path, stats.rates_csv()).with_context(|| path.display().to_string())?;
+        crate::outputs::write_text(path, &stats.rates_csv())?;
     }
     if args.json {
         let mut shown = stats.clone();
@@ -52,7 +52,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(path) = &args.sim_params {
         let fitted = fit::fit(&stats, evtac_sim::SimParams::default());
         let text = serde_json::to_string_pretty(&fitted.params)?;
-        std::fs::write(path, text + "\n").with_context(|| path.display().to_string())?;
+        crate::outputs::write_text(path, &(text + "\n"))?;
         println!("\nwrote {} with these fields measured:", path.display());
         for m in &fitted.measured {
             println!("  {:<24} {:>14}  from {}", m.field, m.value, m.from);

@@ -77,8 +77,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t = pool.install(|| tuning::tune(&cache, &splits, kind, &run))?;
     bars.finish();
     let json_path = out.join(format!("tuning-{}.json", kind.name()));
-    std::fs::write(&json_path, serde_json::to_string_pretty(&t)?)
-        .with_context(|| format!("writing {}", json_path.display()))?;
+    crate::outputs::write_text(&json_path, &serde_json::to_string_pretty(&t)?)?;
     println!(
         "{:>10} {:>9} {:>9} {:>7} {:>7}",
         t.time_name, "threshold", "val MAE", "pitch", "roll"

@@ -20,7 +20,6 @@
 use std::collections::VecDeque;
 
 use super::compression::MAX_PACKET_BYTES;
-use super::header::StreamKind;
 use super::packet::StreamState;
 use super::schema::{self, DataTableEntry};
 
@@ -176,11 +175,7 @@ impl<'a> Planner<'a> {
             ));
         }
         self.last_t[s] = e.timestamp_end;
-        let decoded = matches!(
-            self.streams[s].kind,
-            StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
-        );
-        if decoded && e.timestamp_end >= self.from && e.timestamp_start < self.to {
+        if self.streams[s].decoded && e.timestamp_end >= self.from && e.timestamp_start < self.to {
             if !self.started[s] {
                 self.started[s] = true;
                 self.out.first_index[s] = self.seen[s];

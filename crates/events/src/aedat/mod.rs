@@ -52,6 +52,7 @@ mod index;
 mod packet;
 mod reader;
 pub mod schema;
+mod selection;
 mod table_check;
 mod table_stream;
 mod writer;
@@ -60,6 +61,7 @@ pub use compression::MAX_PACKET_BYTES;
 pub use error::{AedatError, Result};
 pub use header::{AedatHeader, Compression, MAGIC, StreamInfo, StreamKind, parse_description};
 pub use reader::{AedatChunk, AedatReader, Events};
+pub use selection::{ChosenStreams, SelectionError, StreamChoice, StreamSelection, list_streams};
 pub use writer::{
     AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, TRIGGERS_PER_PACKET,
     WriterConfig,

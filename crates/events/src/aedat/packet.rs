@@ -19,6 +19,9 @@ pub(crate) struct StreamState {
     pub count: u64,
     /// Last timestamp decoded (`i64::MIN` before the first).
     pub last_t: i64,
+    /// Whether its packets are decoded: a kind evtac decodes (events, IMU, triggers), and
+    /// selected ([`AedatReader::select_streams`](super::AedatReader::select_streams)).
+    pub decoded: bool,
 }
 
 impl StreamState {

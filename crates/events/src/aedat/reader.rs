@@ -216,6 +216,7 @@ impl<R: Read> AedatReader<R> {
             .streams
             .iter()
             .map(|s| StreamState {
+                decoded: decodable(&s.kind),
                 id: s.id,
                 kind: s.kind.clone(),
                 resolution: s.resolution,
@@ -272,6 +273,17 @@ impl<R: Read> AedatReader<R> {
     /// Gives back the underlying reader.
     pub fn into_inner(self) -> R {
         self.reader
+    }
+
+    /// From now on, decodes only the streams `chosen` names, one of each kind (see
+    /// [`StreamSelection::resolve`](super::StreamSelection::resolve)): packets of the others are
+    /// read past like frames. Without it, every event, IMU and trigger stream is decoded and
+    /// their elements are handed out as they come, whatever stream they belong to
+    /// ([`AedatChunk::stream_id`] tells).
+    pub fn select_streams(&mut self, chosen: &super::ChosenStreams) {
+        for s in &mut self.streams {
+            s.decoded = decodable(&s.kind) && chosen.contains(s.id);
+        }
     }
 
     /// From now on, decodes trigger packets only: event and IMU packets are read past like
@@ -550,13 +562,9 @@ impl<R: Read> AedatReader<R> {
         }
         let state = &mut self.streams[index];
         // A range read's plan lists the packets it needs: those are all decoded.
-        let decoded = if let Some(only) = self.only.as_ref().filter(|_| planned.is_none()) {
-            state.kind == *only
-        } else {
-            matches!(
-                state.kind,
-                StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
-            )
+        let decoded = match self.only.as_ref().filter(|_| planned.is_none()) {
+            Some(only) => state.decoded && state.kind == *only,
+            None => state.decoded,
         };
         if !decoded {
             return Ok(Packet::Skipped);
@@ -798,6 +806,15 @@ impl<R: Read> Iterator for Events<R> {
             }
         }
     }
+}
+
+/// Whether evtac decodes packets of `kind` (events, IMU, triggers; frames and unknown types are
+/// read past).
+fn decodable(kind: &StreamKind) -> bool {
+    matches!(
+        kind,
+        StreamKind::Events | StreamKind::Imu | StreamKind::Triggers
+    )
 }
 
 #[cfg(test)]

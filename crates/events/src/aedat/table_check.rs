@@ -726,6 +726,7 @@ mod tests {
     /// its header) in streams 0 (events) and 1 (IMU).
     fn streams() -> Vec<StreamState> {
         let state = |id, kind| StreamState {
+            decoded: true,
             id,
             kind,
             resolution: None,

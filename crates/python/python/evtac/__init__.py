@@ -138,18 +138,31 @@ def _size(value: Any, what: str) -> Optional[Size]:
         raise ValueError(f"{what} must be (width, height), not {value!r}") from None
 
 
-def read(path: PathLike, roi: Optional[Size] = None, resolution: Optional[Size] = None) -> Recording:
+def read(
+    path: PathLike,
+    roi: Optional[Size] = None,
+    resolution: Optional[Size] = None,
+    stream: Optional[Union[str, int]] = None,
+) -> Recording:
     """Reads a whole event file: AEDAT 4.0, 3.1 or 2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY (the
     formats ``evtac convert`` reads).
 
     ``roi=(w, h)`` keeps the centered ``w x h`` region (coordinates shifted into it; the
     recording's resolution is then the region's). ``resolution=(w, h)`` declares the sensor size
-    of files that do not store it (CSV, NPY) and checks every event against it.
+    of files that do not store it (CSV, NPY) and checks every event against it. ``stream``
+    picks the event stream of an AEDAT4 file with several (two cameras): its id, name, camera
+    name or ``CAMERA/NAME`` as ``evtac info`` lists them; that camera's IMU comes with it.
 
     Returns a :class:`Recording` with ``events``, ``imu``, ``triggers`` (structured arrays),
     ``resolution``, ``format`` and ``source``.
     """
-    return _evtac.read(os.fspath(path), _size(roi, "roi"), _size(resolution, "resolution"))
+    return _evtac.read(
+        os.fspath(path), _size(roi, "roi"), _size(resolution, "resolution"), _stream(stream)
+    )
+
+
+def _stream(stream: Optional[Union[str, int]]) -> Optional[str]:
+    return None if stream is None else str(stream)
 
 
 def open(
@@ -157,14 +170,21 @@ def open(
     roi: Optional[Size] = None,
     resolution: Optional[Size] = None,
     chunk_events: int = 65536,
+    stream: Optional[Union[str, int]] = None,
 ) -> Reader:
     """Opens a large event file for reading in chunks.
 
     Iterating the returned :class:`Reader` yields :class:`Recording` objects of at least
     ``chunk_events`` events each (the last may be shorter), with the IMU samples and triggers
-    read alongside. ``roi`` and ``resolution`` are as for :func:`read`.
+    read alongside. ``roi``, ``resolution`` and ``stream`` are as for :func:`read`.
     """
-    return _evtac.Reader(os.fspath(path), _size(roi, "roi"), _size(resolution, "resolution"), chunk_events)
+    return _evtac.Reader(
+        os.fspath(path),
+        _size(roi, "roi"),
+        _size(resolution, "resolution"),
+        chunk_events,
+        _stream(stream),
+    )
 
 
 def write(

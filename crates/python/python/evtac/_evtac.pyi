@@ -55,12 +55,16 @@ class Reader:
         roi: Optional[_Size] = None,
         resolution: Optional[_Size] = None,
         chunk_events: int = 65536,
+        stream: Optional[str] = None,
     ) -> Reader: ...
     def __iter__(self) -> Iterator[Recording]: ...
     def __next__(self) -> Recording: ...
 
 def read(
-    path: _Path, roi: Optional[_Size] = None, resolution: Optional[_Size] = None
+    path: _Path,
+    roi: Optional[_Size] = None,
+    resolution: Optional[_Size] = None,
+    stream: Optional[str] = None,
 ) -> Recording: ...
 def write(
     path: _Path,

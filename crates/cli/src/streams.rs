@@ -1,0 +1,34 @@
+//! `--stream`, `--imu-stream`, `--trigger-stream`: which streams of an AEDAT4 file with several
+//! (two cameras, say) a command reads, flattened into each command that reads a recording
+//! (`evtac_events::aedat::StreamSelection` has the rule when they are not given).
+
+use evtac_events::aedat::{StreamChoice, StreamSelection};
+
+/// The stream flags.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct StreamArgs {
+    /// The event stream to read from an AEDAT4 file with several (e.g. two cameras): its id, its
+    /// name, its camera's name or CAMERA/NAME, as `evtac info` lists them. Default: the file's
+    /// only event stream.
+    #[arg(long, value_name = "NAME|ID")]
+    pub stream: Option<StreamChoice>,
+    /// The IMU stream, when the file has several. Default: the only one, or the chosen event
+    /// stream's camera's.
+    #[arg(long, value_name = "NAME|ID")]
+    pub imu_stream: Option<StreamChoice>,
+    /// The trigger stream, when the file has several. Default: the only one, or the chosen event
+    /// stream's camera's.
+    #[arg(long, value_name = "NAME|ID")]
+    pub trigger_stream: Option<StreamChoice>,
+}
+
+impl StreamArgs {
+    /// The selection these flags ask for.
+    pub fn selection(&self) -> StreamSelection {
+        StreamSelection {
+            events: self.stream.clone(),
+            imu: self.imu_stream.clone(),
+            triggers: self.trigger_stream.clone(),
+        }
+    }
+}
