@@ -92,7 +92,23 @@ fn main() {
         Command::Online(args) => commands::online::run(args),
     };
     if let Err(err) = result {
-        eprintln!("error: {err:#}");
+        eprintln!("error: {}", report(&err));
         std::process::exit(1);
     }
+}
+
+/// The error and its causes, joined by `: ` as `{:#}` does, but leaving out a cause whose
+/// message the text before it already holds: the library errors embed their inner error's
+/// message (`model.safetensors: No such file or directory`) and some also keep it as their
+/// `source()`, which `{:#}` would print a second time.
+fn report(err: &anyhow::Error) -> String {
+    let mut text = err.to_string();
+    for cause in err.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text.push_str(": ");
+            text.push_str(&cause);
+        }
+    }
+    text
 }

@@ -49,3 +49,32 @@ fn passes_a_simulated_dataset_and_tables_the_problems_of_a_damaged_one() {
     assert_eq!(problems[0]["field"], "file");
     assert_eq!(problems[0]["problem"], "missing");
 }
+
+#[test]
+fn a_missing_or_empty_folder_is_said_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nothing-here");
+    let o = evtac().arg("check").arg(&missing).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!o.status.success());
+    assert!(out.contains("the folder does not exist"), "{out}");
+    assert!(!out.contains("trials.csv"), "{out}");
+    let o = evtac().arg("check").arg(dir.path()).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!o.status.success());
+    assert!(out.contains("the folder is empty"), "{out}");
+}
+
+#[test]
+fn an_error_says_its_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = evtac()
+        .args(["evaluate", "--model"])
+        .arg(dir.path().join("no-model"))
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}

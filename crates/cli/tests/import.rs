@@ -238,6 +238,20 @@ fn several_sessions_and_a_folder_of_trials_import_into_one_dataset() {
         !o.status.success() && err.contains("robot_log.csv:2: column `trial`: `t0000` is also "),
         "{err}"
     );
+    assert!(err.contains("--trial-prefix"), "{err}");
+    let prefixed = p("prefixed");
+    let mut with_prefixes = args.clone();
+    with_prefixes[10] = &prefixed;
+    with_prefixes.extend(["--trial-prefix", "s0_", "--trial-prefix", "s1_"]);
+    run_ok(&with_prefixes);
+    let names: Vec<String> = Manifest::read(dir.path().join("prefixed"))
+        .unwrap()
+        .trials
+        .into_iter()
+        .map(|t| t.trial)
+        .collect();
+    assert_eq!(names, ["s0_t0000", "s0_t0001", "s1_t0000", "s1_t0001"]);
+    assert!(dir.path().join("prefixed/s1_t0001.aedat4").is_file());
     let renamed = p("b/renamed.csv");
     let text = std::fs::read_to_string(&log_b).unwrap();
     std::fs::write(&renamed, text.replace("\nt00", "\nu00")).unwrap();
@@ -337,5 +351,53 @@ fn several_sessions_and_a_folder_of_trials_import_into_one_dataset() {
             (i.motion_start_us - t.motion_start_us).abs() <= 20_000,
             "{i:?}"
         );
+    }
+}
+
+/// `--no-contact-range` with units counts from the recording's first event; plain numbers are
+/// on its clock, and a range there that holds nothing is an error, not an empty recording.
+#[test]
+fn a_no_contact_range_with_units_counts_from_the_recordings_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    simulate_session_tiny("exp1", 3, &dir.path().join("s"), Some(2));
+    let start = read_recording(p("s/session.aedat4")).unwrap().events[0].t;
+    let import = |out: &str, range: &str| {
+        evtac()
+            .args([
+                "import",
+                &p("s/session.aedat4"),
+                "--log",
+                &p("s/robot_log.csv"),
+            ])
+            .args([
+                "--sync",
+                "trigger",
+                "--out",
+                &p(out),
+                "--no-contact-range",
+                range,
+            ])
+            .args(["--calibration", &p("s/calibration.json")])
+            .output()
+            .unwrap()
+    };
+    for (out, range) in [("rel", "0s..2s"), ("rel_ms", "0ms..2000ms")] {
+        let o = import(out, range);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let nc = read_recording(dir.path().join(out).join("no_contact.aedat4")).unwrap();
+        assert!(!nc.events.is_empty());
+        assert!(nc.events[0].t >= start && nc.events.last().unwrap().t < start + 2_000_000);
+    }
+    let absolute = format!("{}..{}", start, start + 2_000_000);
+    let o = import("abs", &absolute);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a = read_recording(dir.path().join("abs/no_contact.aedat4")).unwrap();
+    let r = read_recording(dir.path().join("rel/no_contact.aedat4")).unwrap();
+    assert_eq!(a.events, r.events);
+    for bad in ["0s..2000000", "2s..1s", "0..x"] {
+        let o = import("bad", bad);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(bad), "{bad}: {err}");
     }
 }

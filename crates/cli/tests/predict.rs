@@ -44,6 +44,7 @@ fn predicts_like_the_library_and_numpy() {
         &s(&x_path),
         "--output",
         &s(&y_path),
+        "--unchecked-features",
     ]);
     let y: Array2<f32> = ndarray_npy::read_npy(&y_path).expect("float32 N x 2 output");
     assert_eq!(y.dim(), (6, 2));
@@ -101,10 +102,123 @@ fn rejects_wrong_dtype_and_shape_clearly() {
             .arg(&path)
             .arg("--output")
             .arg(dir.path().join("out.npy"))
+            .arg("--unchecked-features")
             .output()
             .expect("evtac runs");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{name} accepted");
         assert!(stderr.contains(message), "{name}: {stderr}");
     }
+}
+
+fn as_refs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+/// Runs `evtac` expecting failure; returns its stderr.
+fn run_err(args: &[&str]) -> String {
+    let out = evtac().args(args).output().expect("evtac runs");
+    assert!(!out.status.success(), "evtac {args:?} should have failed");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A 320x240 recording with events all over the sensor, and sample times in it.
+fn recording(dir: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let path = dir.join("trial.aedat4");
+    let mut w = evtac_events::EventWriter::create(
+        &path,
+        Some(evtac_events::Resolution::new(320, 240)),
+        None,
+    )
+    .expect("writer");
+    let events: Vec<evtac_events::Event> = (0..40_000i64)
+        .map(|i| evtac_events::Event {
+            t: i * 25,
+            x: ((i * 7) % 320) as u16,
+            y: ((i * 13) % 240) as u16,
+            polarity: i % 3 != 0,
+        })
+        .collect();
+    w.write_events(&events).expect("events");
+    w.finish().expect("finish");
+    let times = dir.join("times.txt");
+    std::fs::write(&times, "200000\n500000\n900000\n").expect("times");
+    (path, times)
+}
+
+#[test]
+fn features_made_otherwise_than_the_models_are_refused_naming_both() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let model = dir.path().join("model");
+    let bundle = ModelBundle::untrained(
+        3,
+        Representation::new(ReprConfig::Static(evtac_repr::StaticConfig::default())),
+        None,
+    );
+    bundle.save(&model).expect("bundle saved");
+    let (trial, times) = recording(dir.path());
+    let s = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
+    let (features, out) = (dir.path().join("f.npy"), dir.path().join("y.npy"));
+    let represent = |extra: &[&str]| {
+        let mut args = vec![
+            "represent".to_string(),
+            s(&trial),
+            "--samples".into(),
+            s(&times),
+            "--output".into(),
+            s(&features),
+        ];
+        args.extend(extra.iter().map(|a| a.to_string()));
+        args
+    };
+    let predict = [
+        "predict".to_string(),
+        "--model".into(),
+        s(&model),
+        "--features".into(),
+        s(&features),
+        "--output".into(),
+        s(&out),
+    ];
+
+    // The README's chain with combined features and a static model: 900 columns each.
+    run_ok(&as_refs(&represent(&["--repr", "combined"])));
+    let provenance = std::fs::read_to_string(dir.path().join("f.npy.json")).expect("sidecar");
+    assert!(provenance.contains("v1_combined_"), "{provenance}");
+    let err = run_err(&as_refs(&predict));
+    assert!(err.contains("the features are v1_combined_"), "{err}");
+    assert!(err.contains("the model reads v1_static_"), "{err}");
+    assert!(err.contains("evtac represent --model"), "{err}");
+    assert!(!out.exists());
+    // Other static settings, the same.
+    run_ok(&as_refs(&represent(&[
+        "--repr", "static", "--tau-ms", "800",
+    ])));
+    let err = run_err(&as_refs(&predict));
+    assert!(err.contains("tau800"), "{err}");
+
+    // The model's own features.
+    run_ok(&as_refs(&represent(&["--model", &s(&model)])));
+    run_ok(&as_refs(&predict));
+    let checked: Array2<f32> = ndarray_npy::read_npy(&out).expect("output");
+    assert_eq!(checked.dim(), (3, 2));
+
+    // Without a record of what made them: refused, unless the user vouches for them.
+    std::fs::remove_file(dir.path().join("f.npy.json")).expect("remove");
+    let err = run_err(&as_refs(&predict));
+    assert!(err.contains("--unchecked-features"), "{err}");
+    let mut unchecked = predict.to_vec();
+    unchecked.push("--unchecked-features".into());
+    run_ok(&as_refs(&unchecked));
+    let y: Array2<f32> = ndarray_npy::read_npy(&out).expect("output");
+    assert_eq!(y, checked);
+
+    // --model sets the representation: settings beside it are refused.
+    let err = run_err(&as_refs(&represent(&[
+        "--model",
+        &s(&model),
+        "--tau-ms",
+        "5",
+    ])));
+    assert!(err.contains("cannot be used with"), "{err}");
 }

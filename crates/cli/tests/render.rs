@@ -191,3 +191,25 @@ fn unknown_panel_and_format_and_angles_without_a_model_are_named() {
         assert!(err.contains(message), "{err}");
     }
 }
+
+/// A contact sheet with the default --fps and --speed spreads 24 frames over a whole simulated
+/// trial (141 frames at 30 fps would not fit in one).
+#[test]
+fn a_png_sheet_with_the_defaults_spreads_24_frames_over_the_trial() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("sim");
+    crate::common::simulate_tiny("exp1", 0, &data, 1);
+    let out = dir.path().join("sheet.png");
+    let o = run_ok(&[
+        "render",
+        data.to_str().unwrap(),
+        "--trial",
+        "t0000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let said =
+        String::from_utf8_lossy(&o.stderr).into_owned() + &String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("24 frames"), "{said}");
+    assert!(out.is_file());
+}

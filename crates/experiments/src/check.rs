@@ -98,6 +98,29 @@ fn dataset_dirs(dir: &Path) -> Vec<PathBuf> {
 /// as it would be opened with `inputs`; `progress` follows the recordings read.
 pub fn check(dir: &Path, inputs: Inputs, progress: &(dyn Fn(CheckProgress) + Sync)) -> CheckReport {
     let mut report = CheckReport::default();
+    // A folder that is not there, or holds nothing, is said as such rather than as the first
+    // file a dataset would need (`exp1/trials.csv cannot be read`).
+    let fix = "give the folder `evtac simulate`, `evtac import` or `reproduce --data` wrote";
+    match std::fs::read_dir(dir).map(|mut entries| entries.next().is_none()) {
+        Err(e) => {
+            let problem = match e.kind() {
+                std::io::ErrorKind::NotFound => "the folder does not exist".to_string(),
+                _ => format!("the folder cannot be read: {e}"),
+            };
+            report
+                .problems
+                .push(Problem::new(dir, None, None, problem, fix));
+            return report;
+        }
+        Ok(true) => {
+            let problem = "the folder is empty: no trials.csv and no dataset folders".to_string();
+            report
+                .problems
+                .push(Problem::new(dir, None, None, problem, fix));
+            return report;
+        }
+        Ok(false) => {}
+    }
     for ds in dataset_dirs(dir) {
         check_dataset(&ds, inputs, progress, &mut report);
     }

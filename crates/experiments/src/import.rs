@@ -137,7 +137,8 @@ pub fn import_parts(
             if let Some(first) = seen.insert(t.trial.clone(), here.clone()) {
                 repeated.push(format!(
                     "{here}: column `trial`: `{}` is also {first} (trial names name the files: \
-                     each must be unique across the logs)",
+                     each must be unique across the logs; `evtac import --trial-prefix` puts a \
+                     prefix per session before them)",
                     t.trial
                 ));
             }

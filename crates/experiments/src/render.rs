@@ -45,7 +45,7 @@ pub use draw::{Layout, Scene, draw_frame, layout};
 pub use frames::{Frame, ReprFrame, Timing, for_each_frame};
 pub use gif::GifWriter;
 pub use mp4::Mp4Writer;
-pub use sheet::{MAX_SHEET_FRAMES, SheetWriter};
+pub use sheet::{MAX_SHEET_FRAMES, SHEET_DEFAULT_FRAMES, SheetWriter};
 
 use evtac_events::Event;
 use evtac_repr::{Mask, ReprConfig, ReprError};

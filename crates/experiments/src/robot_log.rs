@@ -102,6 +102,15 @@ pub struct RobotLog {
 }
 
 impl RobotLog {
+    /// Puts `prefix` before every trial's name (and so its file's): two sessions whose logs
+    /// both name `t0000` go into one dataset as `s0_t0000` and `s1_t0000`.
+    pub fn prefix_trials(&mut self, prefix: &str) {
+        for (_, t) in &mut self.rows {
+            t.trial = format!("{prefix}{}", t.trial);
+            t.file = trial_file(&t.trial).into();
+        }
+    }
+
     /// Reads the log at `path`, shifting its times by `clock_offset_us`.
     pub fn read(path: &Path, clock_offset_us: i64) -> Result<Self, LogError> {
         Self::parse(&read_text(path)?, path, clock_offset_us)

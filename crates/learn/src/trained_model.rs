@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use evtac_repr::{Mask, ReprConfig};
+use evtac_repr::{FeatureProvenance, Mask, ReprConfig};
 
 use crate::bundle::{self, ModelBundle, Representation};
 use crate::predictor::{self, Predictor};
@@ -51,6 +51,17 @@ impl Model {
     /// The no-contact mask the static representation was masked with, if any.
     pub fn mask(&self) -> Option<&Mask> {
         self.bundle.mask.as_ref()
+    }
+
+    /// What the features this model reads are made of: its representation, crop and mask.
+    /// Features whose [`FeatureProvenance`] differs are refused by `evtac predict` and the
+    /// Python `Model.predict`.
+    pub fn feature_provenance(&self) -> FeatureProvenance {
+        FeatureProvenance::new(
+            &self.repr_config(),
+            self.representation().frame,
+            self.mask(),
+        )
     }
 
     /// Predictions (pitch, roll) for `features`, `N x 900` row-major.

@@ -9,7 +9,7 @@ use std::time::Instant;
 use evtac_events::Resolution;
 use evtac_learn::ModelBundle;
 use evtac_online::Estimate;
-use evtac_repr::CROP;
+use evtac_repr::{CROP, FeatureProvenance};
 use ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -81,6 +81,30 @@ impl Model {
                 .map_err(error::value)
         })?;
         Ok(out.into_pyarray(py))
+    }
+
+    /// Refuses features made otherwise than the model's (`provenance`: the JSON a
+    /// `Representation` attaches to its features; `None`: a plain array, which says nothing).
+    #[pyo3(signature = (provenance = None))]
+    fn check_features(&self, provenance: Option<&str>) -> PyResult<()> {
+        let expected = self.inner.feature_provenance();
+        let Some(text) = provenance else {
+            return Err(error::value(format!(
+                "these features carry no record of what made them (a plain array); the model \
+                 {} reads {expected}: compute them with model.representation(sensor).features(...), \
+                 or pass check=False if you know they match",
+                self.inner.dir.display()
+            )));
+        };
+        let got: FeatureProvenance = serde_json::from_str(text)
+            .map_err(|e| error::value(format!("the features' provenance is unreadable: {e}")))?;
+        match got.mismatch(&expected) {
+            None => Ok(()),
+            Some(why) => Err(error::value(format!(
+                "these features do not match the model {}: {why}",
+                self.inner.dir.display()
+            ))),
+        }
     }
 
     /// The representation the model's features are computed with (its config and mask, on

@@ -11,7 +11,9 @@ use std::sync::{Mutex, MutexGuard};
 
 use evtac_events::check::EventCheck;
 use evtac_events::{Event, Resolution, Roi};
-use evtac_repr::{CROP, DynamicConfig, FeatureExtractor, Mask, ReprConfig, StaticConfig};
+use evtac_repr::{
+    CROP, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, ReprConfig, StaticConfig,
+};
 use ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -412,6 +414,14 @@ impl Representation {
                     .map_err(error::value)
             })
             .transpose()
+    }
+
+    /// What its features are made of (representation, crop, mask), as JSON: `Model.predict`
+    /// compares it with the model's.
+    #[getter]
+    fn provenance(&self) -> PyResult<String> {
+        let p = FeatureProvenance::new(&self.config, self.roi.size, self.mask.as_ref());
+        serde_json::to_string(&p).map_err(error::value)
     }
 
     /// Features per sample (900 on the paper's 240x240 crop, 1800 for stacked and late).

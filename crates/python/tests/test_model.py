@@ -29,6 +29,7 @@ def test_predict_is_the_clis(cli, tmp_path, model_dir, recording):
     t = recording.events["t"]
     features = rep.features(recording.events, np.arange(t[0], t[-1], 5000))
     np.save(tmp_path / "x.npy", features)
+    (tmp_path / "x.npy.json").write_text(features.provenance)
     cli("predict", "--model", model_dir, "--features", tmp_path / "x.npy",
         "--output", tmp_path / "y.npy")
     expected = np.load(tmp_path / "y.npy")
@@ -82,9 +83,11 @@ def test_errors(tmp_path, model_dir):
         evtac.Model.load(tmp_path / "no-model")
     model = evtac.Model.load(model_dir)
     with pytest.raises(ValueError, match=r"shape \(N, 900\), got \(2, 899\)"):
-        model.predict(np.zeros((2, 899), np.float32))
+        model.predict(np.zeros((2, 899), np.float32), check=False)
     with pytest.raises(ValueError, match="float"):
-        model.predict(np.zeros((2, 900), np.int32))
+        model.predict(np.zeros((2, 900), np.int32), check=False)
+    with pytest.raises(ValueError, match="carry no record of what made them"):
+        model.predict(np.zeros((2, 900), np.float32))
     with pytest.raises(ValueError, match="smaller than the 240x240"):
         evtac.Estimator(model, (200, 200))
     with pytest.raises(ValueError, match="240x240 crop"):
@@ -113,4 +116,25 @@ def test_torch_module_loads_the_bundle_and_predicts_what_evtac_does(torch, tmp_p
         got = net(torch.from_numpy(x)).numpy()
     np.testing.assert_allclose(got, model.predict(x), rtol=1e-4, atol=1e-4)
     with pytest.raises(ValueError, match="shape"):
-        model.predict(np.zeros((2, 1800 if kind == "combined" else 900), np.float32))
+        model.predict(np.zeros((2, 1800 if kind == "combined" else 900), np.float32), check=False)
+
+
+def test_features_made_otherwise_are_refused_naming_both(model_dir, recording):
+    """The README's chain with the wrong representation: combined features have a static
+    model's 900 columns, and would give confident wrong angles."""
+    model = evtac.Model.load(model_dir)
+    t = recording.events["t"]
+    times = np.arange(t[0], t[-1], 50_000)
+    sensor = recording.resolution
+    for other, why in [
+        (evtac.Representation("static", sensor=sensor), "the features are v1_static"),
+        (evtac.Representation("combined", sensor=sensor), "the model reads v1_combined"),
+        (evtac.Representation("combined", sensor=sensor, tau_ms=800, roi=None), "pooled from"),
+    ]:
+        features = other.features(recording.events, times)
+        with pytest.raises(ValueError, match=why):
+            model.predict(features)
+    own = model.representation(sensor=sensor).features(recording.events, times)
+    assert isinstance(own, evtac.Features) and own.provenance
+    assert model.predict(own[2:5]).shape == (3, 2), "rows keep what made them"
+    np.testing.assert_array_equal(model.predict(np.asarray(own), check=False), model.predict(own))

@@ -56,6 +56,7 @@ mod fifo;
 pub mod mask;
 pub mod pool;
 mod prefetch;
+mod provenance;
 pub mod window;
 
 pub use accumulator::{FrameMap, StaticAccumulator};
@@ -69,4 +70,5 @@ pub use error::ReprError;
 pub use extractor::{FeatureExtractor, extract_features};
 pub use mask::Mask;
 pub use pool::{Pool8, pool8};
+pub use provenance::FeatureProvenance;
 pub use window::SlidingWindow;

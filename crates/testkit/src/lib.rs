@@ -27,7 +27,12 @@ fn missing(what: &str) -> Option<PathBuf> {
     if in_ci() {
         panic!("{what} is required under CI but was not found");
     }
-    eprintln!("skipped: {what} not found");
+    // Straight to the process's standard error: libtest captures `eprintln!` and shows it only
+    // for failing tests or with `--nocapture`, and a skipped test must say so in a plain run.
+    let _ = std::io::Write::write_all(
+        &mut std::io::stderr(),
+        format!("skipped: {what} not found\n").as_bytes(),
+    );
     None
 }
 

@@ -9,6 +9,7 @@ use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::splits::Split;
 use evtac_experiments::training;
 use evtac_learn::Model;
+use evtac_repr::{CROP, FeatureProvenance};
 use std::path::PathBuf;
 
 /// Arguments of `evtac evaluate`.
@@ -55,6 +56,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cache = FeatureCache::new(&ds)?;
     let bar = crate::progress::bar(trials.len() as u64, "features");
     let config = model.repr_config();
+    // The features are the model's representation on the model's crop, but masked with this
+    // dataset's no-contact mask: a different mask is different features.
+    let made = FeatureProvenance::new(&config, CROP, cache.mask(&config)?.as_ref());
+    if let Some(why) = made.mismatch(&model.feature_provenance()) {
+        anyhow::bail!(
+            "the features of {} do not match the model {}: {why} (the dataset's \
+             no_contact.aedat4, or --no-mask, gives the mask; the model was trained with another)",
+            args.dataset.display(),
+            args.model.display()
+        );
+    }
     cache.ensure(&trials, std::slice::from_ref(&config), sampling, &|_| {
         bar.inc(1)
     })?;

@@ -74,6 +74,10 @@ pub struct Args {
         conflicts_with = "log"
     )]
     pub total_step_deg: f64,
+    /// Put this before the trial names of each session (one per session, in order; e.g.
+    /// `--trial-prefix s0_ --trial-prefix s1_`), for sessions whose logs reuse names.
+    #[arg(long, value_name = "PREFIX")]
+    pub trial_prefix: Vec<String>,
     /// The dataset folder to write (must not exist).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -104,10 +108,12 @@ pub struct Args {
     /// A recording of the sensor without contact (for the static representation's mask).
     #[arg(long, value_name = "FILE", conflicts_with = "no_contact_range")]
     pub no_contact: Option<PathBuf>,
-    /// The time range A..B (microseconds on the recording's clock) of the session in which the
-    /// sensor is out of contact, written as the no-contact recording.
+    /// The time range A..B of the (first) session in which the sensor is out of contact,
+    /// written as the no-contact recording. With units (`0s..2s`, `500ms..1500ms`,
+    /// `0us..2000000us`) the times count from the recording's first event; plain numbers are
+    /// microseconds on the recording's clock, as `evtac info` prints them.
     #[arg(long, value_name = "A..B", value_parser = parse_range)]
-    pub no_contact_range: Option<(i64, i64)>,
+    pub no_contact_range: Option<TimeRange>,
     /// The IMU-to-sensor rotation (a calibration.json), copied into the dataset.
     #[arg(long, value_name = "FILE")]
     pub calibration: Option<PathBuf>,
@@ -173,6 +179,27 @@ type Found = Vec<(PathBuf, FoundMotion)>;
 /// each folder split by its log's trials, or without logs the motions found in every file
 /// (returned for review too).
 fn parts(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found)> {
+    anyhow::ensure!(
+        args.trial_prefix.is_empty() || args.trial_prefix.len() == args.sessions.len(),
+        "{} sessions and {} --trial-prefix: give one per session, in the same order",
+        args.sessions.len(),
+        args.trial_prefix.len()
+    );
+    let (mut parts, found) = parts_unprefixed(args, sync)?;
+    if !args.trial_prefix.is_empty() {
+        for part in &mut parts {
+            let k = args
+                .sessions
+                .iter()
+                .position(|s| part.session == *s || part.session.starts_with(s))
+                .context("a part of no session")?;
+            part.log.prefix_trials(&args.trial_prefix[k]);
+        }
+    }
+    Ok((parts, found))
+}
+
+fn parts_unprefixed(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found)> {
     let mut parts = Vec::new();
     let mut found_all = Vec::new();
     if args.log.is_empty() {
@@ -273,12 +300,92 @@ fn parts(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found)> {
     Ok((parts, found_all))
 }
 
-fn parse_range(s: &str) -> Result<(i64, i64), String> {
-    let bad = || format!("`{s}` is not a range A..B of microseconds with A < B");
+/// A time range as given: microseconds on the recording's clock, or (with units) from the
+/// recording's first event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TimeRange {
+    /// Start, microseconds.
+    pub from: i64,
+    /// End, microseconds.
+    pub to: i64,
+    /// Whether both count from the recording's first event.
+    pub from_start: bool,
+}
+
+impl TimeRange {
+    /// The range on the recording's clock, for a recording whose first event is at `start`.
+    fn on_clock(self, start: impl FnOnce() -> anyhow::Result<i64>) -> anyhow::Result<(i64, i64)> {
+        if !self.from_start {
+            return Ok((self.from, self.to));
+        }
+        let start = start()?;
+        Ok((start + self.from, start + self.to))
+    }
+}
+
+/// One bound: `(value, with a unit)` in microseconds.
+fn parse_time(s: &str) -> Option<(i64, bool)> {
+    let s = s.trim();
+    let (number, scale) = if let Some(n) = s.strip_suffix("us") {
+        (n, Some(1.0))
+    } else if let Some(n) = s.strip_suffix("ms") {
+        (n, Some(1e3))
+    } else if let Some(n) = s.strip_suffix('s') {
+        (n, Some(1e6))
+    } else {
+        (s, None)
+    };
+    match scale {
+        None => number.parse::<i64>().ok().map(|v| (v, false)),
+        Some(scale) => {
+            let v: f64 = number.trim().parse().ok()?;
+            let us = (v * scale).round();
+            (us.is_finite() && us.abs() < 9e18).then_some((us as i64, true))
+        }
+    }
+}
+
+fn parse_range(s: &str) -> Result<TimeRange, String> {
+    let bad = || {
+        format!(
+            "`{s}` is not a range A..B with A < B: microseconds on the recording's clock \
+             (1605537493900000..1605537495900000), or with units from its first event (0s..2s)"
+        )
+    };
     let (a, b) = s.split_once("..").ok_or_else(bad)?;
-    let a: i64 = a.trim().parse().map_err(|_| bad())?;
-    let b: i64 = b.trim().parse().map_err(|_| bad())?;
-    if a < b { Ok((a, b)) } else { Err(bad()) }
+    let ((from, unit_a), (to, unit_b)) = (
+        parse_time(a).ok_or_else(bad)?,
+        parse_time(b).ok_or_else(bad)?,
+    );
+    if unit_a != unit_b {
+        return Err(format!(
+            "`{s}`: give both ends with units (from the recording's first event) or both as \
+             plain microseconds (on its clock)"
+        ));
+    }
+    if from < to {
+        Ok(TimeRange {
+            from,
+            to,
+            from_start: unit_a,
+        })
+    } else {
+        Err(bad())
+    }
+}
+
+/// The time of the first event of `session`.
+fn first_event_us(session: &std::path::Path) -> anyhow::Result<i64> {
+    let mut reader = evtac_events::open(session)?;
+    while let Some(chunk) = reader.next_chunk()? {
+        if let Some(e) = chunk.events.first() {
+            return Ok(e.t);
+        }
+    }
+    anyhow::bail!(
+        "{}: no events, so no start to count --no-contact-range from",
+        session.display()
+    )
 }
 
 /// Runs `evtac import`.
@@ -306,7 +413,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .context("--post-ms is too large")?,
         no_contact: match (&args.no_contact, args.no_contact_range) {
             (Some(file), _) => Some(NoContact::File(file.clone())),
-            (None, Some((a, b))) => Some(NoContact::Range(a, b)),
+            (None, Some(range)) => {
+                let (a, b) = range.on_clock(|| first_event_us(&args.sessions[0]))?;
+                Some(NoContact::Range(a, b))
+            }
             (None, None) => None,
         },
         calibration: args.calibration.clone(),

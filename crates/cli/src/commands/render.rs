@@ -12,7 +12,7 @@
 
 use anyhow::Context;
 use evtac_experiments::dataset::{self, Dataset};
-use evtac_experiments::render::{self, Angles, Output, Panel, Scene, Timing};
+use evtac_experiments::render::{self, Angles, Output, Panel, SHEET_DEFAULT_FRAMES, Scene, Timing};
 use evtac_labels::series::LabelSeries;
 use evtac_learn::Model;
 use evtac_repr::{Mask, ReprConfig};
@@ -37,12 +37,15 @@ pub struct Args {
     /// End of the range, in the recording's microseconds [default: the last event].
     #[arg(long, allow_hyphen_values = true)]
     pub to_us: Option<i64>,
-    /// Frames per second of the output; each frame covers speed / fps seconds of recording.
-    #[arg(long, default_value_t = 30.0)]
-    pub fps: f64,
-    /// Playback speed: recording seconds per second of output (0.1 = ten times slower).
-    #[arg(long, default_value_t = 1.0)]
-    pub speed: f64,
+    /// Frames per second of the output; each frame covers speed / fps seconds of recording
+    /// [default: 30; a PNG contact sheet without --fps and --speed shows 24 frames spread over
+    /// the range].
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// Playback speed: recording seconds per second of output (0.1 = ten times slower)
+    /// [default: 1].
+    #[arg(long)]
+    pub speed: Option<f64>,
     /// Panels, comma-separated: events, static, dynamic, combined, features (the pooled
     /// features of each frame panel, in a second row), angles (the model's estimates over
     /// time; added whenever --model is given).
@@ -157,8 +160,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     };
     let mask_refs: Vec<Option<&Mask>> = masks.iter().map(Option::as_ref).collect();
-    let timing = Timing::new(&events, args.from_us, args.to_us, args.fps, args.speed)
-        .with_context(|| format!("rendering {}", args.input.display()))?;
+    let timing = match (output, args.fps, args.speed) {
+        (Output::Png, None, None) => {
+            Timing::spread(&events, args.from_us, args.to_us, SHEET_DEFAULT_FRAMES)
+        }
+        (_, fps, speed) => Timing::new(
+            &events,
+            args.from_us,
+            args.to_us,
+            fps.unwrap_or(30.0),
+            speed.unwrap_or(1.0),
+        ),
+    }
+    .with_context(|| format!("rendering {}", args.input.display()))?;
 
     let started = Instant::now();
     let angles = match &model {

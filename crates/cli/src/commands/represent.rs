@@ -10,9 +10,10 @@
 
 use anyhow::{Context, bail, ensure};
 use evtac_events::{Event, Resolution, Roi};
+use evtac_learn::Model;
 use evtac_repr::{
-    Comparison, Decay, DynamicConfig, FeatureExtractor, Mask, Polarity, ReprConfig, StaticConfig,
-    ThresholdSpace,
+    Comparison, Decay, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, Polarity,
+    ReprConfig, StaticConfig, ThresholdSpace,
 };
 use ndarray::{Array2, Array3};
 
@@ -87,6 +88,7 @@ pub enum DecayArg {
 
 /// Arguments of `evtac represent`.
 #[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("settings").multiple(true)))]
 pub struct Args {
     /// The event recording (AEDAT4, EVT2/EVT3 raw, CSV or NPY).
     pub events: PathBuf,
@@ -95,64 +97,70 @@ pub struct Args {
     #[arg(long)]
     pub samples: PathBuf,
     /// Representation to build.
-    #[arg(long, value_enum, default_value = "combined")]
+    #[arg(long, value_enum, default_value = "combined", group = "settings")]
     pub repr: Repr,
     /// What to write: binary frames, pooled features or static potentials.
     #[arg(long, value_enum, default_value = "features")]
     pub what: What,
-    /// Output NPY file.
+    /// Output NPY file. Features are written with `OUTPUT.json` beside them, saying what made
+    /// them (representation and settings, crop, mask), which `evtac predict` checks against
+    /// the model.
     #[arg(long, short)]
     pub output: PathBuf,
+    /// Make the features a model reads: its representation and settings, its crop and its
+    /// no-contact mask (instead of --repr, the settings, --roi and --mask).
+    #[arg(long, value_name = "MODEL_DIR", conflicts_with = "settings")]
+    pub model: Option<PathBuf>,
     /// Sensor resolution WIDTHxHEIGHT (needed when the file does not say; overrides it).
     #[arg(long)]
     pub resolution: Option<Resolution>,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
     /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub roi: Option<String>,
     /// No-contact mask: an `.npy` mask (non-zero = masked, crop-sized) or a no-contact recording
     /// run through the same static settings.
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub mask: Option<PathBuf>,
     /// Static: decay function [default: exponential].
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, group = "settings")]
     pub decay: Option<DecayArg>,
     /// Static: decay time constant in milliseconds [default: 1000].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub tau_ms: Option<f64>,
     /// Static: event contribution eta [default: 0.15].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub eta: Option<f32>,
     /// Static: threshold in event contributions; set when value > threshold x eta [default: 2].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub threshold: Option<f32>,
     /// Static: where the threshold applies [default: potential].
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, group = "settings")]
     pub threshold_space: Option<Space>,
     /// Static: comparison against the threshold [default: gt].
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, group = "settings")]
     pub cmp: Option<Cmp>,
     /// Static: lower clamp of the potential [default: 0].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, group = "settings")]
     pub min_potential: Option<f32>,
     /// Static: upper clamp of the potential [default: 1].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, group = "settings")]
     pub max_potential: Option<f32>,
     /// Static: neutral potential, the decay target [default: 0].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, group = "settings")]
     pub neutral_potential: Option<f32>,
     /// Static: polarity handling [default: signed].
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, group = "settings")]
     pub polarity: Option<PolarityArg>,
     /// Static: dv-processing's synchronous decay (every pixel decays at each sample).
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub synchronous_decay: bool,
     /// Dynamic: window length in milliseconds [default: 640].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub window_ms: Option<f64>,
     /// Dynamic: set when the window's event count is > this [default: 0].
-    #[arg(long)]
+    #[arg(long, group = "settings")]
     pub count_threshold: Option<u32>,
 }
 
@@ -221,7 +229,16 @@ impl Args {
 
 /// Runs `evtac represent`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let config = args.config();
+    let model = match &args.model {
+        Some(dir) => Some(
+            Model::load(dir)
+                .with_context(|| format!("loading the model bundle {}", dir.display()))?,
+        ),
+        None => None,
+    };
+    let config = model
+        .as_ref()
+        .map_or_else(|| args.config(), Model::repr_config);
     config.validate()?;
     let inputs: Vec<&Path> = [&args.events, &args.samples]
         .into_iter()
@@ -229,21 +246,35 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(PathBuf::as_path)
         .collect();
     evtac_events::output::refuse_input(&args.output, &inputs)?;
+    let sidecar = FeatureProvenance::sidecar(&args.output);
+    if args.what == What::Features {
+        evtac_events::output::refuse_input(&sidecar, &inputs)?;
+    }
     if args.what == What::Potential && config.static_part().is_none() {
         bail!("--what potential needs a static part: --repr static, combined, stacked or late");
     }
     let samples = read_samples(&args.samples)?;
 
     let (sensor, events) = read_events(&args.events, args.resolution, &args.streams)?;
-    let roi = parse_roi(args.roi.as_deref(), sensor)?;
+    let roi = match &model {
+        Some(m) => Roi::centered(sensor, m.representation().frame).with_context(|| {
+            format!(
+                "the model's {} crop does not fit inside the {sensor} sensor of {}",
+                m.representation().frame,
+                args.events.display()
+            )
+        })?,
+        None => parse_roi(args.roi.as_deref(), sensor)?,
+    };
     let mut cropped = Vec::new();
     roi.crop_into(&events, &mut cropped);
     drop(events);
     let frame = roi.size;
 
-    let mask = match &args.mask {
-        None => None,
-        Some(path) => Some(read_mask(path, &args, &config, frame)?),
+    let mask = match (&model, &args.mask) {
+        (Some(m), _) => m.mask().cloned(),
+        (None, None) => None,
+        (None, Some(path)) => Some(read_mask(path, &args, &config, frame)?),
     };
 
     let mut fx = FeatureExtractor::new(&[config], frame, mask.as_ref())?;
@@ -288,7 +319,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     match args.what {
         What::Frames => write_npy(out, &Array3::from_shape_vec((n, frame_h, w), bytes)?)?,
         What::Potential => write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?)?,
-        What::Features => write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)?,
+        What::Features => {
+            write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)?;
+            let made = FeatureProvenance::new(&config, frame, mask.as_ref());
+            crate::outputs::write_text(&sidecar, &(serde_json::to_string_pretty(&made)? + "\n"))?;
+        }
     }
     eprintln!(
         "wrote {} samples of {} ({} events in the {} crop) to {}",

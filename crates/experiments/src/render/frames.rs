@@ -65,6 +65,21 @@ impl Timing {
         })
     }
 
+    /// `frames` frames (fewer when the range is shorter than `frames` microseconds) spread
+    /// evenly over `[from_us, to_us]` (default: the first and last event), as a contact sheet
+    /// shows a whole trial: one frame per second of output, at the speed that takes.
+    pub fn spread(
+        events: &[Event],
+        from_us: Option<i64>,
+        to_us: Option<i64>,
+        frames: usize,
+    ) -> Result<Timing, Error> {
+        let whole = Self::new(events, from_us, to_us, 1e6, 1.0)?;
+        let span = whole.count as i64; // one frame per microsecond: the span in microseconds
+        let step_us = (span + frames.max(1) as i64 - 1) / frames.max(1) as i64;
+        Self::new(events, from_us, to_us, 1.0, step_us as f64 * 1e-6)
+    }
+
     /// The end of frame `k`'s interval, where its representations are sampled.
     pub fn end_us(&self, k: usize) -> i64 {
         self.start_us + (k as i64 + 1) * self.step_us

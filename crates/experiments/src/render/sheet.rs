@@ -11,6 +11,9 @@ use std::path::Path;
 /// The most frames a sheet holds; more would make a PNG too large to look at.
 pub const MAX_SHEET_FRAMES: usize = 100;
 
+/// Frames a contact sheet shows when neither `--fps` nor `--speed` is given: a 6 x 4 grid.
+pub const SHEET_DEFAULT_FRAMES: usize = 24;
+
 /// Streams frames onto a contact sheet, written on [`SheetWriter::finish`].
 pub struct SheetWriter<'p> {
     path: &'p Path,

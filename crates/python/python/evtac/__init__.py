@@ -48,6 +48,7 @@ __all__ = [
     "open",
     "write",
     "Representation",
+    "Features",
     "Model",
     "Estimator",
     "LABEL_DTYPE",
@@ -267,10 +268,12 @@ class Representation:
         self._inner = inner
         return self
 
-    def features(self, events: Any, times_us: Any) -> np.ndarray:
+    def features(self, events: Any, times_us: Any) -> "Features":
         """Pooled features at each sample time: float32 ``(N, 900)`` on a 240x240 crop
-        (``(N, 1800)`` for stacked and late)."""
-        return self._inner.features(_event_bytes(events), _times(times_us))
+        (``(N, 1800)`` for stacked and late), as :class:`Features` that remember what made
+        them, so that :meth:`Model.predict` refuses them for a model that reads other ones."""
+        array = self._inner.features(_event_bytes(events), _times(times_us))
+        return Features._made_by(array, self._inner.provenance)
 
     def frames(self, events: Any, times_us: Any) -> np.ndarray:
         """Binary frames at each sample time: uint8 ``(N, height, width)``, 0 or 1 (stacked and
@@ -338,6 +341,24 @@ class Representation:
         return f"evtac.Representation({self.cache_key}, roi={self.roi})"
 
 
+class Features(np.ndarray):
+    """Pooled features (a float32 ``(N, 900)`` or ``(N, 1800)`` array) that remember what made
+    them: ``provenance`` is the JSON of the representation with its settings, the crop and the
+    mask's digest, as ``evtac represent`` writes beside its NPY (``FEATURES.npy.json``). Rows
+    taken from it keep it; ``np.asarray(features)`` is a plain array again."""
+
+    provenance: Optional[str]
+
+    @classmethod
+    def _made_by(cls, array: np.ndarray, provenance: str) -> "Features":
+        self = array.view(cls)
+        self.provenance = provenance
+        return self
+
+    def __array_finalize__(self, obj: Any) -> None:
+        self.provenance = getattr(obj, "provenance", None)
+
+
 class Model:
     """A trained model bundle (``evtac train``'s output folder), as ``evtac predict`` loads it."""
 
@@ -359,8 +380,15 @@ class Model:
         """Writes the bundle to the folder ``dir``."""
         self._inner.save(os.fspath(dir))
 
-    def predict(self, features: Any) -> np.ndarray:
-        """(pitch, roll) in degrees for each row of float32 ``(N, 900)`` features: ``(N, 2)``."""
+    def predict(self, features: Any, check: bool = True) -> np.ndarray:
+        """(pitch, roll) in degrees for each row of float32 ``(N, 900)`` features: ``(N, 2)``.
+
+        ``features`` must have been made as the model's own are (its representation, crop and
+        mask): :class:`Features` from :meth:`Representation.features` say what made them, and
+        a mismatch is a ``ValueError`` naming both. A plain array says nothing, so it is refused
+        unless ``check=False``."""
+        if check:
+            self._inner.check_features(getattr(features, "provenance", None))
         f = np.asarray(features)
         if f.ndim != 2 or f.dtype.kind != "f":
             raise ValueError(f"features must be a 2-D float array (N, 900); got {f.dtype} {f.shape}")
