@@ -1,8 +1,8 @@
 //! `--identity-calibration` and `--no-mask`: the explicit opt-outs of a dataset's
 //! `calibration.json` and `no_contact.aedat4`, flattened into each command that opens a dataset
-//! (`evtac_experiments::inputs` says why they are not silent fallbacks).
+//! (`evtac_import::inputs` says why they are not silent fallbacks).
 
-use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, NO_MASK_FLAG};
+use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, NO_MASK_FLAG};
 
 /// The opt-out flags.
 #[derive(Debug, Clone, clap::Args)]

@@ -165,15 +165,16 @@ fn a_failed_convert_leaves_no_output_and_an_earlier_one_untouched() {
 
 /// dv-processing's `StereoCameraWriter` records two cameras whose events and IMU samples
 /// interleave in time (the right camera 3 us after the left), each dumped raw beside it.
-const PY_STEREO: &str = r#"
+pub(crate) const PY_STEREO: &str = r#"
 import sys, numpy as np, dv_processing as dv
 out = sys.argv[1]
+left, right = (sys.argv[2], sys.argv[3]) if len(sys.argv) > 3 else ("DVXplorer_L", "DAVIS346_R")
 def cfg(name, size):
     c = dv.io.MonoCameraWriter.Config(name)
     c.addEventStream(size)
     c.addImuStream()
     return c
-w = dv.io.StereoCameraWriter(f"{out}/stereo.aedat4", cfg("DVXplorer_L", (640, 480)), cfg("DAVIS346_R", (346, 260)))
+w = dv.io.StereoCameraWriter(f"{out}/stereo.aedat4", cfg(left, (640, 480)), cfg(right, (346, 260)))
 rng = np.random.default_rng(34)
 t0 = 1_600_000_000_000_000
 dumps = {}
@@ -304,4 +305,10 @@ fn a_two_camera_file_is_read_one_camera_at_a_time() {
     assert!(err.contains("2 event streams have that name"), "{err}");
     let err = run_err(&["info", s(&stereo), "--stream", "7"]);
     assert!(err.contains("--stream 7: no event stream"), "{err}");
+    // stats reads one camera too (the recording is too short for its noise figures, which is
+    // the next thing it says).
+    let err = run_err(&["stats", s(&stereo)]);
+    assert!(err.contains("2 event streams"), "{err}");
+    let err = run_err(&["stats", s(&stereo), "--stream", "DAVIS346_R"]);
+    assert!(!err.contains("event streams"), "{err}");
 }

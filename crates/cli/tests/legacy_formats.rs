@@ -7,7 +7,7 @@ use crate::common::run_ok;
 /// (AEDAT 2.0, jAER's DAVIS240 addresses), `a31.aedat` (AEDAT 3.1, one polarity packet and one
 /// IMU6 packet of 3 samples), `e21.raw` (EVT 2.1, one event per vector word). Prints
 /// `count on first_t last_t`.
-const PY_WRITE: &str = r##"
+pub(crate) const PY_WRITE: &str = r##"
 import random, struct, sys, os
 d = sys.argv[1]
 rng = random.Random(5)

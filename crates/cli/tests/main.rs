@@ -4,6 +4,7 @@ mod check;
 mod common;
 mod convert;
 mod data_loss;
+mod doc_examples;
 mod evaluate;
 mod import;
 mod info;

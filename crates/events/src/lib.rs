@@ -36,6 +36,7 @@ pub mod check;
 pub mod csv;
 mod error;
 pub mod evt;
+mod io_error;
 pub mod layout;
 pub mod manifest;
 pub mod npy;
@@ -47,6 +48,7 @@ mod text_header;
 mod types;
 
 pub use error::Error;
+pub use io_error::{Cause, IoError};
 pub use range::{RangeIndex, ScanReason};
 pub use recording::{
     Chunk, EventReader, EventWriter, Events, Format, Recording, open, open_with, read_recording,

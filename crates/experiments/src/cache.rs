@@ -16,9 +16,9 @@
 //! interrupted run resumes with the files it finished. Trials run in parallel (rayon).
 
 use crate::dataset::{self, Dataset};
-use crate::io::IoError;
 use crate::sampling::{Phase, SampleTime, Sampling};
 use evtac_events::Event;
+use evtac_events::IoError;
 use evtac_events::layout::CACHE_DIR;
 use evtac_events::manifest::TrialMeta;
 use evtac_learn::FeatureSet;
@@ -92,7 +92,7 @@ pub enum Error {
     },
 }
 
-fn io<E: Into<crate::io::Cause>>(path: &Path) -> impl Fn(E) -> Error + '_ {
+fn io<E: Into<evtac_events::Cause>>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Io(IoError::at(path)(e))
 }
 

@@ -4,13 +4,13 @@
 //! Opening one takes the [`Inputs`] to use: a missing calibration or no-contact recording is an
 //! error unless they opt out of it.
 
-use crate::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
-use crate::io::IoError;
 use crate::sampling::{SampleTime, Sampling};
 use crate::splits::{self, Splits, Stratum};
+use evtac_events::IoError;
 use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE, SIMULATOR_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
+use evtac_import::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use evtac_labels::geometry::Calibration;
 use evtac_labels::{LabelConfig, LabelSeries};
 use evtac_repr::{CROP, Mask, ReprConfig};

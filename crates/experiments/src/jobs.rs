@@ -3,8 +3,8 @@
 //! jobs (folders with `done`); a half-written folder is redone. The same job list can be exported
 //! as one `evtac ...` command per line for a Slurm array or GNU parallel.
 
-use crate::io::IoError;
 use crate::stage::Stage;
+use evtac_events::IoError;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

@@ -3,16 +3,11 @@
 //! states no value evtac chose one; [`choices`] lists them all, with the value used.
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
-//!   `no_contact.aedat4`, `labels/`), labels computed when missing; [`inputs`]: whether its
-//!   calibration and mask come from its files or were opted out of.
-//! - [`check`]: a dataset validated before training, every problem listed (`evtac check`);
-//!   [`LabelCheck`]: its labels against the commanded stop angles and the ground truth.
-//! - [`import`]: a recording session cut into a dataset by the robot's log ([`robot_log`]), put
-//!   on the recording's clock by [`sync`] (from the IMU: [`imu_sync`]), or by the motions found
-//!   in its gyroscope ([`motions`]); several sessions, or a folder of per-trial files
-//!   ([`trial_folder`]), into one dataset.
-//! - [`sensor_stats`]: what a recording says about its sensor (noise at rest, hot pixels, the
-//!   IMU's noise and bias), as simulator parameters (`evtac stats`).
+//!   `no_contact.aedat4`, `labels/`), labels computed when missing, opened with
+//!   `evtac_import::inputs` (whether its calibration and mask come from its files or were opted
+//!   out of); [`LabelCheck`]: its labels against the commanded stop angles and the ground truth.
+//!   Making and checking datasets (import, clock sync, motions, `evtac check`, sensor
+//!   statistics) is `evtac-import`'s.
 //! - [`splits`]: 70:15:15 train/validation/test trials with balanced marginals, `splits.json`.
 //! - [`sampling`]: 50 equally spaced motion points per trial on the 1 ms grid (+10 stop points).
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
@@ -28,8 +23,8 @@
 //!   [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the PNG
 //!   figures; [`choices`] lists the values evtac chose where the paper states none.
 //!
-//! Modules that only the pipeline calls (`noise`, `exp2`, `exp3`, `examples`, `label_check`,
-//! `io`) are private: their results are in [`results`], their errors in [`pipeline::Error`].
+//! Modules that only the pipeline calls (`noise`, `exp2`, `exp3`, `examples`, `label_check`)
+//! are private: their results are in [`results`], their errors in [`pipeline::Error`].
 //!
 //! ```no_run
 //! use evtac_experiments::jobs::Quiet;
@@ -50,7 +45,6 @@
 //! ```
 
 pub mod cache;
-pub mod check;
 pub mod choices;
 pub mod context;
 pub mod dataset;
@@ -58,14 +52,9 @@ mod examples;
 pub mod exp1;
 mod exp2;
 mod exp3;
-pub mod import;
-pub mod imu_sync;
-pub mod inputs;
-mod io;
 pub mod jobs;
 mod label_check;
 pub mod latency;
-pub mod motions;
 mod noise;
 pub mod pipeline;
 pub mod plan;
@@ -74,18 +63,13 @@ pub mod render;
 pub mod report;
 pub mod repr_example;
 pub mod results;
-pub mod robot_log;
 pub mod sampling;
-pub mod sensor_stats;
 pub mod sensor_view;
 pub mod slurm;
 pub mod splits;
 pub mod stage;
 pub mod stage_log;
-pub mod sync;
 pub mod training;
-pub mod trial_folder;
 pub mod tuning;
 
-pub use io::IoError;
 pub use label_check::LabelCheck;

@@ -6,7 +6,6 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::{self, Dataset};
 use crate::exp3::Axis;
-use crate::inputs::Inputs;
 use crate::jobs::{self, Progress};
 use crate::plan::Plan;
 use crate::results::{Results, RunInfo};
@@ -20,6 +19,7 @@ use crate::{
     choices, examples, exp1, exp2, exp3, label_check, latency, noise, report, repr_example,
     sensor_view,
 };
+use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -92,10 +92,10 @@ impl Datasets {
                 .then_some(p)
         };
         Datasets {
-            exp1: dir.join("exp1"),
-            exp2: opt("exp2"),
-            exp3_speed: opt("exp3-speed"),
-            exp3_depth: opt("exp3-depth"),
+            exp1: dir.join(evtac_sim::Protocol::Exp1.name()),
+            exp2: opt(evtac_sim::Protocol::Exp2.name()),
+            exp3_speed: opt(evtac_sim::Protocol::Exp3Speed.name()),
+            exp3_depth: opt(evtac_sim::Protocol::Exp3Depth.name()),
             inputs: Inputs::FROM_FILES,
         }
     }

@@ -201,7 +201,7 @@ pub enum Error {
     },
     /// Creating the temporary file or renaming it to the output failed.
     #[error(transparent)]
-    Io(#[from] crate::io::IoError),
+    Io(#[from] evtac_events::IoError),
 }
 
 impl<'a> Scene<'a> {
@@ -256,7 +256,7 @@ pub fn render(
         }
     }
     temp.persist(path)
-        .map_err(|e| crate::io::IoError::at(path)(e.error))?;
+        .map_err(|e| evtac_events::IoError::at(path)(e.error))?;
     Ok(())
 }
 
@@ -280,5 +280,5 @@ fn temporary_beside(path: &Path) -> Result<tempfile::TempPath, Error> {
     builder
         .tempfile_in(dir)
         .map(tempfile::NamedTempFile::into_temp_path)
-        .map_err(|e| Error::Io(crate::io::IoError::at(dir)(e)))
+        .map_err(|e| Error::Io(evtac_events::IoError::at(dir)(e)))
 }

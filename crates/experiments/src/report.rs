@@ -2,9 +2,9 @@
 //! (every number) and the figures under `OUT/figures/`.
 
 use crate::exp2::SETTINGS;
-use crate::io::IoError;
 use crate::plots;
 use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind};
+use evtac_events::IoError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -238,7 +238,7 @@ pub struct RunInfo {
     /// Where every dataset's calibration and mask came from (absent in results written before
     /// this was recorded).
     #[serde(default)]
-    pub inputs: Option<crate::inputs::Inputs>,
+    pub inputs: Option<evtac_import::inputs::Inputs>,
 }
 
 /// Example curves of one pause trial (Experiment 2's figure).

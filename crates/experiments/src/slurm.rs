@@ -22,12 +22,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use crate::inputs::Inputs;
-use crate::io::IoError;
 use crate::jobs::{self, Progress};
 use crate::pipeline::{self, Datasets};
 use crate::plan::Plan;
 use crate::stage::{PROTOCOLS, Stage};
+use evtac_events::IoError;
+use evtac_import::inputs::Inputs;
 
 /// What can go wrong running on Slurm.
 #[derive(Debug, thiserror::Error)]

@@ -7,7 +7,7 @@
 //! speed, depth and direction (and overall size), so every marginal ends within a trial or two of
 //! 70:15:15. A plain random split leaves marginals off by several trials at these sizes.
 
-use crate::io::IoError;
+use evtac_events::IoError;
 use evtac_events::layout::SPLITS_FILE;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};

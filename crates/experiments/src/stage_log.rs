@@ -7,7 +7,7 @@
 //! little about the reproduction. Each invocation takes the next number and appends a row as
 //! each of its stages finishes, so an interrupted invocation keeps what it finished too.
 
-use crate::io::IoError;
+use evtac_events::IoError;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::{Path, PathBuf};

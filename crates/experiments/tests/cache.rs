@@ -3,9 +3,9 @@
 use crate::simulate;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
-use evtac_experiments::inputs::Inputs;
 use evtac_experiments::plan;
 use evtac_experiments::sampling::{Phase, Sampling};
+use evtac_import::inputs::Inputs;
 use evtac_sim::Protocol;
 
 #[test]

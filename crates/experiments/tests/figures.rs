@@ -5,10 +5,10 @@
 use crate::simulate;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
-use evtac_experiments::inputs::Inputs;
 use evtac_experiments::results::SensorKind;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::{exp1, plan, repr_example, sensor_view};
+use evtac_import::inputs::Inputs;
 use evtac_sim::Protocol;
 
 #[test]

@@ -1,12 +1,9 @@
 //! Integration tests of evtac-experiments on small simulated datasets.
 
 mod cache;
-mod check;
 mod figures;
-mod import;
 mod inputs;
 mod resume;
-mod session;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
 use std::path::Path;

@@ -4,9 +4,9 @@ use crate::simulate;
 use evtac_experiments::cache::FeatureCache;
 use evtac_experiments::dataset::Dataset;
 use evtac_experiments::exp1;
-use evtac_experiments::inputs::Inputs;
 use evtac_experiments::jobs::{self, Quiet};
 use evtac_experiments::plan::{self, Plan};
+use evtac_import::inputs::Inputs;
 use evtac_learn::ModelBundle;
 use evtac_sim::Protocol;
 

@@ -1,9 +1,9 @@
 //! `evtac check`: validates a dataset (or the datasets of a `reproduce --data` folder) before
 //! hours of training, and prints every problem as a table: file, line of `trials.csv`, field,
 //! what is wrong, how to fix it. Exit status 1 when there is any problem, 0 and a short summary
-//! when there is none. The checks are `evtac_experiments::check`'s.
+//! when there is none. The checks are `evtac_import::check`'s.
 
-use evtac_experiments::check::{self, CheckProgress, CheckReport, Problem};
+use evtac_import::check::{self, CheckProgress, CheckReport, Problem};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `evtac check`.

@@ -1,20 +1,20 @@
 //! `evtac import`: a recording session and the robot's log of its motions in (or without a log,
-//! the motions found in its gyroscope: `evtac_experiments::motions`), a dataset folder out (one
+//! the motions found in its gyroscope: `evtac_import::motions`), a dataset folder out (one
 //! AEDAT4 per trial, `trials.csv`, and the no-contact recording and calibration when given),
 //! written into a temporary folder and renamed at the end. The work is
-//! `evtac_experiments::import`'s.
+//! `evtac_import::import`'s.
 
 use anyhow::Context;
 use evtac_events::Trigger;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
-use evtac_experiments::import::{
+use evtac_import::import::{
     DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, Part, import_parts,
 };
-use evtac_experiments::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
-use evtac_experiments::motions::{self, FoundMotion};
-use evtac_experiments::robot_log::RobotLog;
-use evtac_experiments::sync::{Sync, synchronise};
-use evtac_experiments::trial_folder::{split_by_file, trial_files};
+use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, NO_MASK_FLAG};
+use evtac_import::motions::{self, FoundMotion};
+use evtac_import::robot_log::RobotLog;
+use evtac_import::sync::{Sync, synchronise};
+use evtac_import::trial_folder::{split_by_file, trial_files};
 use evtac_labels::geometry::Calibration;
 use std::path::{Path, PathBuf};
 

@@ -45,6 +45,8 @@ pub struct Args {
     /// Sensor size `WIDTHxHEIGHT` for inputs that do not state it (CSV, NPY).
     #[arg(long)]
     pub sensor: Option<Resolution>,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
     /// Chunks the queue between ingestion and estimation holds.
     #[arg(long, default_value_t = PipelineConfig::default().queue_chunks)]
     pub queue_chunks: usize,
@@ -125,6 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             stall_timeout: seconds("--stall-timeout-s", args.stall_timeout_s)?,
             ..NetworkOptions::default()
         },
+        streams: args.streams.selection(),
     };
     let max_duration = args
         .max_duration_s

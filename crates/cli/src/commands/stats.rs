@@ -1,12 +1,12 @@
 //! `evtac stats`: what a recording says about its sensor in the simulator's terms (event rate
 //! over time, background rate and ON fraction at rest, hot pixels, the IMU's noise and bias),
 //! and with `--sim-params` a simulator parameter file for `evtac simulate --params`. The work
-//! is `evtac_experiments::sensor_stats`'s.
+//! is `evtac_import::sensor_stats`'s.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
-use evtac_experiments::sensor_stats::{SensorStats, fit, measure};
+use evtac_import::sensor_stats::{SensorStats, fit, measure_streams};
 
 /// Arguments of `evtac stats`.
 #[derive(Debug, clap::Args)]
@@ -24,6 +24,8 @@ pub struct Args {
     /// Print the statistics as one JSON object instead of text (without the bins).
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
 }
 
 /// Runs `evtac stats`.
@@ -32,7 +34,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| args.recording.display().to_string())?
         .len();
     let bar = crate::progress::bytes(2 * len, "measuring");
-    let stats = measure(&args.recording, |bytes| bar.set_position(bytes))?;
+    let selection = args.streams.selection();
+    let stats = measure_streams(&args.recording, &selection, |bytes| bar.set_position(bytes))?;
     bar.finish_and_clear();
     if let Some(path) = &args.rates {
         crate::outputs::write_text(path, &stats.rates_csv())?;

@@ -2,6 +2,7 @@
 
 use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
+use evtac_events::aedat::StreamSelection;
 use evtac_events::{Event, EventReader, Resolution};
 use std::path::Path;
 
@@ -14,15 +15,20 @@ pub struct FileSource {
 }
 
 impl FileSource {
-    /// Opens `path`; `sensor` declares the sensor size for formats that do not store it (CSV,
-    /// NPY) and must match the file's own otherwise.
-    pub fn open(path: &Path, sensor: Option<Resolution>) -> Result<Self, InputError> {
+    /// Opens `path` (the streams `streams` picks of an AEDAT4 file with several); `sensor`
+    /// declares the sensor size for formats that do not store it (CSV, NPY) and must match the
+    /// file's own otherwise.
+    pub fn open(
+        path: &Path,
+        sensor: Option<Resolution>,
+        streams: &StreamSelection,
+    ) -> Result<Self, InputError> {
         let name = path.display().to_string();
         let events = |source| InputError::Events {
             input: name.clone(),
             source,
         };
-        let mut reader = evtac_events::open(path).map_err(events)?;
+        let mut reader = evtac_events::open_with(path, streams).map_err(events)?;
         if let Some(sensor) = sensor {
             reader.set_resolution(sensor).map_err(events)?;
         }

@@ -92,7 +92,7 @@ pub enum InputError {
 }
 
 /// How an input named on the command line is opened.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct OpenOptions {
     /// Replay a file at recorded pace ([`Paced`]) instead of as fast as possible.
     pub realtime: bool,
@@ -102,6 +102,8 @@ pub struct OpenOptions {
     pub sensor: Option<Resolution>,
     /// Connection and reconnection of network inputs.
     pub network: NetworkOptions,
+    /// Which streams of an AEDAT4 file with several (two cameras) to replay.
+    pub streams: evtac_events::aedat::StreamSelection,
 }
 
 /// An opened input: the source and the sensor size it announced.
@@ -141,7 +143,7 @@ pub fn open(
     };
     Ok(match spec {
         SourceSpec::File(path) => {
-            let source = FileSource::open(path, options.sensor)?;
+            let source = FileSource::open(path, options.sensor, &options.streams)?;
             let resolution = source.resolution().or(options.sensor);
             Opened {
                 source: pace(Box::new(source)),

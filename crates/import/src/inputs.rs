@@ -2,7 +2,7 @@
 //! dataset without `calibration.json` or `no_contact.aedat4` is refused unless the caller opts out
 //! explicitly (`--identity-calibration`, `--no-mask`), because running a real sensor's data with
 //! the identity rotation or without a mask changes the labels and the static features without a
-//! word. The report states which were used ([`crate::results::RunInfo`]).
+//! word. The report states which were used (`evtac_experiments::results::RunInfo`).
 
 use evtac_labels::CalibrationSource;
 use serde::{Deserialize, Serialize};

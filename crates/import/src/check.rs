@@ -23,6 +23,7 @@ use evtac_events::layout::{MANIFEST_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, TrialMeta};
 use evtac_labels::{CalibrationSource, LabelConfig};
 use evtac_repr::CROP;
+use evtac_sim::Protocol;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -87,10 +88,14 @@ fn dataset_dirs(dir: &Path) -> Vec<PathBuf> {
     if dir.join(MANIFEST_FILE).is_file() {
         return vec![dir.to_path_buf()];
     }
-    let data = crate::pipeline::Datasets::in_dir(dir);
-    let optional = [data.exp2, data.exp3_speed, data.exp3_depth];
-    std::iter::once(data.exp1)
-        .chain(optional.into_iter().flatten())
+    // The folders are named after the protocols that fill them (`evtac simulate` lays them out
+    // so); `evtac-experiments`' `pipeline::Datasets::in_dir` reads the same.
+    let optional = [Protocol::Exp2, Protocol::Exp3Speed, Protocol::Exp3Depth]
+        .map(|p| dir.join(p.name()))
+        .into_iter()
+        .filter(|d| d.join(MANIFEST_FILE).is_file());
+    std::iter::once(dir.join(Protocol::Exp1.name()))
+        .chain(optional)
         .collect()
 }
 

@@ -19,8 +19,8 @@
 
 use crate::check::{self, Problem};
 use crate::inputs::{Inputs, MaskSource};
-use crate::io::IoError;
 use crate::robot_log::RobotLog;
+use evtac_events::IoError;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{EventWriter, RangeIndex};

@@ -1,8 +1,10 @@
-//! The one I/O error of this crate: the file it happened to and the cause, kept whole.
+//! The I/O error of the crates above this one (`evtac-import`, `evtac-experiments`): the file it
+//! happened to and the cause, kept whole.
 //!
-//! Every module's errors carry file failures as [`IoError`] (their `Io` variant), so a message
+//! Their modules' errors carry file failures as [`IoError`] (their `Io` variant), so a message
 //! always names the file and `source()` still reaches the underlying error (an
-//! `std::io::Error`, or the NPY or JSON library's), instead of a string copy of it.
+//! `std::io::Error`, or the NPY or JSON library's), instead of a string copy of it. (This
+//! crate's own readers report through [`Error`](crate::Error), which names the format too.)
 
 use std::path::{Path, PathBuf};
 

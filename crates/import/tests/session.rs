@@ -5,13 +5,13 @@
 
 use evtac_events::Trigger;
 use evtac_events::manifest::{Manifest, TrialMeta};
-use evtac_experiments::check::check;
-use evtac_experiments::import::{ImportConfig, NoContact, import_session};
-use evtac_experiments::imu_sync::{imu_offset_whole, read_imu};
-use evtac_experiments::inputs::Inputs;
-use evtac_experiments::motions::{FindConfig, as_log, find_motions, find_motions_in};
-use evtac_experiments::robot_log::RobotLog;
-use evtac_experiments::sync::{Sync, SyncError, synchronise};
+use evtac_import::check::check;
+use evtac_import::import::{ImportConfig, NoContact, import_session};
+use evtac_import::imu_sync::{imu_offset_whole, read_imu};
+use evtac_import::inputs::Inputs;
+use evtac_import::motions::{FindConfig, as_log, find_motions, find_motions_in};
+use evtac_import::robot_log::RobotLog;
+use evtac_import::sync::{Sync, SyncError, synchronise};
 use evtac_labels::dataset::{label_trial, read_calibration, read_calibration_file};
 use evtac_labels::{LabelConfig, LabelSeries, TruthError};
 use evtac_sim::{

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use crate::import::{ImportError, Part};
-use crate::io::IoError;
 use crate::robot_log::RobotLog;
+use evtac_events::IoError;
 
 /// The extensions of the files a folder of trials is read for.
 pub const TRIAL_EXTENSIONS: [&str; 2] = ["aedat4", "aedat"];

@@ -4,8 +4,8 @@
 use crate::simulate;
 use evtac_events::manifest::Manifest;
 use evtac_events::{EventWriter, read_recording};
-use evtac_experiments::check::{CheckReport, check};
-use evtac_experiments::inputs::Inputs;
+use evtac_import::check::{CheckReport, check};
+use evtac_import::inputs::Inputs;
 use evtac_sim::Protocol;
 use std::path::Path;
 

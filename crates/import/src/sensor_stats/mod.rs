@@ -9,10 +9,10 @@
 //! two counters per pixel and one entry per 50 ms bin, however long the recording.
 //!
 //! ```no_run
-//! let stats = evtac_experiments::sensor_stats::measure("no_contact.aedat4".as_ref(), |_| {})?;
-//! let fitted = evtac_experiments::sensor_stats::fit::fit(&stats, Default::default());
+//! let stats = evtac_import::sensor_stats::measure("no_contact.aedat4".as_ref(), |_| {})?;
+//! let fitted = evtac_import::sensor_stats::fit::fit(&stats, Default::default());
 //! println!("{} fields measured", fitted.measured.len());
-//! # Ok::<(), evtac_experiments::sensor_stats::StatsError>(())
+//! # Ok::<(), evtac_import::sensor_stats::StatsError>(())
 //! ```
 
 pub mod fit;
@@ -20,6 +20,7 @@ pub mod imu;
 pub mod pixels;
 pub mod rest;
 
+use evtac_events::aedat::StreamSelection;
 use std::path::{Path, PathBuf};
 
 use evtac_events::Resolution;
@@ -97,8 +98,17 @@ impl SensorStats {
 
 /// Measures the recording at `path` (any format evtac reads that states its sensor's size);
 /// `on_bytes` sees the bytes read so far over both passes (twice the file's length in all).
-pub fn measure(path: &Path, mut on_bytes: impl FnMut(u64)) -> Result<SensorStats, StatsError> {
-    let mut reader = evtac_events::open(path)?;
+pub fn measure(path: &Path, on_bytes: impl FnMut(u64)) -> Result<SensorStats, StatsError> {
+    measure_streams(path, &StreamSelection::default(), on_bytes)
+}
+
+/// [`measure`] on the streams `streams` picks of an AEDAT4 file with several cameras.
+pub fn measure_streams(
+    path: &Path,
+    streams: &StreamSelection,
+    mut on_bytes: impl FnMut(u64),
+) -> Result<SensorStats, StatsError> {
+    let mut reader = evtac_events::open_with(path, streams)?;
     let resolution = reader
         .resolution()
         .ok_or_else(|| StatsError::NoResolution(path.to_path_buf()))?;
@@ -133,7 +143,7 @@ pub fn measure(path: &Path, mut on_bytes: impl FnMut(u64)) -> Result<SensorStats
                 .is_some_and(|b| b.rest)
     };
 
-    let mut reader = evtac_events::open(path)?;
+    let mut reader = evtac_events::open_with(path, streams)?;
     let mut counts = PixelCounts::new(resolution);
     let mut imu = ImuAccumulator::default();
     while let Some(chunk) = reader.next_chunk()? {

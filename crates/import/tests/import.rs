@@ -6,10 +6,10 @@
 use crate::simulate;
 use evtac_events::manifest::Manifest;
 use evtac_events::{Event, EventWriter, ImuSample, Recording, Trigger, read_recording};
-use evtac_experiments::check::check;
-use evtac_experiments::import::{ImportConfig, ImportError, NoContact, import_session};
-use evtac_experiments::inputs::Inputs;
-use evtac_experiments::robot_log::RobotLog;
+use evtac_import::check::check;
+use evtac_import::import::{ImportConfig, ImportError, NoContact, import_session};
+use evtac_import::inputs::Inputs;
+use evtac_import::robot_log::RobotLog;
 use evtac_sim::Protocol;
 use std::path::Path;
 

@@ -1,0 +1,297 @@
+//! Every `evtac` command in the shell examples of the README and `docs/*.md`, run as written,
+//! so that an example that drifts from the tool fails the build.
+//!
+//! Each fenced `sh` block runs in a folder of its own, after its document's setup has put there
+//! the files the prose assumes (a recording, a session and its log, a trained model): real
+//! fixtures from `../shared`, and simulated data. The commands run through `bash` in block
+//! order with the `evtac` under test first on the `PATH`; lines that are not `evtac` commands
+//! (`sbatch`, `cargo ...`) are not run. Two changes are made, both printed: `--scale small` and
+//! `--scale paper` become `--scale tiny` (the pipeline is the same; CI has minutes, not hours),
+//! and a few commands are skipped with the reason (a live camera, a Slurm cluster, a job
+//! array's task id), each run elsewhere by a test of its own.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common::run_ok;
+use evtac_testkit::{real_fixture, run_python, workspace_root};
+
+/// Commands not run here, by a piece of their text, with why.
+const SKIP: &[(&str, &str)] = &[
+    (
+        "--input tcp://",
+        "a live DV network stream (tests/online.rs serves one on loopback)",
+    ),
+    (
+        "--executor slurm",
+        "a Slurm cluster (tests/slurm.rs runs reproduce on a local slurmctld/slurmd)",
+    ),
+    (
+        "SLURM_ARRAY_TASK_ID",
+        "inside a Slurm job array (tests/jobs.rs runs exported jobs)",
+    ),
+    (
+        "/shared/",
+        "a cluster's shared folder (docs/cluster.md's setting)",
+    ),
+];
+
+/// One shell command of a block: its text (continuation lines included) and its line.
+#[derive(Debug)]
+struct Example {
+    line: usize,
+    text: String,
+}
+
+/// The `sh`/`bash` blocks of `markdown`, each as its commands.
+fn blocks(markdown: &str) -> Vec<Vec<Example>> {
+    let mut out = Vec::new();
+    let mut current: Option<Vec<Example>> = None;
+    let mut continued = false;
+    for (i, line) in markdown.lines().enumerate() {
+        let fence = line.trim_start().starts_with("```");
+        match (&mut current, fence) {
+            (None, true) => {
+                let lang = line.trim_start().trim_start_matches('`').trim();
+                if lang == "sh" || lang == "bash" {
+                    current = Some(Vec::new());
+                }
+            }
+            (Some(_), true) => out.push(current.take().unwrap_or_default()),
+            (Some(commands), false) => {
+                let code = strip_comment(line);
+                if continued {
+                    if let Some(last) = commands.last_mut() {
+                        last.text.push('\n');
+                        last.text.push_str(line);
+                    }
+                } else if !code.trim().is_empty() {
+                    commands.push(Example {
+                        line: i + 1,
+                        text: line.to_string(),
+                    });
+                }
+                continued = code.trim_end().ends_with('\\');
+            }
+            (None, false) => {}
+        }
+    }
+    out
+}
+
+/// `line` without a trailing `# comment` (a `#` starting a word, outside quotes).
+fn strip_comment(line: &str) -> &str {
+    let mut quote = None;
+    let mut previous = ' ';
+    for (i, c) in line.char_indices() {
+        match (quote, c) {
+            (None, '"' | '\'') => quote = Some(c),
+            (Some(q), c) if c == q => quote = None,
+            (None, '#') if previous.is_whitespace() => return &line[..i],
+            _ => {}
+        }
+        previous = c;
+    }
+    line
+}
+
+/// Whether a command runs `evtac` (first, or after a pipe).
+fn runs_evtac(text: &str) -> bool {
+    let code = strip_comment(text.lines().next().unwrap_or_default()).trim();
+    code.starts_with("evtac ") || code.contains("| evtac ")
+}
+
+/// The command as run: `--scale small|paper` at the tiny scale.
+fn as_run(text: &str) -> String {
+    text.replace("--scale small", "--scale tiny")
+        .replace("--scale paper", "--scale tiny")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// A simulated session (two motions of Experiment 1, tiny scale) in `dir`.
+fn session(dir: &Path, seed: u64) {
+    crate::common::simulate_session_tiny("exp1", seed, dir, Some(2));
+}
+
+/// The README's setup: the recordings its examples name.
+fn readme_setup(dir: &Path) -> Option<()> {
+    let aedat = real_fixture("dvxplorer_320x240_imu.aedat4")?;
+    for name in ["recording.aedat4", "in.aedat4", "session.aedat4"] {
+        std::fs::copy(&aedat, dir.join(name)).ok()?;
+    }
+    std::fs::copy(
+        real_fixture("prophesee_gen3_640x480.evt2.raw")?,
+        dir.join("recording.raw"),
+    )
+    .ok()?;
+    run_python(crate::legacy_formats::PY_WRITE, &[s(dir)])?;
+    std::fs::rename(dir.join("a2.aedat"), dir.join("neurotac_davis240.aedat")).ok()?;
+    run_python(
+        crate::data_loss::PY_STEREO,
+        &[s(dir), "DVXplorer_DXA00092", "DVXplorer_DXA00093"],
+    )?;
+    for (k, seed) in [(0, 11), (1, 12)] {
+        let sim = dir.join(format!("sim-s{k}"));
+        session(&sim, seed);
+        std::fs::copy(sim.join("session.aedat4"), dir.join(format!("s{k}.aedat4"))).ok()?;
+        std::fs::copy(sim.join("robot_log.csv"), dir.join(format!("s{k}.csv"))).ok()?;
+    }
+    std::fs::create_dir_all(dir.join("docs/img")).ok()
+}
+
+/// docs/real-data.md's setup: a session with its log, no-contact recording and calibration.
+fn real_data_setup(dir: &Path) -> Option<()> {
+    let sim = dir.join("sim-session");
+    // Every motion of the tiny Experiment 1: the walkthrough ends in a reproduction, which
+    // splits the trials into training, validation and test.
+    crate::common::simulate_session_tiny("exp1", 21, &sim, None);
+    for name in [
+        "session.aedat4",
+        "robot_log.csv",
+        "no_contact.aedat4",
+        "calibration.json",
+    ] {
+        std::fs::copy(sim.join(name), dir.join(name)).ok()?;
+    }
+    Some(())
+}
+
+/// docs/online.md's setup: a trained model, a trial, and its events as CSV.
+fn online_setup(dir: &Path) -> Option<()> {
+    let data = dir.join("sim");
+    crate::common::simulate_tiny("exp1", 31, &data, 4);
+    run_ok(&[
+        "train",
+        s(&data),
+        "--repr",
+        "static",
+        "--epochs",
+        "2",
+        "--out",
+        s(&dir.join("runs/static")),
+    ]);
+    let trial = dir.join("trial.aedat4");
+    std::fs::copy(data.join("t0000.aedat4"), &trial).ok()?;
+    run_ok(&["convert", s(&trial), s(&dir.join("events.csv"))]);
+    Some(())
+}
+
+fn no_setup(_: &Path) -> Option<()> {
+    Some(())
+}
+
+/// Before a command containing the first text, runs the second (what the prose says the
+/// reader has made by then).
+const BEFORE: &[(&str, &str)] = &[(
+    "--samples times.txt",
+    r#"t0=$(evtac info data/exp1/t0000.aedat4 --json | sed -n 's/.*"first_t_us": \([0-9]*\).*/\1/p' | head -1)
+for i in $(seq 1 20); do echo $((t0 + i * 50000)); done > times.txt"#,
+)];
+
+type Setup = fn(&Path) -> Option<()>;
+
+/// The documents and their setups.
+const DOCS: &[(&str, Setup)] = &[
+    ("README.md", readme_setup),
+    ("docs/real-data.md", real_data_setup),
+    ("docs/online.md", online_setup),
+    ("docs/cluster.md", no_setup),
+    ("docs/simulator.md", no_setup),
+];
+
+/// Runs `text` with bash in `dir`, the tested `evtac` first on the PATH.
+fn run_bash(dir: &Path, text: &str) -> std::process::Output {
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_evtac"));
+    let path = format!(
+        "{}:{}",
+        bin.parent().expect("the binary's folder").display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    Command::new("bash")
+        .args(["-c", &format!("set -eo pipefail\n{text}")])
+        .current_dir(dir)
+        .env("PATH", path)
+        .output()
+        .expect("bash runs")
+}
+
+fn say(text: &str) {
+    // Past libtest's capture: what was skipped or changed shows in a plain run.
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), text.as_bytes());
+}
+
+#[test]
+fn every_documented_evtac_command_runs_as_written() {
+    let root = workspace_root();
+    let mut failures = Vec::new();
+    let mut ran = 0;
+    let mut every_doc_documented = 0;
+    for (doc, setup) in DOCS {
+        let markdown = std::fs::read_to_string(root.join(doc)).expect("the document");
+        for block in blocks(&markdown) {
+            let commands: Vec<&Example> = block.iter().filter(|c| runs_evtac(&c.text)).collect();
+            if commands.is_empty() {
+                continue;
+            }
+            every_doc_documented += 1;
+            let dir = tempfile::tempdir().expect("tmp");
+            if setup(dir.path()).is_none() {
+                return; // a fixture or Python is missing outside CI: said by the testkit
+            }
+            for c in commands {
+                let at = format!("{doc}:{}", c.line);
+                if let Some((_, why)) = SKIP.iter().find(|(text, _)| c.text.contains(text)) {
+                    say(&format!("skipped: {at}: needs {why}\n"));
+                    continue;
+                }
+                let command = as_run(&c.text);
+                if command != c.text {
+                    say(&format!("{at}: run at --scale tiny\n"));
+                }
+                for (when, prepare) in BEFORE {
+                    if c.text.contains(when) {
+                        let out = run_bash(dir.path(), prepare);
+                        assert!(out.status.success(), "{at}: preparing: {out:?}");
+                    }
+                }
+                let out = run_bash(dir.path(), &command);
+                ran += 1;
+                if !out.status.success() {
+                    let err = String::from_utf8_lossy(&out.stderr);
+                    let tail: Vec<&str> = err.lines().rev().take(6).collect();
+                    let tail: Vec<&str> = tail.into_iter().rev().collect();
+                    failures.push(format!("{at}: {}\n  {}", c.text, tail.join("\n  ")));
+                }
+            }
+        }
+    }
+    assert!(
+        every_doc_documented >= DOCS.len(),
+        "every document has examples"
+    );
+    assert!(ran > 30, "only {ran} commands ran");
+    assert!(
+        failures.is_empty(),
+        "{} of {ran} documented commands failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn blocks_split_commands_at_their_ends_and_keep_continuations() {
+    let md = "text\n```sh\nevtac a \\\n  --b  # c\n# only a comment\nevtac d \"#x\"   # e\n```\n```python\nevtac no\n```\n";
+    let b = blocks(md);
+    assert_eq!(b.len(), 1);
+    let texts: Vec<&str> = b[0].iter().map(|c| c.text.as_str()).collect();
+    assert_eq!(texts, ["evtac a \\\n  --b  # c", "evtac d \"#x\"   # e"]);
+    assert_eq!(b[0][1].line, 6);
+    assert_eq!(strip_comment("evtac d \"#x\"   # e"), "evtac d \"#x\"   ");
+    assert!(runs_evtac("cat e.csv | evtac online"));
+    assert!(!runs_evtac(
+        "sbatch --array=0-$(( $(evtac jobs count x) - 1 )) a.sbatch"
+    ));
+}
