@@ -157,10 +157,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut stdout = None;
     let out: &mut dyn Write = match &mut file {
         Some(f) => f,
-        None => &mut stdout,
+        None => stdout.insert(std::io::BufWriter::new(std::io::stdout().lock())),
     };
     writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
     let stop = stop_on_interrupt()?;
