@@ -77,12 +77,19 @@ pub(crate) fn has_identifier(buf: &[u8], identifier: &str) -> bool {
         && flatbuffers::buffer_has_identifier(buf, identifier, true)
 }
 
-/// Decodes `data` completely, as a file (sequentially, and through its data table as a range
-/// read) and as a network stream, discarding the results: the entry point of the `aedat`
+/// Decodes `data` completely, as a file (sequentially, the streams a default selection picks,
+/// and through its data table as a range read) and as a network stream, discarding the results: the entry point of the `aedat`
 /// cargo-fuzz target. It must never panic, whatever the bytes.
 #[doc(hidden)]
 pub fn fuzz_decode(data: &[u8]) {
     if let Ok(mut reader) = AedatReader::from_slice(data) {
+        while let Ok(Some(_)) = reader.next_chunk() {}
+    }
+    // The streams a default selection picks (several cameras: an error listing them).
+    if let Ok(mut reader) = AedatReader::from_slice(data)
+        && let Ok(chosen) = StreamSelection::default().resolve(reader.header())
+    {
+        reader.select_streams(&chosen);
         while let Ok(Some(_)) = reader.next_chunk() {}
     }
     if let Ok(mut reader) = AedatReader::new(std::io::Cursor::new(data))
