@@ -21,6 +21,13 @@ pub fn run_ok(args: &[&str]) -> Output {
     out
 }
 
+/// Runs `evtac` with `args`, expecting it to fail; returns its stderr.
+pub fn run_err(args: &[&str]) -> String {
+    let out = evtac().args(args).output().expect("evtac runs");
+    assert!(!out.status.success(), "evtac {args:?} should have failed");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 /// Simulates the first `limit` trials of `protocol` at the tiny scale with `seed` into `out`.
 pub fn simulate_tiny(protocol: &str, seed: u64, out: &std::path::Path, limit: usize) {
     simulate(protocol, seed, out, Some(limit), false);

@@ -4,19 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{evtac, run_ok};
+use crate::common::{run_err, run_ok};
 use evtac_events::{Event, EventWriter, ImuSample, Resolution, read_recording};
 use evtac_testkit::{real_fixture, run_python};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// Runs `evtac` with `args`, expecting it to fail; returns its stderr.
-fn run_err(args: &[&str]) -> String {
-    let out = evtac().args(args).output().expect("evtac runs");
-    assert!(!out.status.success(), "evtac {args:?} should have failed");
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// A small AEDAT4 recording with IMU samples, and its bytes.

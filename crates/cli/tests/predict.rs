@@ -1,6 +1,6 @@
 //! Tests of `evtac predict`.
 
-use crate::common::{evtac, run_ok};
+use crate::common::{evtac, run_err, run_ok};
 use evtac_learn::{ModelBundle, Parameters, Predictor, Representation};
 use evtac_repr::ReprConfig;
 use ndarray::Array2;
@@ -113,13 +113,6 @@ fn rejects_wrong_dtype_and_shape_clearly() {
 
 fn as_refs(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
-}
-
-/// Runs `evtac` expecting failure; returns its stderr.
-fn run_err(args: &[&str]) -> String {
-    let out = evtac().args(args).output().expect("evtac runs");
-    assert!(!out.status.success(), "evtac {args:?} should have failed");
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// A 320x240 recording with events all over the sensor, and sample times in it.

@@ -1,7 +1,7 @@
 //! Tests of `evtac reproduce`: the whole protocol at the tiny scale, the report with every
 //! figure, resuming, and the exported job list.
 
-use crate::common::run_ok;
+use crate::common::{run_err, run_ok};
 use evtac_experiments::choices;
 use evtac_experiments::plan::Plan;
 use evtac_experiments::report::{CHOICES_TITLE, FIGURES};
@@ -282,13 +282,6 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
     );
     assert!(lines.iter().any(|l| l.contains("--repr static")));
     assert!(lines.iter().any(|l| l.contains("--repr dynamic")));
-}
-
-/// Runs `evtac` with `args`, expecting it to fail; returns its stderr.
-fn run_err(args: &[&str]) -> String {
-    let out = crate::common::evtac().args(args).output().unwrap();
-    assert!(!out.status.success(), "evtac {args:?} succeeded");
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]

@@ -42,18 +42,7 @@ impl Timing {
                 "--speed {speed} at --fps {fps} gives frames shorter than 1 us"
             )));
         }
-        let (first, last) = match (events.first(), events.last()) {
-            (Some(a), Some(b)) => (a.t, b.t),
-            _ => (0, 0),
-        };
-        let start_us = from_us.unwrap_or(first);
-        let end_us = to_us.unwrap_or(last);
-        if end_us <= start_us {
-            return Err(Error::Timing(format!(
-                "the time range is empty: from {start_us} us to {end_us} us (no events in the \
-                 crop, or --to-us not after --from-us)"
-            )));
-        }
+        let (start_us, end_us) = range(events, from_us, to_us)?;
         // The last, partial interval still gets a frame so the range's end is shown.
         let count = ((end_us - start_us + step_us - 1) / step_us) as usize;
         Ok(Timing {
@@ -74,9 +63,9 @@ impl Timing {
         to_us: Option<i64>,
         frames: usize,
     ) -> Result<Timing, Error> {
-        let whole = Self::new(events, from_us, to_us, 1e6, 1.0)?;
-        let span = whole.count as i64; // one frame per microsecond: the span in microseconds
-        let step_us = (span + frames.max(1) as i64 - 1) / frames.max(1) as i64;
+        let (start_us, end_us) = range(events, from_us, to_us)?;
+        let frames = frames.max(1) as i64;
+        let step_us = (end_us - start_us + frames - 1) / frames;
         Self::new(events, from_us, to_us, 1.0, step_us as f64 * 1e-6)
     }
 
@@ -84,6 +73,23 @@ impl Timing {
     pub fn end_us(&self, k: usize) -> i64 {
         self.start_us + (k as i64 + 1) * self.step_us
     }
+}
+
+/// `[from_us, to_us]`, by default the first and last event's times; an empty range is an error.
+fn range(events: &[Event], from_us: Option<i64>, to_us: Option<i64>) -> Result<(i64, i64), Error> {
+    let (first, last) = match (events.first(), events.last()) {
+        (Some(a), Some(b)) => (a.t, b.t),
+        _ => (0, 0),
+    };
+    let start_us = from_us.unwrap_or(first);
+    let end_us = to_us.unwrap_or(last);
+    if end_us <= start_us {
+        return Err(Error::Timing(format!(
+            "the time range is empty: from {start_us} us to {end_us} us (no events in the crop, \
+             or --to-us not after --from-us)"
+        )));
+    }
+    Ok((start_us, end_us))
 }
 
 /// One representation in a frame.
