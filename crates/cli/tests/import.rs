@@ -202,6 +202,12 @@ fn a_simulated_session_imports_by_its_triggers_or_its_imu_and_reproduces() {
     );
 }
 
+/// The trial names of the dataset in `dir`, in manifest order.
+fn trial_names(dir: &std::path::Path) -> Vec<String> {
+    let manifest = Manifest::read(dir).unwrap();
+    manifest.trials.into_iter().map(|t| t.trial).collect()
+}
+
 /// Several sessions into one dataset (each with its log, or their motions found in the
 /// gyroscope), and a folder of per-trial files (cut by a log on each file's clock, or each
 /// file's motion found).
@@ -244,26 +250,20 @@ fn several_sessions_and_a_folder_of_trials_import_into_one_dataset() {
     with_prefixes[10] = &prefixed;
     with_prefixes.extend(["--trial-prefix", "s0_", "--trial-prefix", "s1_"]);
     run_ok(&with_prefixes);
-    let names: Vec<String> = Manifest::read(dir.path().join("prefixed"))
-        .unwrap()
-        .trials
-        .into_iter()
-        .map(|t| t.trial)
-        .collect();
-    assert_eq!(names, ["s0_t0000", "s0_t0001", "s1_t0000", "s1_t0001"]);
+    assert_eq!(
+        trial_names(&dir.path().join("prefixed")),
+        ["s0_t0000", "s0_t0001", "s1_t0000", "s1_t0001"]
+    );
     assert!(dir.path().join("prefixed/s1_t0001.aedat4").is_file());
     let renamed = p("b/renamed.csv");
     let text = std::fs::read_to_string(&log_b).unwrap();
     std::fs::write(&renamed, text.replace("\nt00", "\nu00")).unwrap();
     args[6] = &renamed;
     run_ok(&args);
-    let names: Vec<String> = Manifest::read(dir.path().join("both"))
-        .unwrap()
-        .trials
-        .into_iter()
-        .map(|t| t.trial)
-        .collect();
-    assert_eq!(names, ["t0000", "t0001", "u0000", "u0001"]);
+    assert_eq!(
+        trial_names(&dir.path().join("both")),
+        ["t0000", "t0001", "u0000", "u0001"]
+    );
     run_ok(&["check", &out, "--no-mask"]);
     // One log for two sessions is ambiguous.
     let o = evtac()
