@@ -26,7 +26,6 @@
 //! # Ok::<(), std::io::Error>(())
 //! ```
 
-use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -69,19 +68,9 @@ impl OutputFile {
         Ok(Self { temp, path })
     }
 
-    /// The final name.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
     /// Where the bytes are until [`commit`](Self::commit) (for writers that take a path).
     pub fn temp_path(&self) -> &Path {
         self.temp.path()
-    }
-
-    /// The temporary file.
-    pub fn file_mut(&mut self) -> &mut File {
-        self.temp.as_file_mut()
     }
 
     /// Flushes the file and renames it to its final name, replacing any file there.

@@ -48,6 +48,7 @@ pub use mp4::Mp4Writer;
 pub use sheet::{MAX_SHEET_FRAMES, SHEET_DEFAULT_FRAMES, SheetWriter};
 
 use evtac_events::Event;
+use evtac_events::output::OutputFile;
 use evtac_repr::{Mask, ReprConfig, ReprError};
 use std::path::{Path, PathBuf};
 
@@ -237,48 +238,27 @@ pub fn render(
     scene: Scene<'_>,
 ) -> Result<(), Error> {
     let timing = scene.timing;
-    let temp = temporary_beside(path)?;
+    // Written beside `path` and renamed when complete; the writers take the temporary path
+    // (ffmpeg and plotters open it themselves).
+    let out = OutputFile::create(path).map_err(evtac_events::IoError::at(path))?;
+    let temp = out.temp_path();
     match output {
         Output::Gif => {
-            let mut gif = GifWriter::create(&temp, path, scene)?;
+            let mut gif = GifWriter::create(temp, path, scene)?;
             for_each_frame(events, reprs, masks, &timing, |f| gif.push(f))?;
             gif.finish()?;
         }
         Output::Mp4 => {
-            let mut mp4 = Mp4Writer::create(&temp, path, scene)?;
+            let mut mp4 = Mp4Writer::create(temp, path, scene)?;
             for_each_frame(events, reprs, masks, &timing, |f| mp4.push(f))?;
             mp4.finish()?;
         }
         Output::Png => {
-            let mut sheet = SheetWriter::create(&temp, path, scene)?;
+            let mut sheet = SheetWriter::create(temp, path, scene)?;
             for_each_frame(events, reprs, masks, &timing, |f| sheet.push(f))?;
             sheet.finish()?;
         }
     }
-    temp.persist(path)
-        .map_err(|e| evtac_events::IoError::at(path)(e.error))?;
+    out.commit().map_err(evtac_events::IoError::at(path))?;
     Ok(())
-}
-
-/// An empty temporary file in `path`'s folder (so the final rename is atomic), named like it
-/// (`.NAME.XXXXXX.EXT`: plotters picks the PNG encoder by the extension), deleted when dropped
-/// unless persisted.
-fn temporary_beside(path: &Path) -> Result<tempfile::TempPath, Error> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path.file_stem().unwrap_or_default().to_string_lossy();
-    let ext = path.extension().unwrap_or_default().to_string_lossy();
-    let (prefix, suffix) = (format!(".{name}."), format!(".{ext}"));
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(&suffix);
-    // A temporary file is private (0600); the output is an ordinary file, so it gets the
-    // permissions `File::create` gives (0666 less the umask).
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    builder
-        .tempfile_in(dir)
-        .map(tempfile::NamedTempFile::into_temp_path)
-        .map_err(|e| Error::Io(evtac_events::IoError::at(dir)(e)))
 }
