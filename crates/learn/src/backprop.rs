@@ -425,7 +425,7 @@ fn first_layer_rows(
 mod tests {
     use super::*;
     use crate::adamw::AdamWConfig;
-    use crate::model::Mlp;
+    use crate::burn_reference::Mlp;
     use burn::nn::loss::{HuberLossConfig, Reduction};
     use burn::tensor::{Device, Tensor, TensorData};
 
@@ -458,7 +458,7 @@ mod tests {
             .init()
             .forward(mlp.forward(x), y, Reduction::Mean);
         let grads = loss.backward();
-        let value = crate::model::to_vec(&loss).expect("loss")[0];
+        let value = crate::burn_reference::to_vec(&loss).expect("loss")[0];
         let layers = mlp
             .layers
             .iter()

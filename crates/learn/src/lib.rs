@@ -1,8 +1,8 @@
 //! The MLP contact-angle regressor of the paper: model, training loop, checkpoints, prediction
 //! and metrics.
 //!
-//! - [`model`]: the 900 -> 256 -> 128 -> 64 -> 2 ReLU MLP as a burn module ([`Mlp`]) and as plain
-//!   weights in PyTorch `nn.Linear` layout ([`Parameters`]), initialised as PyTorch does from a
+//! - [`model`]: the 900 -> 256 -> 128 -> 64 -> 2 ReLU MLP as plain weights in PyTorch
+//!   `nn.Linear` layout ([`Parameters`]), initialised as PyTorch does from a
 //!   seeded `ChaCha8Rng`; [`architecture`]: the networks for two frames side by side
 //!   (`stacked`, and `late` fusion's two branches), stored and run as the same four layers.
 //! - [`data`]: in-memory [`FeatureSet`]s and the seeded epoch shuffling.
@@ -21,8 +21,8 @@
 //!
 //! Training runs a hand-written forward and backward pass (`backprop.rs`, on the panel layout of
 //! `panels.rs` that inference shares) that skips zero inputs, one thread per training run
-//! (parallelism comes from running several runs side by side). burn defines the model
-//! ([`Mlp`]) and is the independent reference its gradients are tested against.
+//! (parallelism comes from running several runs side by side). burn, a dev-dependency, is the
+//! independent reference its gradients are tested against (`burn_reference.rs`, tests only).
 //!
 //! ```no_run
 //! use evtac_learn::{FeatureSet, Model, ModelBundle, Representation, TrainConfig, train};
@@ -45,6 +45,8 @@ pub mod adamw;
 pub mod architecture;
 mod backprop;
 pub mod bundle;
+#[cfg(test)]
+mod burn_reference;
 pub mod cell_layer;
 pub mod data;
 pub mod ftz;
@@ -64,7 +66,7 @@ pub use bundle::{BundleConfig, BundleMetrics, ModelBundle, Representation};
 pub use data::FeatureSet;
 pub use ftz::flush_denormals;
 pub use metrics::{Mae, mae};
-pub use model::{INPUTS, MAX_INPUTS, Mlp, OUTPUTS, Parameters};
+pub use model::{INPUTS, MAX_INPUTS, OUTPUTS, Parameters};
 pub use predictor::Predictor;
 pub use streaming::StreamingPredictor;
 pub use trained_model::Model;

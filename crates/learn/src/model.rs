@@ -1,19 +1,15 @@
 //! The regressor: the paper's 900 -> 256 -> 128 -> 64 -> 2 multi-layer perceptron with ReLU (or
-//! one of the two-frame networks of [`crate::architecture`]), as a burn module ([`Mlp`]) and as
-//! plain host weights in PyTorch's layout ([`Parameters`]).
+//! one of the two-frame networks of [`crate::architecture`]), as plain host weights in PyTorch's
+//! layout ([`Parameters`]).
 //!
 //! [`Parameters`] is the common currency: initialisation draws it from a seeded
-//! [`ChaCha8Rng`], the bundle saves and loads it, the trainer uploads it into burn and the
+//! [`ChaCha8Rng`], the bundle saves and loads it, the trainer updates it in place and the
 //! [`crate::Predictor`] runs it. Its layout is PyTorch's `nn.Linear`: layer `i` has
 //! `weight` `[out, in]` row-major and `bias` `[out]`, so a PyTorch
 //! `nn.Sequential(Linear, ReLU, Linear, ReLU, Linear, ReLU, Linear)` whose linear layers are
 //! named `layers.0` .. `layers.3` loads the saved tensors unchanged (late fusion's layout in
 //! PyTorch is in `bundle.rs`).
 
-use burn::module::{Module, Param};
-use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::relu;
-use burn::tensor::{Device, Tensor, TensorData};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -24,8 +20,8 @@ use crate::architecture::{BRANCH, HIDDEN};
 /// hidden layers of 256, 128 and 64, and 2.
 pub const LAYER_SIZES: [usize; LAYERS + 1] = [INPUTS, HIDDEN[0], HIDDEN[1], HIDDEN[2], OUTPUTS];
 /// The hidden layers' activation, by name (for reports; the paper states none): every hidden
-/// layer applies it, the output layer is linear. [`Mlp::forward`], [`Parameters::forward_f64`]
-/// and the [`crate::Predictor`] all apply `max(0, x)`.
+/// layer applies it, the output layer is linear. [`Parameters::forward_f64`], the training
+/// passes and the [`crate::Predictor`] all apply `max(0, x)`.
 pub const ACTIVATION: &str = "ReLU";
 
 /// Errors of this module.
@@ -71,9 +67,6 @@ pub enum Error {
         /// `static` or `dynamic`: the frame the unit's branch reads.
         frame: &'static str,
     },
-    /// burn returned tensor data of an unexpected type.
-    #[error("reading a tensor back from burn failed: {0}")]
-    Readback(String),
 }
 
 /// One linear layer's weights in PyTorch `nn.Linear` layout.
@@ -235,98 +228,6 @@ impl Parameters {
     }
 }
 
-/// The network as a burn module: four [`Linear`] layers named `layers.0` .. `layers.3`, ReLU
-/// between them and none after the last (late fusion as its block-diagonal first layer: the
-/// same function, not the same gradients for the cross-branch weights).
-///
-/// burn's `Linear` stores its weight `[in, out]`; [`Mlp::from_parameters`] and
-/// [`Mlp::parameters`] transpose to and from PyTorch's `[out, in]`.
-#[derive(Module, Debug)]
-pub struct Mlp {
-    /// The linear layers, input first.
-    pub layers: Vec<Linear>,
-}
-
-impl Mlp {
-    /// A model with PyTorch-default initial weights from `seed` (see [`Parameters::init`]).
-    pub fn new(seed: u64, device: &Device) -> Self {
-        // Sizes come from the architecture constants, so the freshly drawn weights always fit.
-        Self::from_parameters(&Parameters::init(seed), device)
-            .unwrap_or_else(|e| unreachable!("initial parameters fit the architecture: {e}"))
-    }
-
-    /// Uploads `params` (PyTorch layout) to `device`.
-    pub fn from_parameters(params: &Parameters, device: &Device) -> Result<Self, Error> {
-        params.validate()?;
-        let sizes = params.architecture.layer_sizes();
-        let layers = params
-            .layers
-            .iter()
-            .zip(sizes.windows(2))
-            .map(|(p, w)| {
-                let (fan_in, fan_out) = (w[0], w[1]);
-                let mut linear = LinearConfig::new(fan_in, fan_out).init(device);
-                let weight = Tensor::<2>::from_data(
-                    TensorData::new(transpose(&p.weight, fan_out, fan_in), [fan_in, fan_out]),
-                    device,
-                );
-                let bias =
-                    Tensor::<1>::from_data(TensorData::new(p.bias.clone(), [fan_out]), device);
-                linear.weight = Param::from_tensor(weight);
-                linear.bias = Some(Param::from_tensor(bias));
-                linear
-            })
-            .collect();
-        Ok(Self { layers })
-    }
-
-    /// Downloads the weights into PyTorch layout, as the weights of `architecture` (checked).
-    pub fn parameters(&self, architecture: Architecture) -> Result<Parameters, Error> {
-        let sizes = architecture.layer_sizes();
-        if self.layers.len() != LAYERS {
-            return Err(Error::Shape {
-                architecture: architecture.describe(),
-                layer: self.layers.len().min(LAYERS),
-                tensor: "weight",
-                got: 0,
-                expected: sizes[0] * sizes[1],
-            });
-        }
-        let layers = self
-            .layers
-            .iter()
-            .zip(sizes.windows(2))
-            .map(|(linear, w)| {
-                let (fan_in, fan_out) = (w[0], w[1]);
-                let weight = to_vec(&linear.weight.val())?;
-                let bias = match &linear.bias {
-                    Some(b) => to_vec(&b.val())?,
-                    None => vec![0.0; fan_out],
-                };
-                Ok(LayerParameters {
-                    weight: transpose(&weight, fan_in, fan_out),
-                    bias,
-                })
-            })
-            .collect::<Result<Vec<_>, Error>>()?;
-        let params = Parameters {
-            architecture,
-            layers,
-        };
-        params.validate()?;
-        Ok(params)
-    }
-
-    /// Forward pass: `[batch, inputs]` features to `[batch, 2]` (pitch, roll).
-    pub fn forward(&self, x: Tensor<2>) -> Tensor<2> {
-        let last = self.layers.len().saturating_sub(1);
-        self.layers.iter().enumerate().fold(x, |h, (i, linear)| {
-            let z = linear.forward(h);
-            if i < last { relu(z) } else { z }
-        })
-    }
-}
-
 /// Late fusion's block-diagonal first layer (`[256, 1800]`) from its two branches (static,
 /// dynamic; each `[BRANCH, 900]`): every cross-branch weight zero.
 pub(crate) fn join_branches(branches: &[LayerParameters; 2]) -> LayerParameters {
@@ -352,13 +253,6 @@ pub(crate) fn transpose(values: &[f32], rows: usize, cols: usize) -> Vec<f32> {
     out
 }
 
-/// A burn tensor's values as f32.
-pub(crate) fn to_vec<const D: usize>(t: &Tensor<D>) -> Result<Vec<f32>, Error> {
-    t.to_data()
-        .try_into_vec::<f32>()
-        .map_err(|e| Error::Readback(format!("{e:?}")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -377,26 +271,6 @@ mod tests {
         }
         assert_eq!(p, Parameters::init(3));
         assert_ne!(p, Parameters::init(4));
-    }
-
-    #[test]
-    fn burn_round_trip_and_forward_match_the_reference() {
-        let device = Device::flex();
-        let p = Parameters::init(1);
-        let mlp = Mlp::from_parameters(&p, &device).expect("fits");
-        assert_eq!(mlp.parameters(Architecture::Mlp).expect("readback"), p);
-        let x: Vec<f32> = (0..2 * INPUTS).map(|i| ((i % 17) as f32) * 0.1).collect();
-        let out = to_vec(&mlp.forward(Tensor::from_data(
-            TensorData::new(x.clone(), [2, INPUTS]),
-            &device,
-        )))
-        .expect("readback");
-        for s in 0..2 {
-            let r = p.forward_f64(&x[s * INPUTS..(s + 1) * INPUTS]);
-            for k in 0..OUTPUTS {
-                assert!((f64::from(out[s * OUTPUTS + k]) - r[k]).abs() < 1e-4);
-            }
-        }
     }
 
     #[test]

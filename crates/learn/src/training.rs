@@ -76,7 +76,7 @@ pub enum Error {
         /// Optimiser step (1-based).
         step: u64,
     },
-    /// Moving weights between burn and the host failed.
+    /// The weights do not fit the architecture.
     #[error(transparent)]
     Model(#[from] model::Error),
     /// Computing the validation MAE failed.
