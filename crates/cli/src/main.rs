@@ -6,6 +6,7 @@
 
 mod commands;
 mod inputs;
+mod kinds;
 mod outputs;
 mod progress;
 mod streams;

@@ -192,7 +192,7 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         results["choices"].as_array().map(Vec::len),
         Some(expected.len())
     );
-    let reprs = evtac_experiments::exp1::NAMES.len();
+    let reprs = evtac_repr::ReprKind::ALL.len();
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(reprs));
     // Experiment 1 at every noise level of the plan, for every representation; x1 is
     // Experiment 1 itself, and no noise means no background events.

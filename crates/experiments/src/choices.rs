@@ -8,28 +8,15 @@
 //! and weight decay, batch 32, 100 epochs, ten runs, 70:15:15 splits, 50 + 10 samples on a 1 ms
 //! grid, the 500 ms stop, the chosen tau, window and thresholds) is not listed.
 
-use crate::exp1;
 use crate::plan::Plan;
+pub use crate::results::Choice;
 use crate::sampling::{GRID_US, MOTION_POINTS, STOP_POINTS};
 use crate::splits::RATIOS;
 use evtac_labels::LabelConfig;
 use evtac_learn::TrainConfig;
 use evtac_repr::{Comparison, DynamicConfig, StaticConfig};
 use evtac_sim::SimParams;
-use serde::{Deserialize, Serialize};
-
-/// One value evtac chose.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Choice {
-    /// What was chosen (also the row's key in tests).
-    pub what: String,
-    /// The value the run used.
-    pub value: String,
-    /// Why this value.
-    pub why: String,
-    /// The flag or file that changes it.
-    pub change: String,
-}
+use serde::Serialize;
 
 fn row(what: &str, value: String, why: &str, change: &str) -> Choice {
     Choice {
@@ -287,7 +274,7 @@ pub fn of_run(
             format!(
                 "master seed {seed}: simulation, splits, and Experiment 1's runs with seeds {} \
                  (weights and shuffling from `ChaCha8Rng`)",
-                list(&exp1::seeds(seed, plan.seeds))
+                list(&crate::exp1::seeds(seed, plan.seeds))
             ),
             "the paper states ten runs, not their seeds",
             "`evtac reproduce --seed`",

@@ -7,7 +7,7 @@ use crate::training::Error;
 use evtac_events::manifest::TrialMeta;
 use evtac_learn::Model;
 use evtac_repr::CROP;
-use evtac_repr::{FeatureExtractor, ReprConfig};
+use evtac_repr::{FeatureExtractor, ReprConfig, ReprKind};
 
 /// Spacing of the example curves' samples (20 ms: smooth curves, few predictions).
 const CURVE_STEP_US: i64 = 20_000;
@@ -21,11 +21,11 @@ fn repr_err(trial: &str) -> impl Fn(evtac_repr::ReprError) -> Error + '_ {
     }
 }
 
-/// The example curves of `meta` with `models` (name, model), every 20 ms of the motion.
+/// The example curves of `meta` with `models` (kind, model), every 20 ms of the motion.
 pub fn example_trial(
     cache: &FeatureCache<'_>,
     meta: &TrialMeta,
-    models: &[(&str, &Model)],
+    models: &[(ReprKind, &Model)],
 ) -> Result<ExampleTrial, Error> {
     let ds = cache.dataset();
     let labels = ds.labels(meta)?;
@@ -65,11 +65,7 @@ pub fn example_trial(
                 [p as f32, r as f32]
             })
             .collect(),
-        predictions: models
-            .iter()
-            .map(|(n, _)| n.to_string())
-            .zip(preds)
-            .collect(),
+        predictions: models.iter().map(|(n, _)| *n).zip(preds).collect(),
     })
 }
 

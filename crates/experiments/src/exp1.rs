@@ -13,40 +13,20 @@ use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error, TrainSpec};
 use evtac_learn::Model;
 use evtac_learn::ModelBundle;
-use evtac_repr::ReprConfig;
+use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 
-/// The display names of the representations compared, in report order: the paper's three, then
-/// evtac's learned fusions.
-pub const NAMES: [&str; 5] = ["Static", "Dynamic", "Combined", "Stacked", "Late"];
-/// The learned fusions among [`NAMES`] (not in the paper).
-pub const FUSIONS: [&str; 2] = ["Stacked", "Late"];
-
-/// The representations of [`NAMES`] among `names` (results' names, in any order and repeated),
-/// in report order: the columns and panels of a table or figure.
-pub fn in_order<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'static str> {
-    let names: Vec<&str> = names.collect();
-    NAMES.into_iter().filter(|n| names.contains(n)).collect()
-}
-
-/// The paper's three representations, display name and config: static, dynamic and their
-/// OR (what `evtac render` draws as frames).
-pub fn paper_representations(
-    static_cfg: ReprConfig,
-    dynamic_cfg: ReprConfig,
-) -> Vec<(&'static str, ReprConfig)> {
+/// The paper's three representations: static, dynamic and their OR (what `evtac render` draws
+/// as frames).
+pub fn paper_representations(static_cfg: ReprConfig, dynamic_cfg: ReprConfig) -> Vec<ReprConfig> {
     let mut out = representations(static_cfg, dynamic_cfg);
-    out.truncate(3);
+    out.truncate(ReprKind::PAPER.len());
     out
 }
 
 /// The representations a plan compares: [`representations`], less the learned fusions when
 /// the plan leaves them out ([`Plan::fusions`]).
-pub fn of_plan(
-    plan: &Plan,
-    static_cfg: ReprConfig,
-    dynamic_cfg: ReprConfig,
-) -> Vec<(&'static str, ReprConfig)> {
+pub fn of_plan(plan: &Plan, static_cfg: ReprConfig, dynamic_cfg: ReprConfig) -> Vec<ReprConfig> {
     if plan.fusions {
         representations(static_cfg, dynamic_cfg)
     } else {
@@ -54,42 +34,19 @@ pub fn of_plan(
     }
 }
 
-/// The representations compared, display name and config: the paper's three (static,
+/// The representations compared, in [`ReprKind::ALL`]'s order: the paper's three (static,
 /// dynamic, their OR) and the two learned fusions of the same tuned parts (`Stacked`: one dense
 /// network over both frames; `Late`: a branch per frame joined before the head), which are not
 /// tuned on their own: they take the settings chosen for static and dynamic.
-pub fn representations(
-    static_cfg: ReprConfig,
-    dynamic_cfg: ReprConfig,
-) -> Vec<(&'static str, ReprConfig)> {
-    let [st, dy, combined, stacked, late] = NAMES;
-    let mut out = vec![(st, static_cfg), (dy, dynamic_cfg)];
+pub fn representations(static_cfg: ReprConfig, dynamic_cfg: ReprConfig) -> Vec<ReprConfig> {
+    let mut out = vec![static_cfg, dynamic_cfg];
     if let (Some(&static_part), Some(&dynamic_part)) =
         (static_cfg.static_part(), dynamic_cfg.dynamic_part())
     {
-        out.extend([
-            (
-                combined,
-                ReprConfig::Combined {
-                    static_part,
-                    dynamic_part,
-                },
-            ),
-            (
-                stacked,
-                ReprConfig::Stacked {
-                    static_part,
-                    dynamic_part,
-                },
-            ),
-            (
-                late,
-                ReprConfig::Late {
-                    static_part,
-                    dynamic_part,
-                },
-            ),
-        ]);
+        out.extend(
+            [ReprKind::Combined, ReprKind::Stacked, ReprKind::Late]
+                .map(|kind| kind.config(static_part, dynamic_part)),
+        );
     }
     out
 }
@@ -100,17 +57,17 @@ pub fn seeds(seed: u64, n: usize) -> Vec<u64> {
 }
 
 /// The folder of one Experiment 1 model.
-pub fn model_dir(out: &Path, name: &str, seed: u64) -> PathBuf {
+pub fn model_dir(out: &Path, kind: ReprKind, seed: u64) -> PathBuf {
     out.join("exp1")
-        .join(name.to_lowercase())
+        .join(kind.name())
         .join(format!("seed{seed}"))
 }
 
 /// A job of a multi-seed experiment.
 #[derive(Debug, Clone)]
 pub struct SeedJob {
-    /// Representation name.
-    pub name: &'static str,
+    /// The representation's kind.
+    pub kind: ReprKind,
     /// The training job.
     pub spec: TrainSpec,
     /// Its folder.
@@ -118,30 +75,25 @@ pub struct SeedJob {
 }
 
 /// The training jobs of Experiment 1.
-pub fn jobs(
-    reprs: &[(&'static str, ReprConfig)],
-    plan: &Plan,
-    seed: u64,
-    out: &Path,
-) -> Vec<SeedJob> {
+pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<SeedJob> {
     let seeds = seeds(seed, plan.seeds);
     let train = (plan.epochs, Sampling::MOTION, [Phase::Motion].as_slice());
-    seed_jobs(reprs, &seeds, train, |name, s| model_dir(out, name, s))
+    seed_jobs(reprs, &seeds, train, |kind, s| model_dir(out, kind, s))
 }
 
 /// One job per (representation, seed), in that order, each training for `epochs` on `sampling`'s
 /// points of `phases`, in the folder `dir` gives (Experiments 1 and 2 differ only in those).
 pub(crate) fn seed_jobs(
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     seeds: &[u64],
     (epochs, sampling, phases): (usize, Sampling, &[Phase]),
-    dir: impl Fn(&str, u64) -> PathBuf,
+    dir: impl Fn(ReprKind, u64) -> PathBuf,
 ) -> Vec<SeedJob> {
     let mut v = Vec::new();
-    for &(name, repr) in reprs {
+    for &repr in reprs {
         for &seed in seeds {
             v.push(SeedJob {
-                name,
+                kind: repr.kind(),
                 spec: TrainSpec {
                     repr,
                     seed,
@@ -149,7 +101,7 @@ pub(crate) fn seed_jobs(
                     sampling,
                     phases: phases.to_vec(),
                 },
-                dir: dir(name, seed),
+                dir: dir(repr.kind(), seed),
             });
         }
     }
@@ -178,7 +130,7 @@ pub fn train_all(
 pub fn features_then_training(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     sampling: Sampling,
     (features, training): (FeatureSet, Stage),
     jobs: &[SeedJob],
@@ -192,11 +144,8 @@ pub fn features_then_training(
         ]
         .concat(),
     )?;
-    let configs: Vec<ReprConfig> = reprs.iter().map(|r| r.1).collect();
     progress.stage(Stage::Features(features), all.len() as u64);
-    cache.ensure(&all, &configs, sampling, &|reused| {
-        progress.finished(reused)
-    })?;
+    cache.ensure(&all, reprs, sampling, &|reused| progress.finished(reused))?;
     progress.stage(training, jobs.len() as u64);
     train_all(cache, splits, jobs, progress)
 }
@@ -205,7 +154,7 @@ pub fn features_then_training(
 pub fn run(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     run: &RunContext<'_>,
 ) -> Result<Vec<Exp1Repr>, Error> {
     run_as(
@@ -222,7 +171,7 @@ pub fn run(
 pub fn run_as(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     run: &RunContext<'_>,
     stages: (FeatureSet, Stage),
 ) -> Result<Vec<Exp1Repr>, Error> {
@@ -238,7 +187,8 @@ pub fn run_as(
         progress,
     )?;
     let mut results = Vec::new();
-    for &(name, config) in reprs {
+    for &config in reprs {
+        let kind = config.kind();
         let test = training::load_split(
             cache,
             splits,
@@ -251,14 +201,14 @@ pub fn run_as(
         let mut val_runs = Vec::new();
         let seeds = seeds(seed, plan.seeds);
         for &s in &seeds {
-            let model = training::load_model(&model_dir(out, name, s))?;
+            let model = training::load_model(&model_dir(out, kind, s))?;
             let pred = training::predict(&model, &test)?;
             runs.push(training::mae_in(&test, &pred, None));
             val_runs.push(Mae::from(model.bundle.config.metrics.validation));
         }
         results.push(Exp1Repr {
-            name: name.into(),
-            config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
+            name: kind,
+            config,
             seeds,
             test: MaeStats::of(&runs),
             runs,
@@ -268,11 +218,11 @@ pub fn run_as(
     Ok(results)
 }
 
-/// Loads the Experiment 1 models of `name`.
-pub fn models(out: &Path, name: &str, seed: u64, n: usize) -> Result<Vec<Model>, Error> {
+/// Loads the Experiment 1 models of `kind`.
+pub fn models(out: &Path, kind: ReprKind, seed: u64, n: usize) -> Result<Vec<Model>, Error> {
     seeds(seed, n)
         .into_iter()
-        .map(|s| training::load_model(&model_dir(out, name, s)))
+        .map(|s| training::load_model(&model_dir(out, kind, s)))
         .collect()
 }
 

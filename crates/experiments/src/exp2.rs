@@ -13,7 +13,7 @@ use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error};
 use evtac_learn::Model;
-use evtac_repr::ReprConfig;
+use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 
 /// The training settings: file name and label in the report.
@@ -24,20 +24,15 @@ pub const SETTINGS: [(&str, &str); 3] = [
 ];
 
 /// The folder of one Experiment 2 model.
-pub fn model_dir(out: &Path, setting: &str, name: &str, seed: u64) -> PathBuf {
+pub fn model_dir(out: &Path, setting: &str, kind: ReprKind, seed: u64) -> PathBuf {
     out.join("exp2")
         .join(setting)
-        .join(name.to_lowercase())
+        .join(kind.name())
         .join(format!("seed{seed}"))
 }
 
 /// The training jobs of Experiment 2 (the two pause-inclusive settings).
-pub fn jobs(
-    reprs: &[(&'static str, ReprConfig)],
-    plan: &Plan,
-    seed: u64,
-    out: &Path,
-) -> Vec<SeedJob> {
+pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<SeedJob> {
     let seeds = exp1::seeds(seed, plan.exp2_seeds);
     let mut v = Vec::new();
     for (setting, phases) in [
@@ -57,7 +52,7 @@ pub fn jobs(
 pub fn run(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     run: &RunContext<'_>,
 ) -> Result<Vec<Exp2Cell>, Error> {
     let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
@@ -67,7 +62,8 @@ pub fn run(
     exp1::features_then_training(cache, splits, reprs, sampling, stages, &jobs, progress)?;
     let mut cells = Vec::new();
     for (setting, _) in SETTINGS {
-        for &(name, config) in reprs {
+        for &config in reprs {
+            let name = config.kind();
             let test = training::load_split(
                 cache,
                 splits,
@@ -92,7 +88,7 @@ pub fn run(
             }
             cells.push(Exp2Cell {
                 setting: setting.into(),
-                name: name.into(),
+                name,
                 motion: MaeStats::of(&motion),
                 stop: MaeStats::of(&stop),
                 motion_runs: motion,

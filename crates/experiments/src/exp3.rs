@@ -9,6 +9,7 @@ use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error};
 use evtac_events::manifest::TrialMeta;
 use evtac_learn::Model;
+use evtac_repr::ReprKind;
 use std::collections::BTreeMap;
 
 /// Which condition a dataset varies.
@@ -29,13 +30,13 @@ impl Axis {
     }
 }
 
-/// Evaluates `models` (name, Experiment 1 models) on every trial of `cache`'s dataset, grouped by
+/// Evaluates `models` (kind, Experiment 1 models) on every trial of `cache`'s dataset, grouped by
 /// the value of `axis`. A value is seen when its trials say `group = seen` or, without groups,
 /// when it is one of `training_values`.
 pub fn run(
     cache: &FeatureCache<'_>,
     axis: Axis,
-    models: &[(&str, Vec<Model>)],
+    models: &[(ReprKind, Vec<Model>)],
     training_values: &[f64],
     progress: &dyn Progress,
 ) -> Result<Vec<Exp3Point>, Error> {
@@ -97,7 +98,7 @@ pub fn run(
                 })
                 .collect();
             out.push(Exp3Point {
-                name: (*name).into(),
+                name: *name,
                 value,
                 seen,
                 trials: members.len(),

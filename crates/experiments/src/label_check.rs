@@ -6,23 +6,12 @@
 //! so the figure describes those labels and not a fresh computation.
 
 use crate::dataset::{self, Dataset};
+pub use crate::results::LabelCheck;
 use evtac_labels::validation::check_stop;
 use evtac_labels::{LabelConfig, LabelSeries, Summary, TruthError};
-use serde::{Deserialize, Serialize};
 
 /// The paper's label validation at the stops: mean and standard deviation, degrees.
 pub const PAPER_STOP_ERROR_DEG: (f64, f64) = (-0.01, 0.04);
-
-/// What the check found over one dataset.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LabelCheck {
-    /// Mean labelled tilt over each stop minus the commanded stop angle, degrees (trials with
-    /// a stop).
-    pub stop_error_deg: Option<Summary>,
-    /// Per-trial RMS error of the labels against the ground truth over pitch and roll, degrees
-    /// (trials with a truth file).
-    pub truth_rms_deg: Option<Summary>,
-}
 
 /// Checks the labels of every trial of `ds` (computing those that are missing).
 pub fn of_dataset(ds: &Dataset) -> Result<LabelCheck, dataset::Error> {

@@ -25,6 +25,7 @@ use crate::sampling::{MOTION_POINTS, equally_spaced_indices};
 use evtac_events::manifest::TrialMeta;
 use evtac_learn::Model;
 use evtac_online::Estimator;
+use evtac_repr::ReprKind;
 use std::time::Instant;
 
 /// Errors of the latency study.
@@ -44,11 +45,11 @@ pub enum Error {
     },
 }
 
-/// Measures `model` (named `name` in the results) at `interval_ms` over `trials`.
+/// Measures `model` (of representation `name`) at `interval_ms` over `trials`.
 pub fn measure(
     ds: &Dataset,
     trials: &[&TrialMeta],
-    name: &str,
+    name: ReprKind,
     model: &Model,
     interval_ms: u32,
 ) -> Result<LatencyCell, Error> {
@@ -91,7 +92,7 @@ pub fn measure(
 }
 
 /// Summary statistics of measured times.
-pub fn cell(name: &str, interval_ms: u32, times_us: Vec<f64>) -> LatencyCell {
+pub fn cell(name: ReprKind, interval_ms: u32, times_us: Vec<f64>) -> LatencyCell {
     let mut sorted = times_us.clone();
     sorted.sort_by(f64::total_cmp);
     let q = |p: f64| {
@@ -105,7 +106,7 @@ pub fn cell(name: &str, interval_ms: u32, times_us: Vec<f64>) -> LatencyCell {
     };
     let interval_us = f64::from(interval_ms) * 1000.0;
     LatencyCell {
-        name: name.into(),
+        name,
         interval_ms,
         samples: sorted.len(),
         median_us: q(0.5),
@@ -123,10 +124,18 @@ mod tests {
 
     #[test]
     fn percentiles_are_nearest_rank() {
-        let c = cell("Static", 1, (1..=100).map(f64::from).collect());
+        let c = cell(
+            evtac_repr::ReprKind::Static,
+            1,
+            (1..=100).map(f64::from).collect(),
+        );
         assert_eq!((c.median_us, c.p99_us, c.max_us), (50.0, 99.0, 100.0));
         assert_eq!(c.over_interval, 0);
-        let c = cell("Static", 1, vec![500.0, 1500.0, 20_000.0]);
+        let c = cell(
+            evtac_repr::ReprKind::Static,
+            1,
+            vec![500.0, 1500.0, 20_000.0],
+        );
         assert_eq!((c.over_interval, c.over_10ms), (2, 1));
     }
 }

@@ -82,7 +82,7 @@ fn points(level: f64, rate: f64, results: &[Exp1Repr]) -> Vec<NoisePoint> {
         .iter()
         .map(|r| NoisePoint {
             level,
-            name: r.name.clone(),
+            name: r.name,
             no_contact_events_per_s: rate,
             runs: r.runs.clone(),
             test: r.test,
@@ -96,7 +96,7 @@ fn points(level: f64, rate: f64, results: &[Exp1Repr]) -> Vec<NoisePoint> {
 pub fn run(
     ds1: &Dataset,
     e1: &[Exp1Repr],
-    reprs: &[(&'static str, ReprConfig)],
+    reprs: &[ReprConfig],
     run: &RunContext<'_>,
     out: &Path,
 ) -> Result<Vec<NoisePoint>, Error> {

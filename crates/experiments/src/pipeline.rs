@@ -21,7 +21,7 @@ use crate::{
 };
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
-use evtac_repr::ReprConfig;
+use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -60,9 +60,6 @@ pub enum Error {
     /// The log of stage times (`stage-times.csv`) could not be read or appended to.
     #[error(transparent)]
     StageLog(#[from] crate::stage_log::Error),
-    /// A tuning run's chosen config could not be read back.
-    #[error("the {0} tuning chose no readable config")]
-    NoChoice(&'static str),
 }
 
 /// The datasets of a reproduction (Experiment 1 is required).
@@ -150,10 +147,6 @@ impl Stages<'_> {
     }
 }
 
-fn chosen(t: &crate::results::Tuning, kind: Kind) -> Result<ReprConfig, Error> {
-    tuning::chosen(t).ok_or(Error::NoChoice(kind.name()))
-}
-
 /// Runs the whole protocol on `data` and writes the report into `out`. Each stage's time is
 /// appended to `log` (the output folder's, opened by this invocation) as it finishes; the
 /// report tables every invocation's.
@@ -188,7 +181,7 @@ pub fn reproduce(
     stages.done("tuning (static)")?;
     let dt = tuning::tune(&cache1, &splits1, Kind::Dynamic, &run)?;
     stages.done("tuning (dynamic)")?;
-    let (static_cfg, dynamic_cfg) = (chosen(&st, Kind::Static)?, chosen(&dt, Kind::Dynamic)?);
+    let (static_cfg, dynamic_cfg) = (st.chosen_config, dt.chosen_config);
     let reprs = exp1::of_plan(plan, static_cfg, dynamic_cfg);
 
     let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
@@ -214,22 +207,26 @@ pub fn reproduce(
         // The example: the first test trial with a stop, with the motion + stop models.
         let test = ds2.trials(splits2.get(Split::Test))?;
         if let Some(meta) = test.iter().find(|t| t.stop_start_us.is_some()) {
-            let loaded: Vec<(&str, Model)> = reprs
+            let loaded: Vec<(ReprKind, Model)> = reprs
                 .iter()
-                .map(|(name, _)| {
-                    training::load_model(&exp2::model_dir(&models, exp2::SETTINGS[2].0, name, seed))
-                        .map(|m| (*name, m))
+                .map(|config| {
+                    let kind = config.kind();
+                    training::load_model(&exp2::model_dir(&models, exp2::SETTINGS[2].0, kind, seed))
+                        .map(|m| (kind, m))
                 })
                 .collect::<Result<_, _>>()?;
-            let refs: Vec<(&str, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
+            let refs: Vec<(ReprKind, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
             example = Some(examples::example_trial(&cache2, meta, &refs)?);
         }
         stages.done("experiment 2")?;
     }
 
-    let exp1_models: Vec<(&str, Vec<Model>)> = reprs
+    let exp1_models: Vec<(ReprKind, Vec<Model>)> = reprs
         .iter()
-        .map(|(name, _)| exp1::models(&models, name, seed, plan.seeds).map(|m| (*name, m)))
+        .map(|config| {
+            let kind = config.kind();
+            exp1::models(&models, kind, seed, plan.seeds).map(|m| (kind, m))
+        })
         .collect::<Result<_, _>>()?;
     let speeds: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.speed_deg_s).collect();
     let depths: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.depth_mm).collect();
@@ -258,17 +255,13 @@ pub fn reproduce(
     if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
         stages.done("experiment 3")?;
     }
-    let overlays = examples::overlays(&cache1, reprs[0].1, reprs[1].1)?;
+    let overlays = examples::overlays(&cache1, reprs[0], reprs[1])?;
     // The paper's Fig. 2 and the sensor's camera view, both on the first test trial.
     let test = ds1.trials(splits1.get(Split::Test))?;
     let (repr_example, sensor) = match test.first() {
         Some(meta) => {
             // The paper's three frames (the fusions' are the static and dynamic ones).
-            let paper_reprs: Vec<_> = reprs
-                .iter()
-                .filter(|(_, c)| c.frames() == 1)
-                .copied()
-                .collect();
+            let paper_reprs: Vec<_> = reprs.iter().filter(|c| c.frames() == 1).copied().collect();
             let example = repr_example::example(&cache1, meta, &paper_reprs)?;
             // The tilt at the example's sample (commanded: constant speed from onset).
             let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
@@ -289,7 +282,7 @@ pub fn reproduce(
     for (name, ms) in &exp1_models {
         let Some(model) = ms.first() else { continue };
         for &iv in &plan.latency_intervals_ms {
-            lat.push(latency::measure(&ds1, test, name, model, iv)?);
+            lat.push(latency::measure(&ds1, test, *name, model, iv)?);
             progress.advance(1);
         }
     }
@@ -299,7 +292,7 @@ pub fn reproduce(
         run: RunInfo {
             scale: plan.scale.name().to_string(),
             seed,
-            plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
+            plan: plan.clone(),
             stage_seconds: Vec::new(),
             stage_history: Vec::new(),
             datasets,

@@ -10,7 +10,7 @@
 //! varied while the other is fixed, as the paper's tuning figure shows). The report states the
 //! plan it ran.
 
-use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use evtac_sim::Scale;
 use serde::{Deserialize, Serialize};
 
@@ -123,11 +123,10 @@ impl Plan {
     /// Representations trained per seed in Experiments 1 and 2 and the noise study: the
     /// paper's three, and the two learned fusions unless left out.
     pub fn representations(&self) -> usize {
-        let all = crate::exp1::NAMES.len();
         if self.fusions {
-            all
+            ReprKind::ALL.len()
         } else {
-            all - crate::exp1::FUSIONS.len()
+            ReprKind::PAPER.len()
         }
     }
 

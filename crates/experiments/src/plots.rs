@@ -34,6 +34,8 @@ use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use evtac_repr::ReprKind;
+
 /// The embedded font (DejaVu Sans, Bitstream Vera license).
 static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 /// The font family name figures use.
@@ -137,11 +139,10 @@ where
         .map_err(draw_err(path))
 }
 
-/// The color of a representation by name (one per [`crate::exp1::NAMES`], in that order; the
-/// combined one's for any other name).
-pub(crate) fn repr_color(name: &str) -> RGBColor {
-    let i = crate::exp1::NAMES.iter().position(|n| *n == name);
-    REPR_COLORS[i.unwrap_or(2)]
+/// The color of a representation (one per [`ReprKind::ALL`], in that order).
+pub(crate) fn repr_color(kind: ReprKind) -> RGBColor {
+    // The enum's variants are declared in `ALL`'s order, so its discriminant is the index.
+    REPR_COLORS[kind as usize]
 }
 
 /// A tick label: at most three decimals, without trailing zeros (`5.5`, `100`, `0.25`).

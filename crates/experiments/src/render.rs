@@ -40,7 +40,7 @@ mod gif;
 mod mp4;
 mod sheet;
 
-pub use angles::{Angles, estimate_times, repr_name};
+pub use angles::{Angles, estimate_times};
 pub use draw::{Layout, Scene, draw_frame, layout};
 pub use frames::{Frame, ReprFrame, Timing, for_each_frame};
 pub use gif::GifWriter;
@@ -49,7 +49,7 @@ pub use sheet::{MAX_SHEET_FRAMES, SHEET_DEFAULT_FRAMES, SheetWriter};
 
 use evtac_events::Event;
 use evtac_events::output::OutputFile;
-use evtac_repr::{Mask, ReprConfig, ReprError};
+use evtac_repr::{Mask, ReprConfig, ReprError, ReprKind};
 use std::path::{Path, PathBuf};
 
 /// One kind of panel in a rendered frame.
@@ -95,13 +95,12 @@ impl Panel {
         }
     }
 
-    /// The representation (`Static`, `Dynamic`, `Combined`, as
-    /// [`crate::exp1::paper_representations`] names them) a frame panel shows.
-    pub fn repr_name(self) -> Option<&'static str> {
+    /// The representation a frame panel shows.
+    pub fn repr_kind(self) -> Option<ReprKind> {
         match self {
-            Panel::Static => Some("Static"),
-            Panel::Dynamic => Some("Dynamic"),
-            Panel::Combined => Some("Combined"),
+            Panel::Static => Some(ReprKind::Static),
+            Panel::Dynamic => Some(ReprKind::Dynamic),
+            Panel::Combined => Some(ReprKind::Combined),
             Panel::Events | Panel::Features | Panel::Angles => None,
         }
     }
@@ -233,7 +232,7 @@ pub fn render(
     path: &Path,
     output: Output,
     events: &[Event],
-    reprs: &[(&str, ReprConfig)],
+    reprs: &[ReprConfig],
     masks: &[Option<&Mask>],
     scene: Scene<'_>,
 ) -> Result<(), Error> {

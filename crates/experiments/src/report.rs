@@ -5,6 +5,7 @@ use crate::exp2::SETTINGS;
 use crate::plots;
 use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind};
 use evtac_events::IoError;
+use evtac_repr::ReprKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -14,12 +15,41 @@ mod fusion;
 pub type MeanStd = (f64, f64);
 
 /// The paper's Table (Experiment 1, test MAE in degrees, mean ± std over ten runs):
-/// (name, overall, pitch, roll).
-pub const PAPER_TABLE: [(&str, MeanStd, MeanStd, MeanStd); 3] = [
-    ("Static", (0.160, 0.004), (0.158, 0.005), (0.163, 0.008)),
-    ("Dynamic", (0.186, 0.007), (0.183, 0.007), (0.189, 0.010)),
-    ("Combined", (0.173, 0.006), (0.169, 0.008), (0.177, 0.006)),
+/// (representation, overall, pitch, roll).
+pub const PAPER_TABLE: [(ReprKind, MeanStd, MeanStd, MeanStd); 3] = [
+    (
+        ReprKind::Static,
+        (0.160, 0.004),
+        (0.158, 0.005),
+        (0.163, 0.008),
+    ),
+    (
+        ReprKind::Dynamic,
+        (0.186, 0.007),
+        (0.183, 0.007),
+        (0.189, 0.010),
+    ),
+    (
+        ReprKind::Combined,
+        (0.173, 0.006),
+        (0.169, 0.008),
+        (0.177, 0.006),
+    ),
 ];
+/// A plan's list or pair as JSON (`[250.0,1000.0]`), as `results.json` holds it.
+fn json<T: serde::Serialize + ?Sized>(value: &T) -> String {
+    serde_json::to_string(value).unwrap_or_else(|e| format!("? ({e})"))
+}
+
+/// The report names of `kinds`, as a table row's cells.
+fn titles(kinds: &[ReprKind]) -> String {
+    kinds
+        .iter()
+        .map(|k| k.title())
+        .collect::<Vec<_>>()
+        .join(" | ")
+}
+
 /// The paper's best Experiment 2 numbers (static, pause-inclusive): motion and stop MAE.
 pub const PAPER_EXP2_STATIC: (f64, f64) = (0.211, 0.251);
 
@@ -155,22 +185,22 @@ fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str),
     values.dedup_by(|a, b| a.0 == b.0);
     let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit, paper_gap));
     let unit = format!("{axis} ({unit})");
-    let names = crate::exp1::in_order(points.iter().map(|p| p.name.as_str()));
+    let names = ReprKind::in_order(points.iter().map(|p| p.name));
     let _ = writeln!(
         md,
         "| {unit} | seen | trials | {} |\n| ---: | :---: | ---: |{}",
-        names.join(" | "),
+        titles(&names),
         " ---: |".repeat(names.len())
     );
     for (v, seen) in values {
-        let get = |name: &str| {
+        let get = |name: ReprKind| {
             points
                 .iter()
                 .find(|p| p.value == v && p.name == name)
                 .map_or("-".to_string(), |p| cell(&p.stats.overall))
         };
         let trials = points.iter().find(|p| p.value == v).map_or(0, |p| p.trials);
-        let cells: Vec<String> = names.iter().map(|n| get(n)).collect();
+        let cells: Vec<String> = names.iter().map(|&n| get(n)).collect();
         let _ = writeln!(
             md,
             "| {v} | {} | {trials} | {} |",
@@ -207,32 +237,31 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
             inputs.mask_text()
         );
     }
-    let get = |k: &str| plan.get(k).map_or("?".to_string(), |v| v.to_string());
     let _ = writeln!(
         md,
         "Plan: static taus {} ms x thresholds {}; dynamic windows {} ms x thresholds {}; {}; \
          {} epochs per tuning run, {} epochs per final run; {} seeds per representation in \
          Experiment 1, {} in Experiment 2; latency on up to {} test trials at {} ms.\n",
-        get("static_taus_ms"),
-        get("static_thresholds"),
-        get("dynamic_windows_ms"),
-        get("dynamic_thresholds"),
-        if plan.get("full_grid").and_then(|v| v.as_bool()) == Some(true) {
+        json(&plan.static_taus_ms),
+        json(&plan.static_thresholds),
+        json(&plan.dynamic_windows_ms),
+        json(&plan.dynamic_thresholds),
+        if plan.full_grid {
             "every combination (the paper's grid search)".to_string()
         } else {
             format!(
                 "a cross through the paper's chosen settings (static {}, dynamic {}: one parameter \
                  varied with the other fixed) instead of the full grid, to fit the time budget",
-                get("static_center"),
-                get("dynamic_center")
+                json(&plan.static_center),
+                json(&plan.dynamic_center)
             )
         },
-        get("tuning_epochs"),
-        get("epochs"),
-        get("seeds"),
-        get("exp2_seeds"),
-        get("latency_trials"),
-        get("latency_intervals_ms"),
+        plan.tuning_epochs,
+        plan.epochs,
+        plan.seeds,
+        plan.exp2_seeds,
+        plan.latency_trials,
+        json(&plan.latency_intervals_ms),
     );
     if r.run.scale != "paper" {
         let _ = writeln!(
@@ -253,7 +282,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
 
     let _ = writeln!(md, "## Experiment 1: hyperparameter search\n");
     for t in &r.tuning {
-        let (unit, paper_choice) = if t.repr == "static" {
+        let (unit, paper_choice) = if t.repr == ReprKind::Static {
             ("tau", "1000 ms, threshold 2")
         } else {
             ("window", "640 ms, threshold 0")
@@ -261,13 +290,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(
             md,
             "{}: chosen {unit} {} ms, threshold {} (paper: {paper_choice}).\n",
-            if t.repr == "static" {
-                "Static"
-            } else {
-                "Dynamic"
-            },
-            t.chosen_time_ms,
-            t.chosen_threshold
+            t.repr, t.chosen_time_ms, t.chosen_threshold
         );
         let _ = writeln!(
             md,
@@ -291,12 +314,11 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     );
     let _ = writeln!(md, "| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     // The paper's three always (its numbers beside ours), then the learned fusions run.
-    let fusions = crate::exp1::in_order(r.exp1.iter().map(|e| e.name.as_str()));
-    let names = PAPER_TABLE.iter().map(|p| p.0).chain(
-        fusions
-            .into_iter()
-            .filter(|n| crate::exp1::FUSIONS.contains(n)),
-    );
+    let fusions = ReprKind::in_order(r.exp1.iter().map(|e| e.name));
+    let names = PAPER_TABLE
+        .iter()
+        .map(|p| p.0)
+        .chain(fusions.into_iter().filter(|n| n.is_fusion()));
     for name in names {
         let ours = r.exp1.iter().find(|e| e.name == name);
         let s = ours.map(|e| e.test).unwrap_or_default();
@@ -422,7 +444,11 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
 }
 
 /// Test MAE statistics of `name` at noise `level`, if measured.
-fn noise_stats(points: &[NoisePoint], level: f64, name: &str) -> Option<crate::results::MeanStd> {
+fn noise_stats(
+    points: &[NoisePoint],
+    level: f64,
+    name: ReprKind,
+) -> Option<crate::results::MeanStd> {
     points
         .iter()
         .find(|p| p.level == level && p.name == name)
@@ -498,16 +524,16 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
-    let names = crate::exp1::in_order(r.noise.iter().map(|p| p.name.as_str()));
+    let names = ReprKind::in_order(r.noise.iter().map(|p| p.name));
     let _ = writeln!(
         md,
         "| noise | background events/s | {} | dynamic - static |\n| ---: | ---: |{} ---: |",
-        names.join(" | "),
+        titles(&names),
         " ---: |".repeat(names.len())
     );
     let mut gaps = Vec::new();
     for &level in &levels {
-        let cell_of = |name: &str| {
+        let cell_of = |name: ReprKind| {
             r.noise
                 .iter()
                 .find(|p| p.level == level && p.name == name)
@@ -518,13 +544,13 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
             .iter()
             .find(|p| p.level == level)
             .map_or(0.0, |p| p.no_contact_events_per_s);
-        let gap = noise_stats(&r.noise, level, "Dynamic")
-            .zip(noise_stats(&r.noise, level, "Static"))
+        let gap = noise_stats(&r.noise, level, ReprKind::Dynamic)
+            .zip(noise_stats(&r.noise, level, ReprKind::Static))
             .map(|(d, s)| (d.mean - s.mean, d.std.hypot(s.std)));
         if let Some((g, spread)) = gap {
             gaps.push((level, g, spread));
         }
-        let cells: Vec<String> = names.iter().map(|n| cell_of(n)).collect();
+        let cells: Vec<String> = names.iter().map(|&n| cell_of(n)).collect();
         let _ = writeln!(
             md,
             "| x{level} | {rate:.0} | {} | {} |",
@@ -627,7 +653,7 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
 }
 
 /// Statistics shown for a representation in Experiment 1, if present.
-pub fn exp1_stats<'a>(r: &'a Results, name: &str) -> Option<&'a MaeStats> {
+pub fn exp1_stats(r: &Results, name: ReprKind) -> Option<&MaeStats> {
     r.exp1.iter().find(|e| e.name == name).map(|e| &e.test)
 }
 

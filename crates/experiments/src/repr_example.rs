@@ -19,15 +19,14 @@ use evtac_repr::{CROP, FeatureExtractor, ReprConfig};
 pub fn example(
     cache: &FeatureCache<'_>,
     meta: &TrialMeta,
-    reprs: &[(&str, ReprConfig)],
+    reprs: &[ReprConfig],
 ) -> Result<Option<ReprExample>, Error> {
     let samples = cache.samples(meta, Sampling::MOTION)?;
     let Some(sample) = samples.times.get(samples.times.len() / 2) else {
         return Ok(None);
     };
     let t_k = sample.t_us;
-    let configs: Vec<ReprConfig> = reprs.iter().map(|(_, c)| *c).collect();
-    let masks = configs
+    let masks = reprs
         .iter()
         .map(|c| cache.mask(c))
         .collect::<Result<Vec<_>, _>>()?;
@@ -36,15 +35,15 @@ pub fn example(
         trial: meta.trial.clone(),
         source,
     };
-    let mut fx = FeatureExtractor::new_with_masks(&configs, CROP, &mask_refs).map_err(repr_err)?;
+    let mut fx = FeatureExtractor::new_with_masks(reprs, CROP, &mask_refs).map_err(repr_err)?;
     let events = cache.dataset().events(meta)?;
     let mut panels = Vec::new();
     fx.run(&events, &[t_k], |_, fx| {
         panels = reprs
             .iter()
             .enumerate()
-            .map(|(i, (name, _))| ReprPanel {
-                name: (*name).to_string(),
+            .map(|(i, config)| ReprPanel {
+                name: config.kind(),
                 frame: fx.frame(i).to_vec(),
                 features: fx.features(i).to_vec(),
             })
@@ -53,7 +52,7 @@ pub fn example(
     .map_err(repr_err)?;
     // The window the dynamic representation counts at t_k, `(t_k - window, t_k]`; without a
     // dynamic part (never in the report), the paper's 640 ms.
-    let window_us = configs
+    let window_us = reprs
         .iter()
         .find_map(|c| c.dynamic_part())
         .map_or(640_000, |d| d.window_us());

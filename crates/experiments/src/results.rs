@@ -1,7 +1,15 @@
 //! The numbers a reproduction produces, as one serde tree written to `OUT/results.json` and read
 //! by the report and the figures.
+//!
+//! Plain typed data at the bottom of the crate: this file imports nothing from the experiments
+//! that fill it (only the [`Plan`] they ran, itself plain data), so the report reads it without
+//! knowing how it was made. Representations are [`ReprKind`]s, written as their report names
+//! (`"Static"`) as `results.json` always spelled them; older files still read.
 
+use evtac_repr::{ReprConfig, ReprKind};
 use serde::{Deserialize, Serialize};
+
+use crate::plan::Plan;
 
 /// Mean absolute errors in degrees: overall (mean of pitch and roll), pitch and roll.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -109,8 +117,9 @@ pub struct TuningRun {
 /// The grid search of one representation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Tuning {
-    /// `static` or `dynamic`.
-    pub repr: String,
+    /// `static` or `dynamic` (written as the CLI spells it).
+    #[serde(with = "evtac_repr::kind_name")]
+    pub repr: ReprKind,
     /// Name of the time parameter (`tau_ms` or `window_ms`).
     pub time_name: String,
     /// Every run of the grid.
@@ -119,8 +128,8 @@ pub struct Tuning {
     pub chosen_time_ms: f64,
     /// The chosen threshold.
     pub chosen_threshold: f64,
-    /// The representation config chosen, as the repr crate serializes it.
-    pub chosen_config: serde_json::Value,
+    /// The representation config chosen.
+    pub chosen_config: ReprConfig,
     /// The time parameter fixed along the threshold curve of the figure.
     pub curve_time_ms: f64,
     /// The threshold fixed along the time curve of the figure.
@@ -130,10 +139,10 @@ pub struct Tuning {
 /// Experiment 1 for one representation: ten seeds with the chosen settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp1Repr {
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// The representation config.
-    pub config: serde_json::Value,
+    pub config: ReprConfig,
     /// Seeds trained.
     pub seeds: Vec<u64>,
     /// Test MAE per seed.
@@ -149,8 +158,8 @@ pub struct Exp1Repr {
 pub struct NoisePoint {
     /// The factor on the simulator's leak, shot and hot-pixel noise (1: Experiment 1 itself).
     pub level: f64,
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// Events per second in the 240x240 crop of the dataset's no-contact recording: the
     /// background activity at this level.
     pub no_contact_events_per_s: f64,
@@ -165,8 +174,8 @@ pub struct NoisePoint {
 pub struct Exp2Cell {
     /// `continuous-only`, `pause-motion` or `pause-motion-stop`.
     pub setting: String,
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// Motion-phase test MAE per seed.
     pub motion_runs: Vec<Mae>,
     /// Stop-phase test MAE per seed.
@@ -180,8 +189,8 @@ pub struct Exp2Cell {
 /// Experiment 3: one condition value (a speed or a depth) for one representation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp3Point {
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// Speed in deg/s or depth in mm.
     pub value: f64,
     /// Whether the value was in the training set (`seen`) or interpolated (`unseen`).
@@ -197,14 +206,13 @@ pub struct Exp3Point {
 /// Latency of one (representation, sampling interval).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LatencyCell {
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// Sampling interval in ms.
     pub interval_ms: u32,
     /// Number of measured samples.
     pub samples: usize,
-    /// Median processing time per estimate in microseconds (events in to estimate out, see
-    /// [`crate::latency`]).
+    /// Median processing time per estimate in microseconds (events in to estimate out).
     pub median_us: f64,
     /// 99th percentile in microseconds.
     pub p99_us: f64,
@@ -226,13 +234,13 @@ pub struct RunInfo {
     /// Master seed.
     pub seed: u64,
     /// The plan (grids, epochs, seeds) as run.
-    pub plan: serde_json::Value,
+    pub plan: Plan,
     /// Wall time per stage in seconds, in order: this invocation's.
     pub stage_seconds: Vec<(String, f64)>,
     /// Every invocation's stages that worked on this output folder, the simulation included
     /// (`stage-times.csv`; absent in results written before it was kept).
     #[serde(default)]
-    pub stage_history: Vec<crate::stage_log::StageRecord>,
+    pub stage_history: Vec<StageRecord>,
     /// Trials per dataset.
     pub datasets: Vec<(String, usize)>,
     /// Where every dataset's calibration and mask came from (absent in results written before
@@ -252,8 +260,8 @@ pub struct ExampleTrial {
     pub t_s: Vec<f64>,
     /// Ground-truth (pitch, roll) at the sample times.
     pub truth: Vec<[f32; 2]>,
-    /// Predictions per representation name.
-    pub predictions: Vec<(String, Vec<[f32; 2]>)>,
+    /// Predictions per representation.
+    pub predictions: Vec<(ReprKind, Vec<[f32; 2]>)>,
 }
 
 /// Binary frames for the contour overlays: two conditions per panel.
@@ -275,7 +283,7 @@ pub struct Overlay {
     pub second: Vec<u8>,
 }
 
-/// The paper's Fig. 2 for one test sample (see [`crate::repr_example`]).
+/// The paper's Fig. 2 for one test sample.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ReprExample {
     /// Trial name.
@@ -297,10 +305,10 @@ pub struct ReprExample {
 }
 
 /// One representation of [`ReprExample`].
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReprPanel {
-    /// `Static`, `Dynamic`, `Combined`, `Stacked` or `Late` ([`crate::exp1::NAMES`]).
-    pub name: String,
+    /// The representation.
+    pub name: ReprKind,
     /// The binary frame (0/1, `width x height`, row-major).
     pub frame: Vec<u8>,
     /// The pooled features (`width / 8 x height / 8`, row-major, each the fraction of set
@@ -317,7 +325,7 @@ pub enum SensorKind {
     EventCounts,
 }
 
-/// The sensor figure's data (see [`crate::sensor_view`]).
+/// The sensor figure's data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SensorView {
     /// What the images are.
@@ -335,6 +343,42 @@ pub struct SensorPanel {
     pub title: String,
     /// Display intensity per pixel in 0..=1 (row-major, full sensor).
     pub values: Vec<f32>,
+}
+
+/// One finished stage of one invocation (a row of `stage-times.csv`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StageRecord {
+    /// The invocation, numbered from 1 in the order they ran.
+    pub invocation: u32,
+    /// The stage's name as the report prints it.
+    pub stage: String,
+    /// Its wall time in seconds.
+    pub seconds: f64,
+}
+
+/// One value evtac chose where the paper states none.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Choice {
+    /// What was chosen (also the row's key in tests).
+    pub what: String,
+    /// The value the run used.
+    pub value: String,
+    /// Why this value.
+    pub why: String,
+    /// The flag or file that changes it.
+    pub change: String,
+}
+
+/// The label check over one dataset: Experiment 2's labels against the commanded stop angles
+/// and the ground truth.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LabelCheck {
+    /// Mean labelled tilt over each stop minus the commanded stop angle, degrees (trials with
+    /// a stop).
+    pub stop_error_deg: Option<evtac_labels::Summary>,
+    /// Per-trial RMS error of the labels against the ground truth over pitch and roll, degrees
+    /// (trials with a truth file).
+    pub truth_rms_deg: Option<evtac_labels::Summary>,
 }
 
 /// Everything a reproduction measured.
@@ -361,11 +405,11 @@ pub struct Results {
     pub noise: Vec<NoisePoint>,
     /// The values evtac chose where the paper states none (absent from older results).
     #[serde(default)]
-    pub choices: Vec<crate::choices::Choice>,
+    pub choices: Vec<Choice>,
     /// Experiment 2's labels against the commanded stop angles and the ground truth (absent
     /// without Experiment 2, and from older results).
     #[serde(default)]
-    pub labels: Option<crate::LabelCheck>,
+    pub labels: Option<LabelCheck>,
     /// Contour overlays (static/dynamic x speed/depth); frames are not written to JSON.
     #[serde(skip)]
     pub overlays: Vec<Overlay>,

@@ -7,8 +7,8 @@
 //! little about the reproduction. Each invocation takes the next number and appends a row as
 //! each of its stages finishes, so an interrupted invocation keeps what it finished too.
 
+pub use crate::results::StageRecord;
 use evtac_events::IoError;
-use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -17,17 +17,6 @@ pub const FILE: &str = "stage-times.csv";
 
 /// Its header.
 const HEADER: &str = "invocation,stage,seconds";
-
-/// One finished stage of one invocation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StageRecord {
-    /// The invocation, numbered from 1 in the order they ran.
-    pub invocation: u32,
-    /// The stage's name as the report prints it.
-    pub stage: String,
-    /// Its wall time in seconds.
-    pub seconds: f64,
-}
 
 /// Errors reading or appending to the log.
 #[derive(Debug, thiserror::Error)]

@@ -12,7 +12,7 @@ use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error, TrainSpec};
 use evtac_learn::ModelBundle;
-use evtac_repr::ReprConfig;
+use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 
 /// Which representation is tuned.
@@ -25,12 +25,17 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// The representation tuned.
+    pub fn repr(self) -> ReprKind {
+        match self {
+            Kind::Static => ReprKind::Static,
+            Kind::Dynamic => ReprKind::Dynamic,
+        }
+    }
+
     /// `static` or `dynamic`.
     pub fn name(self) -> &'static str {
-        match self {
-            Kind::Static => "static",
-            Kind::Dynamic => "dynamic",
-        }
+        self.repr().name()
     }
 }
 
@@ -139,7 +144,7 @@ pub fn tune(
         .map(|(_, p)| p.clone())
         .unwrap_or_else(|| points[0].clone());
     Ok(Tuning {
-        repr: kind.name().into(),
+        repr: kind.repr(),
         time_name: match kind {
             Kind::Static => "tau_ms".into(),
             Kind::Dynamic => "window_ms".into(),
@@ -147,7 +152,7 @@ pub fn tune(
         runs,
         chosen_time_ms: best.time_ms,
         chosen_threshold: best.threshold,
-        chosen_config: serde_json::to_value(best.config).unwrap_or(serde_json::Value::Null),
+        chosen_config: best.config,
         curve_time_ms: if plan.full_grid {
             best.time_ms
         } else {
@@ -165,9 +170,4 @@ pub fn tune(
             }
         },
     })
-}
-
-/// The chosen config of a finished tuning.
-pub fn chosen(t: &Tuning) -> Option<ReprConfig> {
-    serde_json::from_value(t.chosen_config.clone()).ok()
 }

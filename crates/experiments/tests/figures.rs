@@ -27,12 +27,12 @@ fn the_fig2_sample_shows_the_cached_features_and_the_window_events() {
         .expect("the trial has motion samples");
     assert_eq!(ex.panels.len(), 3);
     assert_eq!((ex.width, ex.height, ex.window_ms), (240, 240, 640.0));
-    let configs: Vec<_> = reprs.iter().map(|(_, c)| *c).collect();
     cache
-        .ensure(&[meta], &configs, Sampling::MOTION, &|_| {})
+        .ensure(&[meta], &reprs, Sampling::MOTION, &|_| {})
         .unwrap();
-    for ((name, config), panel) in reprs.iter().zip(&ex.panels) {
-        assert_eq!(panel.name, *name);
+    for (config, panel) in reprs.iter().zip(&ex.panels) {
+        let name = config.kind();
+        assert_eq!(panel.name, name);
         // The middle of the 50 motion samples, as the models saw it (the cache, masks included).
         let loaded = cache
             .load(&[meta], config, Sampling::MOTION, &[Phase::Motion])

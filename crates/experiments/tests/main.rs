@@ -3,6 +3,7 @@
 mod cache;
 mod figures;
 mod inputs;
+mod results;
 mod resume;
 
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};

@@ -26,13 +26,6 @@ pub struct Mlp {
 }
 
 impl Mlp {
-    /// A model with PyTorch-default initial weights from `seed` (see [`Parameters::init`]).
-    pub fn new(seed: u64, device: &Device) -> Self {
-        // Sizes come from the architecture constants, so the freshly drawn weights always fit.
-        Self::from_parameters(&Parameters::init(seed), device)
-            .unwrap_or_else(|e| unreachable!("initial parameters fit the architecture: {e}"))
-    }
-
     /// Uploads `params` (PyTorch layout) to `device`.
     pub fn from_parameters(params: &Parameters, device: &Device) -> Result<Self, Error> {
         params.validate().map_err(|e| e.to_string())?;

@@ -12,7 +12,8 @@ use std::sync::{Mutex, MutexGuard};
 use evtac_events::check::EventCheck;
 use evtac_events::{Event, Resolution, Roi};
 use evtac_repr::{
-    CROP, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, ReprConfig, StaticConfig,
+    CROP, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, ReprConfig, ReprKind,
+    StaticConfig,
 };
 use ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
@@ -43,16 +44,8 @@ const DYNAMIC_SETTINGS: &[&str] = &["window_ms", "count_threshold"];
 pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
     let settings: Map<String, Value> = serde_json::from_str(settings)
         .map_err(|e| error::value(format!("settings must be a JSON object: {e}")))?;
-    let (has_static, has_dynamic) = match kind {
-        "static" => (true, false),
-        "dynamic" => (false, true),
-        "combined" | "stacked" | "late" => (true, true),
-        other => {
-            return Err(error::value(format!(
-                "unknown representation kind `{other}` (static, dynamic, combined, stacked or late)"
-            )));
-        }
-    };
+    let kind: ReprKind = kind.parse().map_err(error::value)?;
+    let (has_static, has_dynamic) = kind.parts();
     let (mut st, mut dy) = (Map::new(), Map::new());
     for (key, value) in settings {
         let (part, allowed) = if STATIC_SETTINGS.contains(&key.as_str()) {
@@ -81,22 +74,18 @@ pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
         serde_json::from_value::<DynamicConfig>(Value::Object(m))
             .map_err(|e| error::value(format!("dynamic settings: {e}")))
     };
-    let config = match kind {
-        "static" => ReprConfig::Static(static_part(st)?),
-        "dynamic" => ReprConfig::Dynamic(dynamic_part(dy)?),
-        "stacked" => ReprConfig::Stacked {
-            static_part: static_part(st)?,
-            dynamic_part: dynamic_part(dy)?,
-        },
-        "late" => ReprConfig::Late {
-            static_part: static_part(st)?,
-            dynamic_part: dynamic_part(dy)?,
-        },
-        _ => ReprConfig::Combined {
-            static_part: static_part(st)?,
-            dynamic_part: dynamic_part(dy)?,
-        },
+    // A part the kind does not take is left at its default (and ignored by `config`).
+    let static_part = if has_static {
+        static_part(st)?
+    } else {
+        StaticConfig::default()
     };
+    let dynamic_part = if has_dynamic {
+        dynamic_part(dy)?
+    } else {
+        DynamicConfig::default()
+    };
+    let config = kind.config(static_part, dynamic_part);
     config.validate().map_err(error::value)?;
     Ok(config)
 }

@@ -380,13 +380,7 @@ impl ReprConfig {
     /// The kind's name as the `kind` tag and the CLI's `--repr` spell it (`static`, `dynamic`,
     /// `combined`, `stacked`, `late`).
     pub fn kind_name(&self) -> &'static str {
-        match self {
-            Self::Static(_) => "static",
-            Self::Dynamic(_) => "dynamic",
-            Self::Combined { .. } => "combined",
-            Self::Stacked { .. } => "stacked",
-            Self::Late { .. } => "late",
-        }
+        self.kind().name()
     }
 
     /// Checks every field of every part.

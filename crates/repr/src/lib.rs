@@ -14,6 +14,9 @@
 //! - **pooling** ([`Pool8`]): 8x8 mean pooling to `(w / 8) x (h / 8)` features (30 x 30 = 900
 //!   for the paper's 240x240 crop), row-major, updated from pixel flips.
 //!
+//! [`ReprKind`] is the one list of kinds (and of learned fusions, `stacked` and `late`, whose
+//! features are both frames side by side), with their names on the command line and in reports.
+//!
 //! [`FeatureExtractor`] runs any number of [`ReprConfig`]s over one event stream in one pass,
 //! sharing accumulators and windows between configs that can share them.
 //!
@@ -53,6 +56,7 @@ mod error;
 pub mod expf;
 pub mod extractor;
 mod fifo;
+pub mod kind;
 pub mod mask;
 pub mod pool;
 mod prefetch;
@@ -68,6 +72,7 @@ pub use config::{
 pub use crop::{CROP, SensorTooSmall, centered_crop};
 pub use error::ReprError;
 pub use extractor::{FeatureExtractor, extract_features};
+pub use kind::{ReprKind, UnknownKind, kind_name};
 pub use mask::Mask;
 pub use pool::{Pool8, pool8};
 pub use provenance::FeatureProvenance;

@@ -111,7 +111,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ReprConfig::Static(static_cfg),
         ReprConfig::Dynamic(dynamic_cfg),
     );
-    for (_, c) in &reprs {
+    for c in &reprs {
         c.validate()?;
     }
     // The model's mask for every frame with its static settings (the mask is built from
@@ -127,7 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => {
             let events = dataset::read_cropped(&args.input)
                 .with_context(|| format!("reading {}", args.input.display()))?;
-            let masks = reprs.iter().map(|(_, c)| model_mask(c)).collect();
+            let masks = reprs.iter().map(model_mask).collect();
             (events, masks)
         }
         Some(trial) => {
@@ -138,7 +138,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let no_contact = ds.no_contact_events()?;
             let masks = reprs
                 .iter()
-                .map(|(_, c)| match model_mask(c) {
+                .map(|c| match model_mask(c) {
                     Some(m) => Ok(Some(m)),
                     None => ds.mask_for(c, no_contact.as_deref()),
                 })

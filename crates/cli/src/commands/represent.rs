@@ -13,28 +13,12 @@ use evtac_events::{Event, Resolution, Roi};
 use evtac_learn::Model;
 use evtac_repr::{
     Comparison, Decay, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, Polarity,
-    ReprConfig, StaticConfig, ThresholdSpace,
+    ReprConfig, ReprKind, StaticConfig, ThresholdSpace,
 };
 use ndarray::{Array2, Array3};
 
 use crate::outputs::write_npy;
 use std::path::{Path, PathBuf};
-
-/// Which representation to build.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Repr {
-    /// Exponential-decay accumulator (dv-processing compatible), masked and thresholded.
-    Static,
-    /// Sliding-window event count, thresholded.
-    Dynamic,
-    /// Pixel-wise OR of the static and dynamic binary frames.
-    Combined,
-    /// The static and dynamic frames side by side (learned fusion's input): frames N x 2H x W,
-    /// static above dynamic; features 2 x 900 per sample, static's first.
-    Stacked,
-    /// The same features as `stacked` (late fusion's network reads them differently).
-    Late,
-}
 
 /// What to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -97,8 +81,8 @@ pub struct Args {
     #[arg(long)]
     pub samples: PathBuf,
     /// Representation to build.
-    #[arg(long, value_enum, default_value = "combined", group = "settings")]
-    pub repr: Repr,
+    #[arg(long, value_parser = crate::kinds::parser(), default_value = "combined", group = "settings")]
+    pub repr: ReprKind,
     /// What to write: binary frames, pooled features or static potentials.
     #[arg(long, value_enum, default_value = "features")]
     pub what: What,
@@ -208,22 +192,8 @@ impl Args {
     }
 
     fn config(&self) -> ReprConfig {
-        match self.repr {
-            Repr::Static => ReprConfig::Static(self.static_config()),
-            Repr::Dynamic => ReprConfig::Dynamic(self.dynamic_config()),
-            Repr::Combined => ReprConfig::Combined {
-                static_part: self.static_config(),
-                dynamic_part: self.dynamic_config(),
-            },
-            Repr::Stacked => ReprConfig::Stacked {
-                static_part: self.static_config(),
-                dynamic_part: self.dynamic_config(),
-            },
-            Repr::Late => ReprConfig::Late {
-                static_part: self.static_config(),
-                dynamic_part: self.dynamic_config(),
-            },
-        }
+        self.repr
+            .config(self.static_config(), self.dynamic_config())
     }
 }
 

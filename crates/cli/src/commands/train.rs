@@ -9,32 +9,15 @@ use evtac_experiments::jobs;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::training::{self, TrainSpec};
 use evtac_learn::TrainConfig;
-use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
+use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use std::path::PathBuf;
-
-/// Which representation to build.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ReprKind {
-    /// Exponential-decay accumulator, masked and thresholded.
-    Static,
-    /// Sliding-window event count, thresholded.
-    Dynamic,
-    /// Pixel-wise OR of the static and dynamic frames.
-    Combined,
-    /// Both frames pooled side by side (1800 features) into one dense network (learned
-    /// fusion).
-    Stacked,
-    /// Both frames pooled side by side into a network with one 900-128 branch per frame,
-    /// concatenated before the head (learned late fusion).
-    Late,
-}
 
 /// Representation settings shared by `train` and `tune`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReprArgs {
     /// Representation: static, dynamic, combined (the paper's three), stacked or late (learned
     /// fusions of the static and dynamic frames).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::kinds::parser())]
     pub repr: ReprKind,
     /// Static decay constant tau in ms (the default is the paper's choice).
     #[arg(long, default_value_t = StaticConfig::default().tau_ms)]
@@ -74,22 +57,7 @@ impl ReprArgs {
             window_ms: self.window_ms,
             count_threshold: self.count_threshold,
         };
-        let config = match self.repr {
-            ReprKind::Static => ReprConfig::Static(s),
-            ReprKind::Dynamic => ReprConfig::Dynamic(d),
-            ReprKind::Combined => ReprConfig::Combined {
-                static_part: s,
-                dynamic_part: d,
-            },
-            ReprKind::Stacked => ReprConfig::Stacked {
-                static_part: s,
-                dynamic_part: d,
-            },
-            ReprKind::Late => ReprConfig::Late {
-                static_part: s,
-                dynamic_part: d,
-            },
-        };
+        let config = self.repr.config(s, d);
         config.validate()?;
         Ok(config)
     }

@@ -5,16 +5,16 @@ use super::*;
 use crate::results::{Exp3Point, NoisePoint};
 
 /// One marker of an error-vs-condition panel: a representation's test MAE at `x`.
-struct Marker<'a> {
-    name: &'a str,
+struct Marker {
+    name: ReprKind,
     x: f64,
     stats: crate::results::MeanStd,
     /// Filled (seen during training) or hollow (unseen).
     filled: bool,
 }
 
-impl<'a> Marker<'a> {
-    fn new(name: &'a str, x: f64, stats: crate::results::MeanStd, filled: bool) -> Self {
+impl Marker {
+    fn new(name: ReprKind, x: f64, stats: crate::results::MeanStd, filled: bool) -> Self {
         Self {
             name,
             x,
@@ -27,7 +27,7 @@ impl<'a> Marker<'a> {
 /// One panel of test MAE (mean ± std) against a condition, a line per representation.
 fn mae_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    markers: &[Marker<'_>],
+    markers: &[Marker],
     (caption, desc): (&str, &str),
     path: &Path,
 ) -> Result<(), Error>
@@ -43,7 +43,7 @@ where
         false,
     );
     let mut chart = xy_chart(area, (xr, yr), caption, (desc, "test MAE (deg)"), path)?;
-    for name in crate::exp1::NAMES {
+    for name in ReprKind::ALL {
         let color = repr_color(name);
         let mut pts: Vec<&Marker> = markers.iter().filter(|p| p.name == name).collect();
         pts.sort_by(|a, b| a.x.total_cmp(&b.x));
@@ -56,7 +56,7 @@ where
                 color.stroke_width(2),
             ))
             .map_err(&e)?
-            .label(name)
+            .label(name.title())
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
             });
@@ -107,7 +107,7 @@ pub fn speed_depth(path: &Path, speed: &[Exp3Point], depth: &[Exp3Point]) -> Res
         }
         let markers: Vec<Marker> = points
             .iter()
-            .map(|p| Marker::new(&p.name, p.value, p.stats.overall, p.seen))
+            .map(|p| Marker::new(p.name, p.value, p.stats.overall, p.seen))
             .collect();
         mae_panel(area, &markers, (&format!("Error vs {axis}"), desc), path)?;
     }
@@ -121,7 +121,7 @@ pub fn noise(path: &Path, points: &[NoisePoint]) -> Result<(), Error> {
     let root = canvas(path, (800, 520), !points.is_empty())?;
     let markers: Vec<Marker> = points
         .iter()
-        .map(|p| Marker::new(&p.name, p.level, p.test.overall, true))
+        .map(|p| Marker::new(p.name, p.level, p.test.overall, true))
         .collect();
     mae_panel(
         &root,

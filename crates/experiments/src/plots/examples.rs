@@ -63,7 +63,7 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
             .label("ground truth")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(3)));
         for (name, pred) in &ex.predictions {
-            let color = repr_color(name);
+            let color = repr_color(*name);
             let pts: Vec<(f64, f64)> = ex
                 .t_s
                 .iter()
@@ -73,7 +73,7 @@ pub fn example_curves(path: &Path, ex: &ExampleTrial) -> Result<(), Error> {
             chart
                 .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                 .map_err(&e)?
-                .label(name.as_str())
+                .label(name.title())
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                 });

@@ -16,7 +16,7 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// diamond, on a log time axis, with the interval itself (dashed) and the paper's 10 ms bound.
 pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
     let e = draw_err(path);
-    let names = crate::exp1::in_order(cells.iter().map(|c| c.name.as_str()));
+    let names = ReprKind::in_order(cells.iter().map(|c| c.name));
     let width = 500 * names.len().max(1) as u32;
     let root = canvas(path, (width, 520), !cells.is_empty())?;
     let areas = root.split_evenly((1, names.len().max(1)));
@@ -36,7 +36,7 @@ pub fn latency(path: &Path, cells: &[LatencyCell]) -> Result<(), Error> {
         let color = repr_color(name);
         let n = intervals.len() as f64;
         let mut chart = ChartBuilder::on(area)
-            .caption(name, (FAMILY, 22))
+            .caption(name.title(), (FAMILY, 22))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)

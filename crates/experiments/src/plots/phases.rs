@@ -6,7 +6,7 @@ use crate::results::Exp2Cell;
 /// Motion- and stop-phase MAE (mean ± std over seeds) per representation and training setting.
 pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) -> Result<(), Error> {
     let e = draw_err(path);
-    let names = crate::exp1::in_order(cells.iter().map(|c| c.name.as_str()));
+    let names = ReprKind::in_order(cells.iter().map(|c| c.name));
     let root = canvas(
         path,
         (400 + 300 * names.len() as u32, 520),

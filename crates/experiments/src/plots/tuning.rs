@@ -15,17 +15,13 @@ struct Curve {
 fn tuning_panels(tuning: &[Tuning]) -> Vec<Curve> {
     let mut out = Vec::new();
     for t in tuning {
-        let label = if t.repr == "static" {
-            "Static"
-        } else {
-            "Dynamic"
-        };
-        let time_desc = if t.repr == "static" {
+        let label = t.repr.title();
+        let time_desc = if t.repr == ReprKind::Static {
             "decay tau (ms)"
         } else {
             "window (ms)"
         };
-        let th_desc = if t.repr == "static" {
+        let th_desc = if t.repr == ReprKind::Static {
             "threshold (event contributions)"
         } else {
             "threshold (event count)"

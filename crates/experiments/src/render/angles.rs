@@ -12,7 +12,7 @@ use super::frames::Timing;
 use evtac_events::Event;
 use evtac_labels::series::LabelSeries;
 use evtac_learn::Model;
-use evtac_repr::{CROP, FeatureExtractor, ReprConfig};
+use evtac_repr::{CROP, FeatureExtractor, ReprKind};
 
 /// The longest time between two estimates: frame intervals are divided so that the curve
 /// shows the motion between frames (a 200 ms frame would draw it as a few straight lines).
@@ -32,8 +32,8 @@ pub struct Angles {
     pub labels: Option<Vec<[f64; 2]>>,
     /// The simulator's true (pitch, roll) at each time, degrees, when the dataset has them.
     pub truth: Option<Vec<[f64; 2]>>,
-    /// The model's representation (`Static`, `Dynamic`, `Combined`), naming its curve.
-    pub model_repr: &'static str,
+    /// The model's representation, naming its curve.
+    pub model_repr: ReprKind,
 }
 
 impl Angles {
@@ -76,7 +76,7 @@ impl Angles {
             estimates,
             labels: None,
             truth: None,
-            model_repr: repr_name(&config),
+            model_repr: config.kind(),
         })
     }
 
@@ -100,16 +100,6 @@ impl Angles {
         }
         text
     }
-}
-
-/// The name of `config`'s kind, as [`crate::exp1::representations`] names them
-/// ([`crate::exp1::NAMES`]: `Static` for the kind `static`, ...).
-pub fn repr_name(config: &ReprConfig) -> &'static str {
-    let kind = config.kind_name();
-    crate::exp1::NAMES
-        .into_iter()
-        .find(|name| name.eq_ignore_ascii_case(kind))
-        .unwrap_or(kind)
 }
 
 /// The estimate times of `timing`: each frame interval divided into the fewest equal steps of

@@ -139,10 +139,10 @@ pub fn draw_frame<DB: DrawingBackend>(
             )?;
             continue;
         }
-        let Some(repr) = panel.repr_name().and_then(|n| frame.repr(n)) else {
+        let Some(repr) = panel.repr_kind().and_then(|k| frame.repr(k)) else {
             continue;
         };
-        text(format!("{} frame", repr.name), (x, y - TITLE + 2))?;
+        text(format!("{} frame", repr.kind), (x, y - TITLE + 2))?;
         draw_image(
             area,
             (x, y),
@@ -158,7 +158,7 @@ pub fn draw_frame<DB: DrawingBackend>(
             let (fx, fy) = origin(c, 1);
             let (cw, ch) = (w / CELL, h / CELL);
             text(
-                format!("{} features ({cw}x{ch})", repr.name),
+                format!("{} features ({cw}x{ch})", repr.kind),
                 (fx, fy - TITLE + 2),
             )?;
             draw_image(

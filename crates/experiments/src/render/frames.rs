@@ -3,7 +3,7 @@
 
 use super::Error;
 use evtac_events::Event;
-use evtac_repr::{CROP, FeatureExtractor, Mask, ReprConfig};
+use evtac_repr::{CROP, FeatureExtractor, Mask, ReprConfig, ReprKind};
 
 /// When the frames are taken: `count` frames, the k-th at the end of the recording-time
 /// interval `(start_us + k * step_us, start_us + (k + 1) * step_us]`.
@@ -95,8 +95,8 @@ fn range(events: &[Event], from_us: Option<i64>, to_us: Option<i64>) -> Result<(
 /// One representation in a frame.
 #[derive(Debug, Clone, Copy)]
 pub struct ReprFrame<'a> {
-    /// Display name (`Static`, `Dynamic`, `Combined`).
-    pub name: &'a str,
+    /// The representation.
+    pub kind: ReprKind,
     /// The binary frame, row-major, 0 or 1.
     pub frame: &'a [u8],
     /// The pooled features, row-major.
@@ -117,24 +117,23 @@ pub struct Frame<'a> {
 }
 
 impl Frame<'_> {
-    /// The representation called `name`, if rendered.
-    pub fn repr(&self, name: &str) -> Option<&ReprFrame<'_>> {
-        self.reprs.iter().find(|r| r.name == name)
+    /// The representation of `kind`, if rendered.
+    pub fn repr(&self, kind: ReprKind) -> Option<&ReprFrame<'_>> {
+        self.reprs.iter().find(|r| r.kind == kind)
     }
 }
 
-/// Runs `reprs` (name, config; each with its mask from `masks`, `None` for none) over `events`
+/// Runs `reprs` (each with its mask from `masks`, `None` for none) over `events`
 /// (cropped to [`CROP`], time order) and calls `visit` with every frame of `timing`, in order.
 /// Stops at `visit`'s first error and returns it.
 pub fn for_each_frame(
     events: &[Event],
-    reprs: &[(&str, ReprConfig)],
+    reprs: &[ReprConfig],
     masks: &[Option<&Mask>],
     timing: &Timing,
     mut visit: impl FnMut(&Frame<'_>) -> Result<(), Error>,
 ) -> Result<(), Error> {
-    let configs: Vec<ReprConfig> = reprs.iter().map(|(_, c)| *c).collect();
-    let mut fx = FeatureExtractor::new_with_masks(&configs, CROP, masks)?;
+    let mut fx = FeatureExtractor::new_with_masks(reprs, CROP, masks)?;
     let samples: Vec<i64> = (0..timing.count).map(|k| timing.end_us(k)).collect();
     // Events before the range still build up the representations' state (the static
     // accumulator and the dynamic window), as they would live.
@@ -153,8 +152,8 @@ pub fn for_each_frame(
             reprs: reprs
                 .iter()
                 .enumerate()
-                .map(|(i, (name, _))| ReprFrame {
-                    name,
+                .map(|(i, config)| ReprFrame {
+                    kind: config.kind(),
                     frame: fx.frame(i),
                     features: fx.features(i),
                 })

@@ -22,7 +22,7 @@ fn palette() -> &'static [[u8; 3]] {
     static PALETTE: OnceLock<Vec<[u8; 3]>> = OnceLock::new();
     PALETTE.get_or_init(|| {
         let mut p = vec![[0, 0, 0], [255, 255, 255]];
-        let curves = ["Static", "Dynamic", "Combined"].map(crate::plots::repr_color);
+        let curves = evtac_repr::ReprKind::PAPER.map(crate::plots::repr_color);
         for c in [ON, OFF, BOTH].into_iter().chain(curves) {
             p.push([c.0, c.1, c.2]);
         }

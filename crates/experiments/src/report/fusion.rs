@@ -8,9 +8,9 @@
 
 use std::fmt::Write as _;
 
-use crate::exp1::FUSIONS;
 use crate::exp2::SETTINGS;
 use crate::results::{MeanStd, Results};
+use evtac_repr::ReprKind;
 
 /// Whether `fusion` beats `reference` (test MAE, lower is better) beyond the seeds' spread.
 fn beats(fusion: &MeanStd, reference: &MeanStd) -> bool {
@@ -34,22 +34,27 @@ fn compare(fusion: &MeanStd, reference: &MeanStd) -> String {
     }
 }
 
-/// The lower-MAE one of `Static` and `Dynamic` among `(name, stats)`.
-fn best_single<'a>(cells: &[(&'a str, MeanStd)]) -> Option<(&'a str, MeanStd)> {
+/// The lower-MAE one of `Static` and `Dynamic` among `(kind, stats)`.
+fn best_single(cells: &[(ReprKind, MeanStd)]) -> Option<(ReprKind, MeanStd)> {
     cells
         .iter()
-        .filter(|(n, _)| *n == "Static" || *n == "Dynamic")
+        .filter(|(n, _)| matches!(n, ReprKind::Static | ReprKind::Dynamic))
         .min_by(|a, b| a.1.mean.total_cmp(&b.1.mean))
         .copied()
 }
 
 /// One line per fusion against the best single representation among `cells`; the wins
 /// (`where_`, fusion, by how many degrees) are added to `wins`.
-fn against_best(md: &mut String, where_: &str, cells: &[(&str, MeanStd)], wins: &mut Vec<String>) {
+fn against_best(
+    md: &mut String,
+    where_: &str,
+    cells: &[(ReprKind, MeanStd)],
+    wins: &mut Vec<String>,
+) {
     let Some((best, best_stats)) = best_single(cells) else {
         return;
     };
-    for fusion in FUSIONS {
+    for fusion in ReprKind::FUSIONS {
         let Some((_, f)) = cells.iter().find(|(n, _)| *n == fusion) else {
             continue;
         };
@@ -72,7 +77,7 @@ fn against_best(md: &mut String, where_: &str, cells: &[(&str, MeanStd)], wins: 
 
 /// The section, or nothing when the run trained no learned fusion.
 pub(super) fn section(md: &mut String, r: &Results) {
-    if !r.exp1.iter().any(|e| FUSIONS.contains(&e.name.as_str())) {
+    if !r.exp1.iter().any(|e| e.name.is_fusion()) {
         return;
     }
     let _ = writeln!(md, "## Beyond OR: learned fusion\n");
@@ -88,29 +93,25 @@ pub(super) fn section(md: &mut String, r: &Results) {
     );
     let mut lines = String::new();
     let mut wins = Vec::new();
-    let exp1: Vec<(&str, MeanStd)> = r
-        .exp1
-        .iter()
-        .map(|e| (e.name.as_str(), e.test.overall))
-        .collect();
+    let exp1: Vec<(ReprKind, MeanStd)> = r.exp1.iter().map(|e| (e.name, e.test.overall)).collect();
     against_best(&mut lines, "Experiment 1", &exp1, &mut wins);
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
     for level in levels.into_iter().filter(|&l| l != 1.0) {
-        let cells: Vec<(&str, MeanStd)> = r
+        let cells: Vec<(ReprKind, MeanStd)> = r
             .noise
             .iter()
             .filter(|p| p.level == level)
-            .map(|p| (p.name.as_str(), p.test.overall))
+            .map(|p| (p.name, p.test.overall))
             .collect();
         against_best(&mut lines, &format!("noise x{level}"), &cells, &mut wins);
     }
     // Experiment 2 under the pause-inclusive setting: static's stop, dynamic's motion.
     let (key, label) = SETTINGS[SETTINGS.len() - 1];
-    let cell = |name: &str| r.exp2.iter().find(|c| c.setting == key && c.name == name);
-    if let (Some(st), Some(dy)) = (cell("Static"), cell("Dynamic")) {
-        for fusion in FUSIONS {
+    let cell = |kind: ReprKind| r.exp2.iter().find(|c| c.setting == key && c.name == kind);
+    if let (Some(st), Some(dy)) = (cell(ReprKind::Static), cell(ReprKind::Dynamic)) {
+        for fusion in ReprKind::FUSIONS {
             let Some(f) = cell(fusion) else { continue };
             let _ = writeln!(
                 lines,
@@ -165,11 +166,11 @@ mod tests {
         assert!(compare(&ms(0.30, 0.01), &ms(0.20, 0.01)).starts_with("is worse by 0.100 deg"));
         assert!(compare(&ms(0.21, 0.01), &ms(0.20, 0.01)).starts_with("ties (+0.010 deg"));
         let cells = [
-            ("Static", ms(0.2, 0.0)),
-            ("Dynamic", ms(0.1, 0.0)),
-            ("Late", ms(0.05, 0.0)),
+            (ReprKind::Static, ms(0.2, 0.0)),
+            (ReprKind::Dynamic, ms(0.1, 0.0)),
+            (ReprKind::Late, ms(0.05, 0.0)),
         ];
-        assert_eq!(best_single(&cells).map(|b| b.0), Some("Dynamic"));
+        assert_eq!(best_single(&cells).map(|b| b.0), Some(ReprKind::Dynamic));
         let (mut md, mut wins) = (String::new(), Vec::new());
         against_best(&mut md, "Experiment 1", &cells, &mut wins);
         assert_eq!(wins, ["Late at Experiment 1 (by 0.050 deg)"]);
