@@ -1,6 +1,6 @@
 //! Progress bars on stderr, shown only when stderr is a terminal (so logs and CI stay clean).
 
-use evtac_experiments::jobs::Progress;
+use evtac_experiments::progress::Progress;
 use evtac_experiments::stage::Stage;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;

@@ -4,7 +4,7 @@
 use crate::common::{run_err, run_ok};
 use evtac_experiments::choices;
 use evtac_experiments::plan::Plan;
-use evtac_experiments::report::{CHOICES_TITLE, FIGURES};
+use evtac_report::{CHOICES_TITLE, FIGURES};
 use evtac_sim::{Scale, SimParams};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

@@ -3,9 +3,10 @@
 //!
 //! `cargo run -p evtac-experiments --example reproduce -- small OUT_DIR [SEED]`
 
-use evtac_experiments::jobs::{self, Quiet};
+use evtac_experiments::jobs;
 use evtac_experiments::pipeline::{Datasets, reproduce};
 use evtac_experiments::plan::Plan;
+use evtac_experiments::progress::Quiet;
 use evtac_sim::{DatasetConfig, Protocol, Scale, simulate_dataset};
 use std::path::PathBuf;
 use std::time::Instant;

@@ -17,7 +17,6 @@
 
 use crate::dataset::{self, Dataset};
 use crate::sampling::{Phase, SampleTime, Sampling};
-use evtac_events::Event;
 use evtac_events::IoError;
 use evtac_events::layout::CACHE_DIR;
 use evtac_events::manifest::TrialMeta;
@@ -130,7 +129,7 @@ pub struct CacheStats {
 #[derive(Debug)]
 pub struct FeatureCache<'a> {
     ds: &'a Dataset,
-    no_contact: Option<Vec<Event>>,
+    no_contact: Option<crate::dataset::NoContact>,
     masks: std::sync::Mutex<HashMap<String, Option<Mask>>>,
 }
 
@@ -148,7 +147,7 @@ impl<'a> FeatureCache<'a> {
     pub fn new(ds: &'a Dataset) -> Result<Self, Error> {
         Ok(Self {
             ds,
-            no_contact: ds.no_contact_events()?,
+            no_contact: ds.no_contact()?,
             masks: std::sync::Mutex::new(HashMap::new()),
         })
     }
@@ -166,7 +165,7 @@ impl<'a> FeatureCache<'a> {
         {
             return Ok(m.clone());
         }
-        let mask = self.ds.mask_for(config, self.no_contact.as_deref())?;
+        let mask = self.ds.mask_for(config, self.no_contact.as_ref())?;
         if let Ok(mut map) = self.masks.lock() {
             map.insert(key, mask.clone());
         }

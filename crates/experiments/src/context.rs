@@ -3,8 +3,8 @@
 //! so their signatures say what differs between them (the dataset, the representations) and
 //! nothing else.
 
-use crate::jobs::Progress;
 use crate::plan::Plan;
+use crate::progress::Progress;
 use std::path::Path;
 
 /// The settings every experiment of a run shares.

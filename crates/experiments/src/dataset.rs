@@ -144,7 +144,31 @@ fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
 pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
     let (sensor, events) = read_full(path)?;
     let roi = crop_of(sensor, path)?;
-    Ok(events.into_iter().filter_map(|e| roi.map(e)).collect())
+    let mut cropped = Vec::with_capacity(events.len());
+    roi.crop_into(&events, &mut cropped);
+    Ok(cropped)
+}
+
+/// A dataset's no-contact recording as read once for every config's mask: its events on the
+/// full sensor, and the centered [`CROP`] the masks are built on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoContact {
+    /// The sensor's size.
+    pub sensor: Resolution,
+    /// The crop the masks cover.
+    pub roi: Roi,
+    /// The events, sensor coordinates, time order.
+    pub events: Vec<Event>,
+}
+
+impl NoContact {
+    /// How many of the events fall inside the crop (the background the representations see).
+    pub fn events_in_crop(&self) -> usize {
+        self.events
+            .iter()
+            .filter(|&&e| self.roi.map(e).is_some())
+            .count()
+    }
 }
 
 impl Dataset {
@@ -298,13 +322,19 @@ impl Dataset {
         read_cropped(&self.dir.join(&meta.file))
     }
 
-    /// The no-contact recording's events cropped to [`CROP`], or `None` when the dataset was
-    /// opened without a mask.
-    pub fn no_contact_events(&self) -> Result<Option<Vec<Event>>, Error> {
-        match self.inputs.mask {
-            MaskSource::NoContact => read_cropped(&self.dir.join(NO_CONTACT_FILE)).map(Some),
-            MaskSource::Unmasked => Ok(None),
+    /// The no-contact recording, or `None` when the dataset was opened without a mask.
+    pub fn no_contact(&self) -> Result<Option<NoContact>, Error> {
+        if self.inputs.mask == MaskSource::Unmasked {
+            return Ok(None);
         }
+        let path = self.dir.join(NO_CONTACT_FILE);
+        let (sensor, events) = read_full(&path)?;
+        let roi = crop_of(sensor, &path)?;
+        Ok(Some(NoContact {
+            sensor,
+            roi,
+            events,
+        }))
     }
 
     /// The no-contact mask for `config` (built with its static part's settings: evtac's choice,
@@ -313,12 +343,12 @@ impl Dataset {
     pub fn mask_for(
         &self,
         config: &ReprConfig,
-        no_contact: Option<&[Event]>,
+        no_contact: Option<&NoContact>,
     ) -> Result<Option<Mask>, Error> {
-        let (Some(s), Some(events)) = (config.static_part(), no_contact) else {
+        let (Some(s), Some(no_contact)) = (config.static_part(), no_contact) else {
             return Ok(None);
         };
-        Mask::from_no_contact(CROP, s, events)
+        Mask::from_recording(&no_contact.roi, s, &no_contact.events)
             .map(Some)
             .map_err(|source| Error::Mask {
                 path: self.dir.join(NO_CONTACT_FILE),

@@ -4,8 +4,9 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
-use crate::jobs::{self, Progress};
+use crate::jobs;
 use crate::plan::Plan;
+use crate::progress::Progress;
 use crate::results::{Exp1Repr, Mae, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};

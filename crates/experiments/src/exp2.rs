@@ -7,7 +7,7 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::exp1::{self, SeedJob};
 use crate::plan::Plan;
-use crate::results::{Exp2Cell, MaeStats};
+use crate::results::{Exp2Cell, Exp2Setting, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
@@ -16,17 +16,10 @@ use evtac_learn::Model;
 use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 
-/// The training settings: file name and label in the report.
-pub const SETTINGS: [(&str, &str); 3] = [
-    ("continuous-only", "Continuous-only"),
-    ("pause-motion", "Pause-inclusive (motion only)"),
-    ("pause-motion-stop", "Pause-inclusive (motion + stop)"),
-];
-
 /// The folder of one Experiment 2 model.
-pub fn model_dir(out: &Path, setting: &str, kind: ReprKind, seed: u64) -> PathBuf {
+pub fn model_dir(out: &Path, setting: Exp2Setting, kind: ReprKind, seed: u64) -> PathBuf {
     out.join("exp2")
-        .join(setting)
+        .join(setting.key())
         .join(kind.name())
         .join(format!("seed{seed}"))
 }
@@ -36,8 +29,11 @@ pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<See
     let seeds = exp1::seeds(seed, plan.exp2_seeds);
     let mut v = Vec::new();
     for (setting, phases) in [
-        (SETTINGS[1].0, vec![Phase::Motion]),
-        (SETTINGS[2].0, vec![Phase::Motion, Phase::Stop]),
+        (Exp2Setting::PauseMotion, vec![Phase::Motion]),
+        (
+            Exp2Setting::PauseMotionStop,
+            vec![Phase::Motion, Phase::Stop],
+        ),
     ] {
         let train = (plan.epochs, Sampling::WITH_STOP, phases.as_slice());
         v.extend(exp1::seed_jobs(reprs, &seeds, train, |name, s| {
@@ -61,7 +57,7 @@ pub fn run(
     let sampling = Sampling::WITH_STOP;
     exp1::features_then_training(cache, splits, reprs, sampling, stages, &jobs, progress)?;
     let mut cells = Vec::new();
-    for (setting, _) in SETTINGS {
+    for setting in Exp2Setting::ALL {
         for &config in reprs {
             let name = config.kind();
             let test = training::load_split(
@@ -72,7 +68,7 @@ pub fn run(
                 Sampling::WITH_STOP,
                 &[Phase::Motion, Phase::Stop],
             )?;
-            let models: Vec<Model> = if setting == SETTINGS[0].0 {
+            let models: Vec<Model> = if setting == Exp2Setting::ContinuousOnly {
                 exp1::models(out, name, seed, plan.seeds)?
             } else {
                 exp1::seeds(seed, plan.exp2_seeds)
@@ -87,7 +83,7 @@ pub fn run(
                 stop.push(training::mae_in(&test, &pred, Some(Phase::Stop)));
             }
             cells.push(Exp2Cell {
-                setting: setting.into(),
+                setting,
                 name,
                 motion: MaeStats::of(&motion),
                 stop: MaeStats::of(&stop),

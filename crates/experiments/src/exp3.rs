@@ -2,7 +2,7 @@
 //! speed and per depth, with seen (training) and unseen (interpolated) values marked.
 
 use crate::cache::FeatureCache;
-use crate::jobs::Progress;
+use crate::progress::Progress;
 use crate::results::{Exp3Point, MaeStats};
 use crate::sampling::{Phase, Sampling};
 use crate::stage::{FeatureSet, Stage};

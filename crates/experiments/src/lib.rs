@@ -1,6 +1,7 @@
 //! The paper's experiments on datasets of trials: splits, sampling, feature caches, training
-//! jobs, Experiments 1-3, the latency study, and the report with its figures. Where the paper
-//! states no value evtac chose one; [`choices`] lists them all, with the value used.
+//! jobs, Experiments 1-3 and the latency study, and their [`results`]. Where the paper states no
+//! value evtac chose one; [`choices`] lists them all, with the value used. The report, its
+//! figures and rendered recordings are `evtac-report`'s, which reads [`results::Results`].
 //!
 //! - [`dataset`]: a dataset folder (`trials.csv`, recordings, `calibration.json`,
 //!   `no_contact.aedat4`, `labels/`), labels computed when missing, opened with
@@ -14,20 +15,21 @@
 //!   computed in one pass for many configs, reused.
 //! - [`context`]: the plan, seed, model folder and progress an experiment run shares.
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
-//!   [`stage`]s and what each is expected to cost (for progress bars with an ETA).
+//!   [`stage`]s and what each is expected to cost (for progress bars with an ETA), reported
+//!   through [`progress`].
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`latency`] and the crate's own `noise`, `exp2`, `exp3` and
 //!   `examples`: the experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and
 //!   [`sensor_view`] (the sensor at rest and in contact) the data of two illustrative figures;
 //!   [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm cluster);
-//!   [`results`], [`report`] and [`plots`] write `report.md`, `results.json` and the PNG
-//!   figures; [`choices`] lists the values evtac chose where the paper states none.
+//!   [`results`] is what they measured, as plain typed data (it imports nothing from the
+//!   experiments); [`choices`] lists the values evtac chose where the paper states none.
 //!
 //! Modules that only the pipeline calls (`noise`, `exp2`, `exp3`, `examples`, `label_check`)
 //! are private: their results are in [`results`], their errors in [`pipeline::Error`].
 //!
 //! ```no_run
-//! use evtac_experiments::jobs::Quiet;
+//! use evtac_experiments::progress::Quiet;
 //! use evtac_experiments::pipeline::{Datasets, reproduce};
 //! use evtac_experiments::plan::Plan;
 //! use evtac_experiments::stage_log::StageLog;
@@ -48,6 +50,7 @@ pub mod cache;
 pub mod choices;
 pub mod context;
 pub mod dataset;
+mod error;
 mod examples;
 pub mod exp1;
 mod exp2;
@@ -58,9 +61,7 @@ pub mod latency;
 mod noise;
 pub mod pipeline;
 pub mod plan;
-pub mod plots;
-pub mod render;
-pub mod report;
+pub mod progress;
 pub mod repr_example;
 pub mod results;
 pub mod sampling;

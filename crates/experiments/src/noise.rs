@@ -13,30 +13,13 @@
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::{Dataset, Simulated};
+use crate::error::Error;
 use crate::exp1;
 use crate::jobs;
-use crate::pipeline::Error;
 use crate::results::{Exp1Repr, NoisePoint};
 use crate::stage::{FeatureSet, Stage};
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
-
-/// Each factor of `levels` once, in the order given.
-fn unique(levels: &[f64]) -> Vec<f64> {
-    let mut out: Vec<f64> = Vec::new();
-    for &l in levels {
-        if !out.contains(&l) {
-            out.push(l);
-        }
-    }
-    out
-}
-
-/// The factors that need their own dataset: every one but 1 (Experiment 1's), each once, in
-/// the order given.
-pub fn simulated_levels(levels: &[f64]) -> Vec<f64> {
-    unique(levels).into_iter().filter(|&l| l != 1.0).collect()
-}
 
 /// The dataset folder of factor `level` under the run's output folder.
 pub fn dataset_dir(out: &Path, level: f64) -> PathBuf {
@@ -69,7 +52,7 @@ fn simulate(sim: &Simulated, level: f64, dir: &Path, run: &RunContext<'_>) -> Re
 
 /// Events per second in the crop of `ds`'s no-contact recording, which lasts `seconds`.
 fn background_rate(ds: &Dataset, seconds: f64) -> Result<f64, Error> {
-    let n = ds.no_contact_events()?.map_or(0, |e| e.len());
+    let n = ds.no_contact()?.map_or(0, |nc| nc.events_in_crop());
     Ok(if seconds > 0.0 {
         n as f64 / seconds
     } else {
@@ -105,7 +88,7 @@ pub fn run(
     };
     let seconds = sim.params.timeline.no_contact_s;
     let mut all = Vec::new();
-    for level in unique(&run.plan.noise_levels) {
+    for level in run.plan.unique_noise_levels() {
         if level == 1.0 {
             all.extend(points(level, background_rate(ds1, seconds)?, e1));
             continue;
@@ -135,11 +118,19 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plan::Plan;
 
     #[test]
     fn factor_one_is_experiment_1_and_repeats_count_once() {
-        assert_eq!(simulated_levels(&[0.0, 1.0, 3.0, 0.0]), vec![0.0, 3.0]);
-        assert!(simulated_levels(&[1.0]).is_empty());
+        let plan = |noise_levels: &[f64]| Plan {
+            noise_levels: noise_levels.to_vec(),
+            ..Plan::for_scale(evtac_sim::Scale::Tiny)
+        };
+        assert_eq!(
+            plan(&[0.0, 1.0, 3.0, 0.0]).simulated_noise_levels(),
+            [0.0, 3.0]
+        );
+        assert!(plan(&[1.0]).simulated_noise_levels().is_empty());
         assert_eq!(
             dataset_dir(Path::new("out"), 0.5),
             Path::new("out/noise/x0.5")

@@ -4,11 +4,12 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
-use crate::dataset::{self, Dataset};
+use crate::dataset::Dataset;
 use crate::exp3::Axis;
-use crate::jobs::{self, Progress};
+use crate::jobs;
 use crate::plan::Plan;
-use crate::results::{Results, RunInfo};
+use crate::progress::Progress;
+use crate::results::{Exp2Setting, Results, RunInfo};
 use crate::sampling::Sampling;
 use crate::splits::Split;
 use crate::stage::Stage;
@@ -16,8 +17,7 @@ use crate::stage_log::StageLog;
 use crate::training::{self, TrainSpec};
 use crate::tuning::{self, Kind};
 use crate::{
-    choices, examples, exp1, exp2, exp3, label_check, latency, noise, report, repr_example,
-    sensor_view,
+    choices, examples, exp1, exp2, exp3, label_check, latency, noise, repr_example, sensor_view,
 };
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
@@ -25,42 +25,7 @@ use evtac_repr::{ReprConfig, ReprKind};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Errors of a reproduction.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum Error {
-    /// A dataset could not be opened.
-    #[error(transparent)]
-    Dataset(#[from] dataset::Error),
-    /// Features, training or evaluation failed.
-    #[error(transparent)]
-    Training(#[from] training::Error),
-    /// The latency study failed.
-    #[error(transparent)]
-    Latency(#[from] latency::Error),
-    /// The report could not be written.
-    #[error(transparent)]
-    Report(#[from] report::Error),
-    /// The feature cache failed.
-    #[error(transparent)]
-    Cache(#[from] crate::cache::Error),
-    /// A dataset could not be simulated.
-    #[error("simulating {protocol} into {dir}: {source}")]
-    Simulation {
-        /// The protocol.
-        protocol: evtac_sim::Protocol,
-        /// The dataset folder.
-        dir: PathBuf,
-        /// The cause (boxed: it is large, and rare).
-        source: Box<evtac_sim::DatasetError>,
-    },
-    /// The `done` marker of a simulated dataset could not be written.
-    #[error(transparent)]
-    Jobs(#[from] jobs::Error),
-    /// The log of stage times (`stage-times.csv`) could not be read or appended to.
-    #[error(transparent)]
-    StageLog(#[from] crate::stage_log::Error),
-}
+pub use crate::error::Error;
 
 /// The datasets of a reproduction (Experiment 1 is required).
 #[derive(Debug, Clone, PartialEq)]
@@ -147,9 +112,10 @@ impl Stages<'_> {
     }
 }
 
-/// Runs the whole protocol on `data` and writes the report into `out`. Each stage's time is
-/// appended to `log` (the output folder's, opened by this invocation) as it finishes; the
-/// report tables every invocation's.
+/// Runs the whole protocol on `data`, with its models and datasets in `out`, and returns what
+/// it measured (`evtac_report::write` turns that into the report). Each stage's time is
+/// appended to `log` (the output folder's, opened by this invocation) as it finishes, and is in
+/// the results (this invocation's stages, and every invocation's from the log).
 pub fn reproduce(
     data: &Datasets,
     plan: &Plan,
@@ -211,7 +177,8 @@ pub fn reproduce(
                 .iter()
                 .map(|config| {
                     let kind = config.kind();
-                    training::load_model(&exp2::model_dir(&models, exp2::SETTINGS[2].0, kind, seed))
+                    let setting = Exp2Setting::PauseMotionStop;
+                    training::load_model(&exp2::model_dir(&models, setting, kind, seed))
                         .map(|m| (kind, m))
                 })
                 .collect::<Result<_, _>>()?;
@@ -317,10 +284,6 @@ pub fn reproduce(
         repr_example,
         sensor,
     };
-    results.run.stage_seconds = stages.list.clone();
-    results.run.stage_history = log.records();
-    report::write(out, &results)?;
-    stages.done("report")?;
     results.run.stage_seconds = stages.list;
     results.run.stage_history = log.records();
     Ok(results)

@@ -14,6 +14,30 @@ use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use evtac_sim::Scale;
 use serde::{Deserialize, Serialize};
 
+/// Which representation a grid search tunes (the plan has a grid for each).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Decay tau x threshold.
+    Static,
+    /// Window x threshold.
+    Dynamic,
+}
+
+impl Kind {
+    /// The representation tuned.
+    pub fn repr(self) -> ReprKind {
+        match self {
+            Kind::Static => ReprKind::Static,
+            Kind::Dynamic => ReprKind::Dynamic,
+        }
+    }
+
+    /// `static` or `dynamic`.
+    pub fn name(self) -> &'static str {
+        self.repr().name()
+    }
+}
+
 /// The settings of one reproduction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
@@ -128,6 +152,25 @@ impl Plan {
         } else {
             ReprKind::PAPER.len()
         }
+    }
+
+    /// Each noise factor once, in the order given.
+    pub fn unique_noise_levels(&self) -> Vec<f64> {
+        let mut out: Vec<f64> = Vec::new();
+        for &l in &self.noise_levels {
+            if !out.contains(&l) {
+                out.push(l);
+            }
+        }
+        out
+    }
+
+    /// The noise factors that need their own dataset: every one but 1 (Experiment 1's), each
+    /// once, in the order given.
+    pub fn simulated_noise_levels(&self) -> Vec<f64> {
+        let mut levels = self.unique_noise_levels();
+        levels.retain(|&l| l != 1.0);
+        levels
     }
 
     /// The static grid as (tau, threshold) pairs, in a fixed order.

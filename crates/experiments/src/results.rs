@@ -169,11 +169,51 @@ pub struct NoisePoint {
     pub test: MaeStats,
 }
 
+/// Experiment 2's training settings, in the report's order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Exp2Setting {
+    /// Experiment 1's models: trained on the continuous-motion dataset.
+    ContinuousOnly,
+    /// Trained on the pause dataset's motion samples.
+    PauseMotion,
+    /// Trained on the pause dataset's motion and stop samples.
+    PauseMotionStop,
+}
+
+impl Exp2Setting {
+    /// Every setting, in the report's order.
+    pub const ALL: [Self; 3] = [
+        Self::ContinuousOnly,
+        Self::PauseMotion,
+        Self::PauseMotionStop,
+    ];
+
+    /// The name in `results.json` and in model folders: `continuous-only`, `pause-motion`,
+    /// `pause-motion-stop`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::ContinuousOnly => "continuous-only",
+            Self::PauseMotion => "pause-motion",
+            Self::PauseMotionStop => "pause-motion-stop",
+        }
+    }
+
+    /// The label in the report's table and figure.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::ContinuousOnly => "Continuous-only",
+            Self::PauseMotion => "Pause-inclusive (motion only)",
+            Self::PauseMotionStop => "Pause-inclusive (motion + stop)",
+        }
+    }
+}
+
 /// Experiment 2 for one (training setting, representation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Exp2Cell {
-    /// `continuous-only`, `pause-motion` or `pause-motion-stop`.
-    pub setting: String,
+    /// The training setting.
+    pub setting: Exp2Setting,
     /// The representation.
     pub name: ReprKind,
     /// Motion-phase test MAE per seed.

@@ -22,9 +22,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use crate::jobs::{self, Progress};
+use crate::jobs;
 use crate::pipeline::{self, Datasets};
 use crate::plan::Plan;
+use crate::progress::Progress;
 use crate::stage::{PROTOCOLS, Stage};
 use evtac_events::IoError;
 use evtac_import::inputs::Inputs;

@@ -1,12 +1,11 @@
 //! The stages of a reproduction, and what each is expected to cost.
 //!
-//! The library reports its progress stage by stage ([`crate::jobs::Progress`]); a front end
+//! The library reports its progress stage by stage ([`crate::progress::Progress`]); a front end
 //! shows a bar per stage and, with [`CostModel`], an overall bar whose ETA covers the whole run.
 //! The costs are reference figures from the 2-core development machine: they only weigh the
 //! stages against each other, so the ETA follows the actual machine's pace.
 
-use crate::plan::Plan;
-use crate::tuning::Kind;
+use crate::plan::{Kind, Plan};
 use evtac_events::manifest::Manifest;
 use evtac_sim::{DatasetConfig, Protocol, Scale};
 use std::path::Path;
@@ -211,11 +210,11 @@ impl CostModel {
         if counts.exp2 > 0 {
             sum += c(
                 Stage::Exp2Training,
-                crate::exp2::SETTINGS.len() * reprs * plan.exp2_seeds,
+                crate::results::Exp2Setting::ALL.len() * reprs * plan.exp2_seeds,
             );
         }
         // Every noise level but Experiment 1's own: a dataset, its features and the runs.
-        let levels = crate::noise::simulated_levels(&plan.noise_levels).len();
+        let levels = plan.simulated_noise_levels().len();
         sum += levels as f64
             * (c(Stage::NoiseSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::Noise), counts.exp1)

@@ -12,32 +12,10 @@ use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
 use crate::training::{self, Error, TrainSpec};
 use evtac_learn::ModelBundle;
-use evtac_repr::{ReprConfig, ReprKind};
+use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 
-/// Which representation is tuned.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Kind {
-    /// Decay tau x threshold.
-    Static,
-    /// Window x threshold.
-    Dynamic,
-}
-
-impl Kind {
-    /// The representation tuned.
-    pub fn repr(self) -> ReprKind {
-        match self {
-            Kind::Static => ReprKind::Static,
-            Kind::Dynamic => ReprKind::Dynamic,
-        }
-    }
-
-    /// `static` or `dynamic`.
-    pub fn name(self) -> &'static str {
-        self.repr().name()
-    }
-}
+pub use crate::plan::Kind;
 
 /// One grid point: its (time, threshold) and config.
 #[derive(Debug, Clone, PartialEq)]

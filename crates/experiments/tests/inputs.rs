@@ -26,10 +26,14 @@ fn missing_files_are_refused_unless_opted_out() {
         Calibration::default(),
         "the simulator rotates its IMU"
     );
-    let events = ds.no_contact_events().unwrap();
-    assert!(events.as_ref().is_some_and(|e| !e.is_empty()));
+    let no_contact = ds.no_contact().unwrap();
     assert!(
-        ds.mask_for(&static_config, events.as_deref())
+        no_contact
+            .as_ref()
+            .is_some_and(|nc| nc.events_in_crop() > 0)
+    );
+    assert!(
+        ds.mask_for(&static_config, no_contact.as_ref())
             .unwrap()
             .is_some()
     );
@@ -38,7 +42,7 @@ fn missing_files_are_refused_unless_opted_out() {
     let out = Inputs::from_flags(true, true);
     let ds = Dataset::open(dir.path(), out).unwrap();
     assert_eq!(ds.calibration, Calibration::default());
-    assert!(ds.no_contact_events().unwrap().is_none());
+    assert!(ds.no_contact().unwrap().is_none());
 
     std::fs::remove_file(dir.path().join(CALIBRATION_FILE)).unwrap();
     let err = Dataset::open(dir.path(), Inputs::FROM_FILES)
@@ -52,14 +56,14 @@ fn missing_files_are_refused_unless_opted_out() {
     };
     let ds = Dataset::open(dir.path(), identity).unwrap();
     assert_eq!(ds.calibration, Calibration::default());
-    assert!(ds.no_contact_events().unwrap().is_some());
+    assert!(ds.no_contact().unwrap().is_some());
 
     std::fs::remove_file(dir.path().join(NO_CONTACT_FILE)).unwrap();
     let err = Dataset::open(dir.path(), identity).unwrap_err().to_string();
     assert!(err.contains(NO_CONTACT_FILE), "{err}");
     assert!(err.contains("--no-mask"), "{err}");
     let ds = Dataset::open(dir.path(), out).unwrap();
-    assert!(ds.no_contact_events().unwrap().is_none());
+    assert!(ds.no_contact().unwrap().is_none());
     assert!(ds.mask_for(&static_config, None).unwrap().is_none());
 }
 

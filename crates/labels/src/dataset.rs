@@ -23,9 +23,7 @@ pub fn labels_path(dataset_dir: impl AsRef<Path>, trial: &str) -> PathBuf {
         .join(format!("{trial}.csv"))
 }
 
-/// The command-line flag (without its dashes) that labels with the identity rotation instead of
-/// a dataset's `calibration.json`; errors about a missing calibration name it.
-pub const IDENTITY_CALIBRATION_FLAG: &str = "identity-calibration";
+pub use crate::error::IDENTITY_CALIBRATION_FLAG;
 
 /// Where a dataset's IMU-to-sensor rotation comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -15,6 +15,10 @@ use crate::scale::ScaleError;
 use crate::series::SeriesError;
 use crate::validation::ValidationError;
 
+/// The command-line flag (without its dashes) that labels with the identity rotation instead of
+/// a dataset's `calibration.json`; errors about a missing calibration name it.
+pub const IDENTITY_CALIBRATION_FLAG: &str = "identity-calibration";
+
 /// Why one trial could not be labelled.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -90,7 +94,7 @@ pub enum Error {
     #[error(
         "{path} is missing: add the IMU-to-sensor rotation there, or pass --{flag} to label \
          with the identity rotation",
-        flag = crate::dataset::IDENTITY_CALIBRATION_FLAG
+        flag = IDENTITY_CALIBRATION_FLAG
     )]
     MissingCalibration {
         /// The file that is missing.

@@ -9,7 +9,7 @@
 //!
 //! - the first layer's forward pass visits only each sample's non-zero features, or, when most
 //!   features are non-zero (dynamic and combined representations), reads each weight row once
-//!   for four samples ([`GROUPED_DENSITY`]);
+//!   for four samples ([`crate::panels::GROUPED_DENSITY`]);
 //! - its weight gradient is built row by row from the batch's non-zeros (a column-major index
 //!   built once per step) and handed straight to AdamW, so the 900 x 256 gradient is never
 //!   stored and rows no sample reached take the zero-gradient update;
@@ -202,13 +202,6 @@ impl Scratch {
     }
 }
 
-/// Above this fraction of non-zero features in a batch, the first layer's forward pass reads
-/// each weight row once for a group of samples ([`panels::grouped_forward`]) instead of once
-/// per sample over its non-zeros ([`panels::sparse_forward`]). Measured (`benches/training.rs`):
-/// at 75 % non-zero (dynamic, combined) a step takes 274 us grouped against 372 us, at 14 %
-/// (static) 214 us against 184 us. The choice depends on the batch only, so it is reproducible.
-pub(crate) const GROUPED_DENSITY: f64 = 0.35;
-
 /// The most samples one step takes (sample numbers are stored as u16).
 pub(crate) const MAX_BATCH: usize = u16::MAX as usize;
 
@@ -236,7 +229,7 @@ pub(crate) fn step(
     let [h1, h2, h3, out] = &mut scratch.h;
     // Each block of the first layer from its inputs only (late fusion: a branch per frame).
     let blocks = net.architecture.first_layer_blocks();
-    if scratch.index.len() as f64 > GROUPED_DENSITY * x.len() as f64 {
+    if scratch.index.len() as f64 > crate::panels::GROUPED_DENSITY * x.len() as f64 {
         for (x, h) in x.chunks(GROUP * inputs).zip(h1.chunks_mut(GROUP * H1)) {
             let rows = x.len() / inputs;
             for block in blocks {

@@ -240,14 +240,8 @@ impl Representation {
                 return Err(error::value("give a mask or no-contact events, not both"));
             }
             (Some(pixels), None) => {
-                let (h, w) = pixels.as_array().dim();
-                if (h, w) != (usize::from(frame.height), usize::from(frame.width)) {
-                    return Err(error::value(format!(
-                        "the mask is {w}x{h} but the crop is {frame}"
-                    )));
-                }
                 let flat: Vec<u8> = pixels.as_array().iter().copied().collect();
-                Some(Mask::from_pixels(frame, &flat).map_err(error::value)?)
+                Some(Mask::from_grid(frame, pixels.as_array().dim(), &flat).map_err(error::value)?)
             }
             (None, Some(events)) => {
                 let Some(static_part) = config.static_part() else {
@@ -257,8 +251,13 @@ impl Representation {
                 };
                 let events = events.as_slice().map_err(error::value)?;
                 Some(py.detach(|| {
-                    let cropped = crop_events(sensor, &roi, events)?;
-                    Mask::from_no_contact(frame, static_part, &cropped).map_err(error::value)
+                    // Checked against the sensor, or against the crop when the events come
+                    // cropped already (cropping then keeps them all).
+                    let events = records::decode_events(events)?;
+                    EventCheck::new(Some(sensor.unwrap_or(frame)))
+                        .check(&events)
+                        .map_err(error::value)?;
+                    Mask::from_recording(&roi, static_part, &events).map_err(error::value)
                 })?)
             }
             (None, None) => None,

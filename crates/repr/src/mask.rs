@@ -14,7 +14,7 @@
 use crate::ReprError;
 use crate::accumulator::StaticAccumulator;
 use crate::config::StaticConfig;
-use evtac_events::{Event, Resolution};
+use evtac_events::{Event, Resolution, Roi};
 
 /// A per-pixel mask: masked pixels are forced to 0 in static binary frames (before the OR of
 /// the combined representation; dynamic frames are not masked, as in the paper).
@@ -49,6 +49,40 @@ impl Mask {
             resolution,
             pixels: pixels.iter().map(|&p| u8::from(p != 0)).collect(),
         })
+    }
+
+    /// A mask given as a `rows x cols` grid (row-major, non-zero = masked; e.g. a 2-D uint8 or
+    /// bool NPY) for the crop `frame`: an error naming both sizes when the grid is not the
+    /// crop's (a transposed mask has the right length but not the right shape).
+    pub fn from_grid(
+        frame: Resolution,
+        (rows, cols): (usize, usize),
+        pixels: &[u8],
+    ) -> Result<Self, ReprError> {
+        if (rows, cols) != (usize::from(frame.height), usize::from(frame.width)) {
+            let side = |n: usize| u16::try_from(n).unwrap_or(u16::MAX);
+            return Err(ReprError::MaskSize {
+                mask_width: side(cols),
+                mask_height: side(rows),
+                width: frame.width,
+                height: frame.height,
+            });
+        }
+        Self::from_pixels(frame, pixels)
+    }
+
+    /// The mask of a no-contact recording on the crop `roi` of its sensor: its events (sensor
+    /// coordinates, time order) cropped to `roi`, then [`Mask::from_no_contact`]. The one way
+    /// `evtac represent`, the experiments' datasets and the Python package build a mask from a
+    /// recording, so the three cannot crop differently.
+    pub fn from_recording(
+        roi: &Roi,
+        config: &StaticConfig,
+        events: &[Event],
+    ) -> Result<Self, ReprError> {
+        let mut cropped = Vec::with_capacity(events.len());
+        roi.crop_into(events, &mut cropped);
+        Self::from_no_contact(roi.size, config, &cropped)
     }
 
     /// The mask of a no-contact recording (events already cropped to `resolution`, in time

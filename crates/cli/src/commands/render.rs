@@ -1,5 +1,5 @@
 //! `evtac render`: what the sensor and the network see, as an animated GIF, an MP4 video
-//! (through an `ffmpeg` on the `PATH`) or a PNG contact sheet (`evtac_experiments::render`
+//! (through an `ffmpeg` on the `PATH`) or a PNG contact sheet (`evtac_report::render`
 //! draws and encodes).
 //!
 //! The input is a recording in any format evtac reads, or with `--trial` a dataset folder and
@@ -12,9 +12,9 @@
 
 use anyhow::Context;
 use evtac_experiments::dataset::{self, Dataset};
-use evtac_experiments::render::{self, Angles, Output, Panel, SHEET_DEFAULT_FRAMES, Scene, Timing};
 use evtac_labels::series::LabelSeries;
 use evtac_learn::Model;
+use evtac_report::render::{self, Angles, Output, Panel, SHEET_DEFAULT_FRAMES, Scene, Timing};
 use evtac_repr::{Mask, ReprConfig};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -135,12 +135,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .with_context(|| format!("opening the dataset {}", args.input.display()))?;
             let meta = ds.trial(trial)?;
             let events = ds.events(meta)?;
-            let no_contact = ds.no_contact_events()?;
+            let no_contact = ds.no_contact()?;
             let masks = reprs
                 .iter()
                 .map(|c| match model_mask(c) {
                     Some(m) => Ok(Some(m)),
-                    None => ds.mask_for(c, no_contact.as_deref()),
+                    None => ds.mask_for(c, no_contact.as_ref()),
                 })
                 .collect::<Result<_, _>>()?;
             if model.is_some() {

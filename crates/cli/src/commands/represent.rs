@@ -5,7 +5,7 @@
 //! in time order, to `evtac_repr::FeatureExtractor`. `--mask` takes either an `.npy` mask (uint8
 //! or bool, `height x width` of the crop, non-zero = masked) or a no-contact recording, which is
 //! cropped the same way and run through the same static accumulator settings
-//! (`evtac_repr::Mask::from_no_contact`: pixels whose 8-bit frame value differs from the neutral
+//! (`evtac_repr::Mask::from_recording`: pixels whose 8-bit frame value differs from the neutral
 //! level at the end of the recording).
 
 use anyhow::{Context, bail, ensure};
@@ -383,14 +383,9 @@ fn read_mask(
                 .with_context(|| format!("reading {} as a uint8 or bool 2-D mask", path.display()))?
                 .mapv(u8::from),
         };
-        let (h, w) = pixels.dim();
-        ensure!(
-            (h, w) == (usize::from(frame.height), usize::from(frame.width)),
-            "mask {} is {w}x{h} but the crop is {frame}",
-            path.display()
-        );
         let flat: Vec<u8> = pixels.iter().copied().collect();
-        return Ok(Mask::from_pixels(frame, &flat)?);
+        return Mask::from_grid(frame, pixels.dim(), &flat)
+            .with_context(|| format!("the mask {}", path.display()));
     }
     let Some(static_config) = config.static_part() else {
         bail!("--mask applies to the static part: it needs --repr static or combined");
@@ -398,8 +393,6 @@ fn read_mask(
     let (sensor, events) = read_events(path, args.resolution, &args.streams)
         .with_context(|| format!("reading the no-contact recording {}", path.display()))?;
     let roi = parse_roi(args.roi.as_deref(), sensor)?;
-    let mut cropped = Vec::new();
-    roi.crop_into(&events, &mut cropped);
-    Mask::from_no_contact(frame, static_config, &cropped)
+    Mask::from_recording(&roi, static_config, &events)
         .with_context(|| format!("building the no-contact mask from {}", path.display()))
 }

@@ -6,9 +6,9 @@
 
 use crate::progress::Bars;
 use anyhow::Context;
-use evtac_experiments::jobs::Progress;
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
+use evtac_experiments::progress::Progress;
 use evtac_experiments::slurm::{Reproduction, Slurm};
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
@@ -369,6 +369,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let results =
         pool.install(|| pipeline::reproduce(&data, &plan, args.seed, &args.out, &log, &bars))?;
+    // The report is the last stage, timed like the others (its own time is in the log, not in
+    // the report it writes).
+    let report_started = Instant::now();
+    evtac_report::write(&args.out, &results)?;
+    let seconds = report_started.elapsed().as_secs_f64();
+    bars.message(&format!("report: {seconds:.1} s"));
+    log.record("report", seconds)?;
     bars.finish();
     println!("{}", args.out.join("report.md").display());
     for e in &results.exp1 {

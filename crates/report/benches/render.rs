@@ -7,7 +7,7 @@
 
 use criterion::Criterion;
 use evtac_events::Event;
-use evtac_experiments::render::{self, Output, Panel, Scene, Timing};
+use evtac_report::render::{self, Output, Panel, Scene, Timing};
 use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,7 +1,7 @@
 //! The latency study's figure: latency distributions per representation and sampling interval.
 
 use super::*;
-use crate::results::LatencyCell;
+use evtac_experiments::results::LatencyCell;
 
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {

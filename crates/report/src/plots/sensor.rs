@@ -3,7 +3,7 @@
 
 use super::images::{draw_image, grey};
 use super::{Error, FAMILY, canvas, draw_err};
-use crate::results::{SensorKind, SensorView};
+use evtac_experiments::results::{SensorKind, SensorView};
 use evtac_repr::CROP;
 use plotters::prelude::*;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! contour overlays of binary frames under two conditions.
 
 use super::*;
-use crate::results::{ExampleTrial, Overlay};
+use evtac_experiments::results::{ExampleTrial, Overlay};
 
 /// An example pause trial: estimated and true pitch (left) and roll (right) over time, with the
 /// stop phase shaded.

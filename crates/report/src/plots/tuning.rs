@@ -2,7 +2,7 @@
 //! chosen value (the paper's tuning curves).
 
 use super::*;
-use crate::results::Tuning;
+use evtac_experiments::results::Tuning;
 
 /// One tuning panel: validation MAE against one parameter with the other fixed.
 struct Curve {

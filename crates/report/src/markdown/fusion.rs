@@ -8,8 +8,7 @@
 
 use std::fmt::Write as _;
 
-use crate::exp2::SETTINGS;
-use crate::results::{MeanStd, Results};
+use evtac_experiments::results::{Exp2Setting, MeanStd, Results};
 use evtac_repr::ReprKind;
 
 /// Whether `fusion` beats `reference` (test MAE, lower is better) beyond the seeds' spread.
@@ -108,8 +107,15 @@ pub(super) fn section(md: &mut String, r: &Results) {
         against_best(&mut lines, &format!("noise x{level}"), &cells, &mut wins);
     }
     // Experiment 2 under the pause-inclusive setting: static's stop, dynamic's motion.
-    let (key, label) = SETTINGS[SETTINGS.len() - 1];
-    let cell = |kind: ReprKind| r.exp2.iter().find(|c| c.setting == key && c.name == kind);
+    let (setting, label) = (
+        Exp2Setting::PauseMotionStop,
+        Exp2Setting::PauseMotionStop.label(),
+    );
+    let cell = |kind: ReprKind| {
+        r.exp2
+            .iter()
+            .find(|c| c.setting == setting && c.name == kind)
+    };
     if let (Some(st), Some(dy)) = (cell(ReprKind::Static), cell(ReprKind::Dynamic)) {
         for fusion in ReprKind::FUSIONS {
             let Some(f) = cell(fusion) else { continue };

@@ -10,7 +10,7 @@
 //! the output and renamed at the end, so a failed or interrupted render leaves no partial file.
 //!
 //! ```no_run
-//! use evtac_experiments::render::{self, Output, Panel, Scene, Timing};
+//! use evtac_report::render::{self, Output, Panel, Scene, Timing};
 //! use evtac_repr::{DynamicConfig, ReprConfig, StaticConfig};
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let events = evtac_experiments::dataset::read_cropped("trial.aedat4".as_ref())?;
@@ -226,7 +226,7 @@ impl<'a> Scene<'a> {
 
 /// Renders `events` (cropped to [`evtac_repr::CROP`], time order) to `path` as `output`: the
 /// frames of `scene`, the representations `reprs` (name, config, as
-/// [`crate::exp1::paper_representations`] lists them) built with `masks` (one per config, `None` for
+/// [`evtac_experiments::exp1::paper_representations`] lists them) built with `masks` (one per config, `None` for
 /// none).
 pub fn render(
     path: &Path,

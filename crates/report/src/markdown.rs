@@ -1,15 +1,17 @@
 //! The report: `OUT/report.md` (tables, with the paper's numbers beside ours), `OUT/results.json`
 //! (every number) and the figures under `OUT/figures/`.
 
-use crate::exp2::SETTINGS;
 use crate::plots;
-use crate::results::{Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind};
 use evtac_events::IoError;
+use evtac_experiments::results::{
+    Exp2Setting, Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind,
+};
 use evtac_repr::ReprKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 mod fusion;
+mod labels;
 
 /// A mean and a standard deviation, in degrees.
 pub type MeanStd = (f64, f64);
@@ -124,7 +126,7 @@ fn sensor_caption(kind: SensorKind) -> String {
     }
 }
 
-fn cell(s: &crate::results::MeanStd) -> String {
+fn cell(s: &evtac_experiments::results::MeanStd) -> String {
     if s.n == 0 { "-".into() } else { s.display() }
 }
 
@@ -272,7 +274,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     }
     stage_table(&mut md, &r.run);
 
-    md.push_str(&crate::label_check::section(r.labels.as_ref()));
+    md.push_str(&labels::section(r.labels.as_ref()));
 
     if figures.contains(&FIGURES[7].0) || figures.contains(&FIGURES[8].0) {
         let _ = writeln!(md, "## The sensor and the representations\n");
@@ -355,8 +357,9 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
             md,
             "| training setting | representation | motion phase | stop phase |\n| --- | --- | ---: | ---: |"
         );
-        for (key, label) in SETTINGS {
-            for c in r.exp2.iter().filter(|c| c.setting == key) {
+        for setting in Exp2Setting::ALL {
+            let label = setting.label();
+            for c in r.exp2.iter().filter(|c| c.setting == setting) {
                 let _ = writeln!(
                     md,
                     "| {label} | {} | {} | {} |",
@@ -448,7 +451,7 @@ fn noise_stats(
     points: &[NoisePoint],
     level: f64,
     name: ReprKind,
-) -> Option<crate::results::MeanStd> {
+) -> Option<evtac_experiments::results::MeanStd> {
     points
         .iter()
         .find(|p| p.level == level && p.name == name)
@@ -565,8 +568,8 @@ fn noise_section(md: &mut String, r: &Results, figures: &[&str]) {
 /// The title of the section listing the values evtac chose where the paper states none.
 pub const CHOICES_TITLE: &str = "Choices the paper does not state";
 
-/// The section listing [`crate::choices::Choice`]s: what, value used, why, how to change it.
-fn choices_section(md: &mut String, choices: &[crate::choices::Choice]) {
+/// The section listing [`evtac_experiments::results::Choice`]s: what, value used, why, how to change it.
+fn choices_section(md: &mut String, choices: &[evtac_experiments::results::Choice]) {
     let _ = writeln!(md, "## {CHOICES_TITLE}\n");
     if choices.is_empty() {
         let _ = writeln!(md, "Not recorded by the run that wrote `results.json`.\n");
@@ -618,7 +621,7 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
         draw(FIGURES[0].0, &|p| plots::tuning_curves(p, &r.tuning))?;
     }
     if !r.exp2.is_empty() {
-        draw(FIGURES[1].0, &|p| plots::phase_bars(p, &r.exp2, &SETTINGS))?;
+        draw(FIGURES[1].0, &|p| plots::phase_bars(p, &r.exp2))?;
     }
     if let Some(ex) = &r.example {
         draw(FIGURES[2].0, &|p| plots::example_curves(p, ex))?;
@@ -645,10 +648,12 @@ pub fn write(out: &Path, r: &Results) -> Result<Vec<PathBuf>, Error> {
     }
     let json_path = out.join("results.json");
     let json = serde_json::to_string_pretty(r).map_err(IoError::at(&json_path))?;
-    crate::jobs::write_atomic(&json_path, json.as_bytes()).map_err(IoError::at(&json_path))?;
+    evtac_events::output::write_atomic(&json_path, json.as_bytes())
+        .map_err(IoError::at(&json_path))?;
     let md_path = out.join("report.md");
     let markdown = markdown(r, &names);
-    crate::jobs::write_atomic(&md_path, markdown.as_bytes()).map_err(IoError::at(&md_path))?;
+    evtac_events::output::write_atomic(&md_path, markdown.as_bytes())
+        .map_err(IoError::at(&md_path))?;
     Ok(written)
 }
 

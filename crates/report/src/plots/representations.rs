@@ -4,7 +4,7 @@
 
 use super::images::{BOTH, OFF, ON, draw_image, grey, polarity_color};
 use super::{Error, FAMILY, canvas, draw_err};
-use crate::results::ReprExample;
+use evtac_experiments::results::ReprExample;
 use plotters::prelude::*;
 use std::path::Path;
 

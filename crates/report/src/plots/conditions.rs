@@ -2,19 +2,24 @@
 //! Experiment 1 at other background noise.
 
 use super::*;
-use crate::results::{Exp3Point, NoisePoint};
+use evtac_experiments::results::{Exp3Point, NoisePoint};
 
 /// One marker of an error-vs-condition panel: a representation's test MAE at `x`.
 struct Marker {
     name: ReprKind,
     x: f64,
-    stats: crate::results::MeanStd,
+    stats: evtac_experiments::results::MeanStd,
     /// Filled (seen during training) or hollow (unseen).
     filled: bool,
 }
 
 impl Marker {
-    fn new(name: ReprKind, x: f64, stats: crate::results::MeanStd, filled: bool) -> Self {
+    fn new(
+        name: ReprKind,
+        x: f64,
+        stats: evtac_experiments::results::MeanStd,
+        filled: bool,
+    ) -> Self {
         Self {
             name,
             x,

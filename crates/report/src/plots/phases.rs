@@ -1,10 +1,10 @@
 //! Experiment 2's figure: motion- and stop-phase MAE per representation and training setting.
 
 use super::*;
-use crate::results::Exp2Cell;
+use evtac_experiments::results::{Exp2Cell, Exp2Setting};
 
 /// Motion- and stop-phase MAE (mean ± std over seeds) per representation and training setting.
-pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) -> Result<(), Error> {
+pub fn phase_bars(path: &Path, cells: &[Exp2Cell]) -> Result<(), Error> {
     let e = draw_err(path);
     let names = ReprKind::in_order(cells.iter().map(|c| c.name));
     let root = canvas(
@@ -56,11 +56,12 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
             .y_label_formatter(&tick)
             .draw()
             .map_err(&e)?;
-        for (si, (key, label)) in settings.iter().enumerate() {
+        for (si, setting) in Exp2Setting::ALL.iter().enumerate() {
+            let (key, label) = (*setting, setting.label());
             let color = SETTING_COLORS[si % 3];
             let mut first = true;
             for (ri, name) in names.iter().enumerate() {
-                let Some(c) = cells.iter().find(|c| c.setting == *key && c.name == *name) else {
+                let Some(c) = cells.iter().find(|c| c.setting == key && c.name == *name) else {
                     continue;
                 };
                 let s = stat(c);
@@ -76,7 +77,7 @@ pub fn phase_bars(path: &Path, cells: &[Exp2Cell], settings: &[(&str, &str)]) ->
                     )))
                     .map_err(&e)?;
                 if first {
-                    series.label(*label).legend(move |(x, y)| {
+                    series.label(label).legend(move |(x, y)| {
                         Rectangle::new([(x, y - 6), (x + 16, y + 6)], color.filled())
                     });
                     first = false;

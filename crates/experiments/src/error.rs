@@ -1,0 +1,39 @@
+//! [`Error`]: what can stop a reproduction, one variant per stage that can fail. Its own file so
+//! that the stages (the noise study simulates and trains) and the pipeline that runs them share
+//! it without importing each other.
+
+use std::path::PathBuf;
+
+/// Errors of a reproduction.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A dataset could not be opened.
+    #[error(transparent)]
+    Dataset(#[from] crate::dataset::Error),
+    /// Features, training or evaluation failed.
+    #[error(transparent)]
+    Training(#[from] crate::training::Error),
+    /// The latency study failed.
+    #[error(transparent)]
+    Latency(#[from] crate::latency::Error),
+    /// The feature cache failed.
+    #[error(transparent)]
+    Cache(#[from] crate::cache::Error),
+    /// A dataset could not be simulated.
+    #[error("simulating {protocol} into {dir}: {source}")]
+    Simulation {
+        /// The protocol.
+        protocol: evtac_sim::Protocol,
+        /// The dataset folder.
+        dir: PathBuf,
+        /// The cause (boxed: it is large, and rare).
+        source: Box<evtac_sim::DatasetError>,
+    },
+    /// The `done` marker of a simulated dataset could not be written.
+    #[error(transparent)]
+    Jobs(#[from] crate::jobs::Error),
+    /// The log of stage times (`stage-times.csv`) could not be read or appended to.
+    #[error(transparent)]
+    StageLog(#[from] crate::stage_log::Error),
+}
