@@ -2,7 +2,8 @@
 //! `calibration.json` and `no_contact.aedat4`, flattened into each command that opens a dataset
 //! (`evtac_import::inputs` says why they are not silent fallbacks).
 
-use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, NO_MASK_FLAG};
+use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, MaskSource, NO_MASK_FLAG};
+use evtac_labels::CalibrationSource;
 
 /// The opt-out flags.
 #[derive(Debug, Clone, clap::Args)]
@@ -18,6 +19,14 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
+    /// The flags that ask for `inputs`.
+    pub fn of(inputs: Inputs) -> InputArgs {
+        InputArgs {
+            identity_calibration: inputs.calibration == CalibrationSource::Identity,
+            no_mask: inputs.mask == MaskSource::Unmasked,
+        }
+    }
+
     /// The inputs these flags ask for.
     pub fn inputs(&self) -> Inputs {
         Inputs::from_flags(self.identity_calibration, self.no_mask)

@@ -3,8 +3,10 @@
 
 use crate::common::{run_err, run_ok};
 use evtac_experiments::choices;
+use evtac_experiments::job::{Job, TrainJob};
 use evtac_experiments::plan::Plan;
 use evtac_report::{CHOICES_TITLE, FIGURES};
+use evtac_repr::ReprKind;
 use evtac_sim::{Scale, SimParams};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -271,17 +273,32 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
     let fresh = dir.path().join("fresh");
     let a = args(&fresh);
     run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
-    let text = std::fs::read_to_string(&list).unwrap();
-    let lines: Vec<&str> = text.lines().collect();
+    let jobs = evtac_experiments::job::read(&list).unwrap();
     // The tiny cross: 3 static and 3 dynamic settings.
-    assert_eq!(lines.len(), 6, "{text}");
-    assert!(
-        lines
-            .iter()
-            .all(|l| l.contains(" train ") && l.contains("--out"))
+    assert_eq!(jobs.len(), 6, "{jobs:?}");
+    let train: Vec<&TrainJob> = jobs
+        .iter()
+        .filter_map(|j| match j {
+            Job::Train(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(train.len(), 6);
+    let kinds = |k: ReprKind| train.iter().filter(|t| t.spec.repr.kind() == k).count();
+    assert_eq!((kinds(ReprKind::Static), kinds(ReprKind::Dynamic)), (3, 3));
+    // Run one as a Slurm task would: it trains what a local run trains (the same bytes as the
+    // tiny run's model of that setting), and it is no longer listed.
+    let list_s = list.display().to_string();
+    run_ok(&["jobs", "run", &list_s, "--index", "0"]);
+    let trained = std::fs::read(train[0].out.join("model.safetensors")).unwrap();
+    let local = out.join(train[0].out.strip_prefix(&fresh).unwrap());
+    assert_eq!(
+        trained,
+        std::fs::read(local.join("model.safetensors")).unwrap()
     );
-    assert!(lines.iter().any(|l| l.contains("--repr static")));
-    assert!(lines.iter().any(|l| l.contains("--repr dynamic")));
+    let a = args(&fresh);
+    run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(evtac_experiments::job::read(&list).unwrap().len(), 5);
 }
 
 #[test]
@@ -332,12 +349,13 @@ fn datasets_without_calibration_or_no_contact_are_refused_unless_opted_out() {
         "{err}"
     );
     run(&["--identity-calibration", "--no-mask"], true);
-    let jobs = std::fs::read_to_string(&list).unwrap();
+    let jobs = evtac_experiments::job::read(&list).unwrap();
     assert!(!jobs.is_empty());
+    let opted_out = evtac_import::inputs::Inputs::from_flags(true, true);
     assert!(
-        jobs.lines()
-            .all(|l| l.contains(" --identity-calibration") && l.contains(" --no-mask")),
-        "exported jobs must open the dataset as the reproduction does:\n{jobs}"
+        jobs.iter()
+            .all(|j| matches!(j, Job::Train(t) if t.inputs == opted_out)),
+        "exported jobs must open the dataset as the reproduction does:\n{jobs:?}"
     );
     let model = dir.path().join("m").display().to_string();
     for cmd in [
@@ -383,12 +401,13 @@ fn no_fusions_trains_the_papers_three_representations_only() {
         args.extend(["--out", &out_s, "--export-jobs", &list_s]);
         args.extend(extra);
         run_ok(&args);
-        let jobs = std::fs::read_to_string(&list).unwrap();
-        let count = |repr: &str| {
-            let flag = format!("--repr {repr} ");
-            jobs.lines().filter(|l| l.contains(&flag)).count()
+        let jobs = evtac_experiments::job::read(&list).unwrap();
+        let count = |kind: ReprKind| {
+            jobs.iter()
+                .filter(|j| matches!(j, Job::Train(t) if t.spec.repr.kind() == kind))
+                .count()
         };
-        ["static", "dynamic", "combined", "stacked", "late"].map(count)
+        ReprKind::ALL.map(count)
     };
     let all = export(&[]);
     let paper = export(&["--no-fusions"]);

@@ -4,6 +4,8 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
+use crate::dataset::Dataset;
+use crate::job::TrainJob;
 use crate::jobs;
 use crate::plan::Plan;
 use crate::progress::Progress;
@@ -44,8 +46,12 @@ pub fn representations(static_cfg: ReprConfig, dynamic_cfg: ReprConfig) -> Vec<R
     if let (Some(&static_part), Some(&dynamic_part)) =
         (static_cfg.static_part(), dynamic_cfg.dynamic_part())
     {
+        // Every kind built from both parts, in report order: a kind added to `ReprKind` is
+        // compared without a change here.
         out.extend(
-            [ReprKind::Combined, ReprKind::Stacked, ReprKind::Late]
+            ReprKind::ALL
+                .into_iter()
+                .filter(|kind| kind.parts() == (true, true))
                 .map(|kind| kind.config(static_part, dynamic_part)),
         );
     }
@@ -64,37 +70,38 @@ pub fn model_dir(out: &Path, kind: ReprKind, seed: u64) -> PathBuf {
         .join(format!("seed{seed}"))
 }
 
-/// A job of a multi-seed experiment.
-#[derive(Debug, Clone)]
-pub struct SeedJob {
-    /// The representation's kind.
-    pub kind: ReprKind,
-    /// The training job.
-    pub spec: TrainSpec,
-    /// Its folder.
-    pub dir: PathBuf,
-}
-
-/// The training jobs of Experiment 1.
-pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<SeedJob> {
+/// The training jobs of Experiment 1 on `ds`, its splits drawn with `seed`.
+pub fn jobs(
+    ds: &Dataset,
+    reprs: &[ReprConfig],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> Vec<TrainJob> {
     let seeds = seeds(seed, plan.seeds);
     let train = (plan.epochs, Sampling::MOTION, [Phase::Motion].as_slice());
-    seed_jobs(reprs, &seeds, train, |kind, s| model_dir(out, kind, s))
+    seed_jobs((ds, seed), reprs, &seeds, train, |kind, s| {
+        model_dir(out, kind, s)
+    })
 }
 
-/// One job per (representation, seed), in that order, each training for `epochs` on `sampling`'s
-/// points of `phases`, in the folder `dir` gives (Experiments 1 and 2 differ only in those).
+/// One job per (representation, seed), in that order, on the dataset `ds` (splits drawn with
+/// `splits_seed`), each training for `epochs` on `sampling`'s points of `phases`, in the folder
+/// `dir` gives (Experiments 1 and 2 differ only in those).
 pub(crate) fn seed_jobs(
+    (ds, splits_seed): (&Dataset, u64),
     reprs: &[ReprConfig],
     seeds: &[u64],
     (epochs, sampling, phases): (usize, Sampling, &[Phase]),
     dir: impl Fn(ReprKind, u64) -> PathBuf,
-) -> Vec<SeedJob> {
+) -> Vec<TrainJob> {
     let mut v = Vec::new();
     for &repr in reprs {
         for &seed in seeds {
-            v.push(SeedJob {
-                kind: repr.kind(),
+            v.push(TrainJob {
+                dataset: ds.dir.clone(),
+                inputs: ds.inputs,
+                splits_seed,
                 spec: TrainSpec {
                     repr,
                     seed,
@@ -102,7 +109,7 @@ pub(crate) fn seed_jobs(
                     sampling,
                     phases: phases.to_vec(),
                 },
-                dir: dir(repr.kind(), seed),
+                out: dir(repr.kind(), seed),
             });
         }
     }
@@ -113,13 +120,13 @@ pub(crate) fn seed_jobs(
 pub fn train_all(
     cache: &FeatureCache<'_>,
     splits: &Splits,
-    jobs: &[SeedJob],
+    jobs: &[TrainJob],
     progress: &dyn Progress,
 ) -> Result<(), Error> {
     jobs::run_all(
         jobs,
-        |j| j.dir.clone(),
-        |j| training::train_job(cache, splits, &j.spec, &j.dir, |_| {}).map(|_| ()),
+        |j| j.out.clone(),
+        |j| j.run_on(cache, splits, |_| {}).map(|_| ()),
         |skipped| progress.finished(skipped),
     )
 }
@@ -134,7 +141,7 @@ pub fn features_then_training(
     reprs: &[ReprConfig],
     sampling: Sampling,
     (features, training): (FeatureSet, Stage),
-    jobs: &[SeedJob],
+    jobs: &[TrainJob],
     progress: &dyn Progress,
 ) -> Result<(), Error> {
     let all = cache.dataset().trials(
@@ -177,7 +184,7 @@ pub fn run_as(
     stages: (FeatureSet, Stage),
 ) -> Result<Vec<Exp1Repr>, Error> {
     let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
-    let jobs = jobs(reprs, plan, seed, out);
+    let jobs = jobs(cache.dataset(), reprs, plan, seed, out);
     features_then_training(
         cache,
         splits,

@@ -5,7 +5,9 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
-use crate::exp1::{self, SeedJob};
+use crate::dataset::Dataset;
+use crate::exp1;
+use crate::job::TrainJob;
 use crate::plan::Plan;
 use crate::results::{Exp2Cell, Exp2Setting, MaeStats};
 use crate::sampling::{Phase, Sampling};
@@ -24,8 +26,15 @@ pub fn model_dir(out: &Path, setting: Exp2Setting, kind: ReprKind, seed: u64) ->
         .join(format!("seed{seed}"))
 }
 
-/// The training jobs of Experiment 2 (the two pause-inclusive settings).
-pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<SeedJob> {
+/// The training jobs of Experiment 2 on the pause dataset `ds` (the two pause-inclusive
+/// settings), its splits drawn with `seed`.
+pub fn jobs(
+    ds: &Dataset,
+    reprs: &[ReprConfig],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> Vec<TrainJob> {
     let seeds = exp1::seeds(seed, plan.exp2_seeds);
     let mut v = Vec::new();
     for (setting, phases) in [
@@ -36,9 +45,13 @@ pub fn jobs(reprs: &[ReprConfig], plan: &Plan, seed: u64, out: &Path) -> Vec<See
         ),
     ] {
         let train = (plan.epochs, Sampling::WITH_STOP, phases.as_slice());
-        v.extend(exp1::seed_jobs(reprs, &seeds, train, |name, s| {
-            model_dir(out, setting, name, s)
-        }));
+        v.extend(exp1::seed_jobs(
+            (ds, seed),
+            reprs,
+            &seeds,
+            train,
+            |name, s| model_dir(out, setting, name, s),
+        ));
     }
     v
 }
@@ -52,7 +65,7 @@ pub fn run(
     run: &RunContext<'_>,
 ) -> Result<Vec<Exp2Cell>, Error> {
     let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
-    let jobs = jobs(reprs, plan, seed, out);
+    let jobs = jobs(cache.dataset(), reprs, plan, seed, out);
     let stages = (FeatureSet::Exp2, Stage::Exp2Training);
     let sampling = Sampling::WITH_STOP;
     exp1::features_then_training(cache, splits, reprs, sampling, stages, &jobs, progress)?;

@@ -55,6 +55,7 @@ mod examples;
 pub mod exp1;
 mod exp2;
 mod exp3;
+pub mod job;
 pub mod jobs;
 mod label_check;
 pub mod latency;

@@ -6,15 +6,15 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::Dataset;
 use crate::exp3::Axis;
+use crate::job::{Job, SimulateJob};
 use crate::jobs;
 use crate::plan::Plan;
 use crate::progress::Progress;
 use crate::results::{Exp2Setting, Results, RunInfo};
-use crate::sampling::Sampling;
 use crate::splits::Split;
 use crate::stage::Stage;
 use crate::stage_log::StageLog;
-use crate::training::{self, TrainSpec};
+use crate::training;
 use crate::tuning::{self, Kind};
 use crate::{
     choices, examples, exp1, exp2, exp3, label_check, latency, noise, repr_example, sensor_view,
@@ -73,21 +73,17 @@ pub fn simulate_all(
     progress: &dyn Progress,
 ) -> Result<(), Error> {
     for protocol in crate::stage::PROTOCOLS {
-        let out = dir.join(protocol.name());
-        if jobs::is_done(&out) {
+        let job = SimulateJob {
+            protocol,
+            scale,
+            seed,
+            out: dir.join(protocol.name()),
+        };
+        if jobs::is_done(&job.out) {
             continue;
         }
-        let config = evtac_sim::DatasetConfig::new(protocol, scale, seed);
-        let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
-        progress.stage(Stage::Simulating(protocol), n as u64);
-        evtac_sim::simulate_dataset(&config, &out, |_| progress.advance(1)).map_err(|source| {
-            Error::Simulation {
-                protocol,
-                dir: out.clone(),
-                source: Box::new(source),
-            }
-        })?;
-        jobs::mark_done(&out)?;
+        progress.stage(Stage::Simulating(protocol), job.trials() as u64);
+        job.run(|| progress.advance(1))?;
     }
     Ok(())
 }
@@ -289,62 +285,6 @@ pub fn reproduce(
     Ok(results)
 }
 
-/// One `evtac train` command line for `spec` on `dataset` opened with `inputs`, writing into
-/// `dir`.
-pub fn train_command(
-    exe: &str,
-    dataset: &Path,
-    inputs: Inputs,
-    spec: &TrainSpec,
-    splits_seed: u64,
-    dir: &Path,
-) -> String {
-    let mut args: Vec<String> = vec![exe.into(), "train".into(), dataset.display().to_string()];
-    match spec.repr {
-        ReprConfig::Static(s) => {
-            args.extend(["--repr".into(), "static".into()]);
-            args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
-            args.extend(["--threshold".into(), s.threshold.to_string()]);
-        }
-        ReprConfig::Dynamic(d) => {
-            args.extend(["--repr".into(), "dynamic".into()]);
-            args.extend(["--window-ms".into(), d.window_ms.to_string()]);
-            args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
-        }
-        ReprConfig::Combined {
-            static_part: s,
-            dynamic_part: d,
-        }
-        | ReprConfig::Stacked {
-            static_part: s,
-            dynamic_part: d,
-        }
-        | ReprConfig::Late {
-            static_part: s,
-            dynamic_part: d,
-        } => {
-            args.extend(["--repr".into(), spec.repr.kind_name().into()]);
-            args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
-            args.extend(["--threshold".into(), s.threshold.to_string()]);
-            args.extend(["--window-ms".into(), d.window_ms.to_string()]);
-            args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
-        }
-    }
-    args.extend(["--epochs".into(), spec.epochs.to_string()]);
-    args.extend(["--seed".into(), spec.seed.to_string()]);
-    args.extend(["--splits-seed".into(), splits_seed.to_string()]);
-    if spec.sampling == Sampling::WITH_STOP {
-        args.push("--stop-samples".into());
-        if spec.phases.len() > 1 {
-            args.push("--train-on-stop".into());
-        }
-    }
-    args.extend(inputs.flags());
-    args.extend(["--out".into(), dir.display().to_string()]);
-    args.push("--quiet".into());
-    jobs::command_line(&args)
-}
-
 /// Whether every tuning run of both representations is finished in `out`.
 pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
     let models = out.join("models");
@@ -355,29 +295,23 @@ pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
     })
 }
 
-/// The training jobs that can run now and are not finished, as `evtac train` command lines:
-/// the tuning runs, and once both tunings are finished, Experiments 1 and 2. Run them (in any
-/// order, in parallel), then run `evtac reproduce` again: it resumes from the finished jobs.
+/// The training jobs that can run now and are not finished: the tuning runs, and once both
+/// tunings are finished, Experiments 1 and 2. Run them (in any order, in parallel, e.g. with
+/// `evtac jobs run`), then run the reproduction again: it resumes from the finished jobs.
 /// Makes the splits (and needs the Experiment 1 dataset).
-pub fn export_jobs(
-    data: &Datasets,
-    plan: &Plan,
-    seed: u64,
-    out: &Path,
-    exe: &str,
-) -> Result<Vec<String>, Error> {
+pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Result<Vec<Job>, Error> {
     let models = out.join("models");
     let ds1 = Dataset::open(&data.exp1, data.inputs)?;
     ds1.splits(seed)?;
-    let mut lines = Vec::new();
+    let mut jobs = Vec::new();
     let mut tuned = Vec::new();
     for kind in [Kind::Static, Kind::Dynamic] {
         let mut best: Option<(f64, ReprConfig)> = None;
         let mut all_done = true;
         for p in tuning::grid(plan, kind) {
-            let dir = tuning::run_dir(&models, kind, &p.config);
-            if exp1::finished(&dir) {
-                if let Ok(b) = evtac_learn::ModelBundle::load(&dir) {
+            let job = tuning::job(&ds1, kind, p.config, plan, seed, &models);
+            if exp1::finished(&job.out) {
+                if let Ok(b) = evtac_learn::ModelBundle::load(&job.out) {
                     let v = b.config.metrics.validation.overall;
                     if best.is_none_or(|(bv, _)| v < bv) {
                         best = Some((v, p.config));
@@ -385,14 +319,7 @@ pub fn export_jobs(
                 }
             } else {
                 all_done = false;
-                lines.push(train_command(
-                    exe,
-                    &data.exp1,
-                    data.inputs,
-                    &tuning::spec(p.config, plan, seed),
-                    seed,
-                    &dir,
-                ));
+                jobs.push(Job::Train(job));
             }
         }
         if all_done && let Some((_, c)) = best {
@@ -401,26 +328,18 @@ pub fn export_jobs(
     }
     if let [s, d] = tuned[..] {
         let reprs = exp1::of_plan(plan, s, d);
-        for j in exp1::jobs(&reprs, plan, seed, &models) {
-            if !exp1::finished(&j.dir) {
-                lines.push(train_command(
-                    exe,
-                    &data.exp1,
-                    data.inputs,
-                    &j.spec,
-                    seed,
-                    &j.dir,
-                ));
-            }
-        }
+        let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);
         if let Some(d2) = &data.exp2 {
-            Dataset::open(d2, data.inputs)?.splits(seed)?;
-            for j in exp2::jobs(&reprs, plan, seed, &models) {
-                if !exp1::finished(&j.dir) {
-                    lines.push(train_command(exe, d2, data.inputs, &j.spec, seed, &j.dir));
-                }
-            }
+            let ds2 = Dataset::open(d2, data.inputs)?;
+            ds2.splits(seed)?;
+            train.extend(exp2::jobs(&ds2, &reprs, plan, seed, &models));
         }
+        jobs.extend(
+            train
+                .into_iter()
+                .filter(|j| !exp1::finished(&j.out))
+                .map(Job::Train),
+        );
     }
-    Ok(lines)
+    Ok(jobs)
 }

@@ -2,33 +2,36 @@
 //! (`sbatch --array`), followed with `squeue` until it ends; the report is written by a last job
 //! that depends on the final array (`--dependency=afterok`).
 //!
-//! Every job is idempotent and marks its folder done (see [`crate::jobs`]), so the jobs files
-//! are written from what is *not* finished, and a task that was cancelled or failed is found by
+//! Every job is a typed [`Job`] that is idempotent and marks its folder done (see
+//! [`crate::jobs`]), so the jobs files ([`crate::job`]) are written from what is *not* finished, and a task that was cancelled or failed is found by
 //! its missing `done` marker, not by trusting the scheduler's accounting (which many clusters
 //! keep only for minutes, or not at all). Running the same command again resumes: only the
-//! unfinished jobs are submitted. Tasks run the same `evtac` commands as a local run with the
-//! same seed, so the results are the same bytes.
+//! unfinished jobs are submitted. Tasks run the same jobs as a local run with the same seed, so
+//! the results are the same bytes. What a task runs is the front end's to say (`task`: for the
+//! CLI, `evtac jobs run FILE --index $SLURM_ARRAY_TASK_ID`): this library spells no command line
+//! of evtac's.
 //!
 //! The stages, in order (each submitted only when the one before it has finished, because its
 //! job list depends on the one before: Experiments 1 and 2 train the configs the tuning chose):
 //!
-//! 1. `simulate`: one task per dataset not yet simulated (`evtac simulate`);
+//! 1. `simulate`: one task per dataset not yet simulated ([`Job::Simulate`]);
 //! 2. `train`: the training jobs [`pipeline::export_jobs`] lists (first the tuning grid, then,
 //!    once both tunings are done, Experiments 1 and 2);
-//! 3. `report`: one task running `evtac reproduce` itself, which finds every training done and
-//!    evaluates, runs Experiment 3 and the latency study, and writes the report.
+//! 3. `report`: one task running the reproduction itself ([`Job::Reproduce`]), which finds every
+//!    training done and evaluates, runs Experiment 3 and the latency study, and writes the
+//!    report.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
+use crate::job::{self, Job, ReproduceJob, SimulateJob};
 use crate::jobs;
 use crate::pipeline::{self, Datasets};
 use crate::plan::Plan;
 use crate::progress::Progress;
 use crate::stage::{PROTOCOLS, Stage};
 use evtac_events::IoError;
-use evtac_import::inputs::Inputs;
 
 /// What can go wrong running on Slurm.
 #[derive(Debug, thiserror::Error)]
@@ -67,9 +70,12 @@ pub enum Error {
         /// Each failed task: its index, the state Slurm reports, its log file.
         details: String,
     },
-    /// A jobs file could not be written.
+    /// A log folder could not be made.
     #[error(transparent)]
     Io(#[from] IoError),
+    /// A jobs file could not be written.
+    #[error(transparent)]
+    JobsFile(#[from] job::FileError),
     /// Listing the jobs failed.
     #[error(transparent)]
     Pipeline(#[from] pipeline::Error),
@@ -123,30 +129,25 @@ fn run(program: &str, args: &[String]) -> Result<String, Error> {
 }
 
 impl Slurm {
-    /// Submits the `lines` (shell command lines) as one array named `evtac-<stage>`: task `k`
-    /// runs line `k` through `evtac jobs run` (`exe` is the `evtac` binary), one CPU each,
-    /// logging to `logs/<stage>-<job>_<task>.out`, after `after` (if any) has finished well.
+    /// Submits `jobs` as one array named `evtac-<stage>`: they are written to the jobs file
+    /// `logs/<stage>.jobs`, and task `k` runs the shell command `task(file)` (which must run job
+    /// `$SLURM_ARRAY_TASK_ID` of the file), one CPU each, logging to
+    /// `logs/<stage>-<job>_<task>.out`, after `after` (if any) has finished well.
     pub fn submit(
         &self,
         stage: &str,
-        lines: &[String],
-        exe: &str,
+        jobs: &[Job],
+        task: &dyn Fn(&Path) -> String,
         logs: &Path,
         after: Option<&ArrayJob>,
     ) -> Result<ArrayJob, Error> {
         std::fs::create_dir_all(logs).map_err(IoError::at(logs))?;
         let file = logs.join(format!("{stage}.jobs"));
-        let mut text = lines.join("\n");
-        text.push('\n');
-        jobs::write_atomic(&file, text.as_bytes()).map_err(IoError::at(&file))?;
-        let wrap = format!(
-            "{} jobs run {} --index \"$SLURM_ARRAY_TASK_ID\"",
-            jobs::shell_quote(exe),
-            jobs::shell_quote(&file.display().to_string())
-        );
+        job::write(&file, jobs)?;
+        let wrap = task(&file);
         let mut args = vec![
             "--parsable".to_string(),
-            format!("--array=0-{}", lines.len().saturating_sub(1)),
+            format!("--array=0-{}", jobs.len().saturating_sub(1)),
             format!("--job-name=evtac-{stage}"),
             format!("--output={}/{stage}-%A_%a.out", logs.display()),
             "--cpus-per-task=1".to_string(),
@@ -161,7 +162,7 @@ impl Slurm {
         let id = out.trim().split(';').next().unwrap_or_default().to_string();
         Ok(ArrayJob {
             id,
-            tasks: lines.len(),
+            tasks: jobs.len(),
         })
     }
 
@@ -224,138 +225,88 @@ impl Slurm {
     }
 }
 
-/// A reproduction to run on Slurm: the arguments of the `evtac reproduce` it stands for.
-#[derive(Debug, Clone)]
-pub struct Reproduction {
-    /// The `evtac` binary the tasks run (an absolute path every node can reach).
-    pub exe: String,
-    /// Scale name (`tiny`, `small`, `paper`).
-    pub scale: evtac_sim::Scale,
-    /// Master seed.
-    pub seed: u64,
-    /// Output folder (on storage every node shares).
-    pub out: PathBuf,
-    /// Existing datasets, or `None` to simulate them into `out/data`.
-    pub data: Option<PathBuf>,
-    /// Where the datasets' calibration and mask come from (the opt-out flags).
-    pub inputs: Inputs,
-    /// `--noise-levels` as given, or `None` for the plan's default.
-    pub noise_levels: Option<Vec<f64>>,
-    /// `--no-fusions`: the paper's three representations only.
-    pub no_fusions: bool,
+/// The simulation jobs of `reproduction` not yet finished (none when it has data of its own).
+fn simulation_jobs(reproduction: &ReproduceJob) -> Vec<Job> {
+    if reproduction.data.is_some() {
+        return Vec::new();
+    }
+    PROTOCOLS
+        .iter()
+        .map(|&protocol| SimulateJob {
+            protocol,
+            scale: reproduction.scale,
+            seed: reproduction.seed,
+            out: sim_dir(reproduction).join(protocol.name()),
+        })
+        .filter(|j| !jobs::is_done(&j.out))
+        .map(Job::Simulate)
+        .collect()
 }
 
-impl Reproduction {
-    /// The `evtac reproduce` command line of this reproduction, run locally (by the last task).
-    fn local_command(&self) -> String {
-        let mut args = vec![
-            self.exe.clone(),
-            "reproduce".into(),
-            "--scale".into(),
-            self.scale.name().into(),
-            "--seed".into(),
-            self.seed.to_string(),
-            "--out".into(),
-            self.out.display().to_string(),
-            "--jobs".into(),
-            "1".into(),
-        ];
-        if let Some(data) = &self.data {
-            args.extend(["--data".into(), data.display().to_string()]);
-        }
-        args.extend(self.inputs.flags());
-        if let Some(levels) = &self.noise_levels {
-            args.push("--noise-levels".into());
-            if !levels.is_empty() {
-                let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
-                args.push(levels.join(","));
-            }
-        }
-        if self.no_fusions {
-            args.push("--no-fusions".into());
-        }
-        jobs::command_line(&args)
-    }
+/// The folder of a reproduction's simulated datasets.
+fn sim_dir(reproduction: &ReproduceJob) -> PathBuf {
+    reproduction.out.join("data")
+}
 
-    /// The folder of the simulated datasets.
-    fn sim_dir(&self) -> PathBuf {
-        self.out.join("data")
-    }
-
-    /// `evtac simulate` lines for the datasets not yet simulated (none when data is given).
-    fn simulation_jobs(&self) -> Vec<(PathBuf, String)> {
-        if self.data.is_some() {
-            return Vec::new();
-        }
-        PROTOCOLS
-            .iter()
-            .map(|p| (*p, self.sim_dir().join(p.name())))
-            .filter(|(_, dir)| !jobs::is_done(dir))
-            .map(|(p, dir)| {
-                let line = jobs::command_line(&[
-                    self.exe.clone(),
-                    "simulate".into(),
-                    "--protocol".into(),
-                    p.name().into(),
-                    "--scale".into(),
-                    self.scale.name().into(),
-                    "--seed".into(),
-                    self.seed.to_string(),
-                    "--out".into(),
-                    dir.display().to_string(),
-                    "--jobs".into(),
-                    "1".into(),
-                ]);
-                (dir, line)
-            })
-            .collect()
-    }
-
-    /// Runs the whole reproduction on `slurm`: the simulation, the training jobs (two rounds:
-    /// tuning, then Experiments 1 and 2), and the report task; returns when the report is
-    /// written.
-    pub fn run(&self, slurm: &Slurm, plan: &Plan, progress: &dyn Progress) -> Result<(), Error> {
-        let logs = self.out.join("slurm");
-        let sims = self.simulation_jobs();
+impl Slurm {
+    /// Runs `reproduction` (with its `plan`) on the cluster: the simulation, the training jobs
+    /// (two rounds: tuning, then Experiments 1 and 2), and the reproduction's own last task;
+    /// returns when its report is written. Each task runs the shell command `task(jobs_file)`
+    /// (see [`Slurm::submit`]).
+    pub fn reproduce(
+        &self,
+        reproduction: &ReproduceJob,
+        plan: &Plan,
+        task: &dyn Fn(&Path) -> String,
+        progress: &dyn Progress,
+    ) -> Result<(), Error> {
+        let slurm = self;
+        let logs = reproduction.out.join("slurm");
+        let sims = simulation_jobs(reproduction);
         if !sims.is_empty() {
-            let lines: Vec<String> = sims.iter().map(|(_, l)| l.clone()).collect();
-            let job = submit(slurm, "simulate", &lines, &self.exe, &logs, None, progress)?;
+            let job = submit(slurm, "simulate", &sims, task, &logs, None, progress)?;
             slurm.wait(&job, progress)?;
             let unfinished: Vec<usize> = (0..sims.len())
-                .filter(|&k| !jobs::is_done(&sims[k].0))
+                .filter(|&k| !jobs::is_done(sims[k].out()))
                 .collect();
             check(slurm, "simulate", &job, &unfinished, &logs)?;
         }
         let data = Datasets {
-            inputs: self.inputs,
-            ..Datasets::in_dir(self.data.as_deref().unwrap_or(&self.sim_dir()))
+            inputs: reproduction.inputs,
+            ..Datasets::in_dir(
+                reproduction
+                    .data
+                    .as_deref()
+                    .unwrap_or(&sim_dir(reproduction)),
+            )
         };
-        let report = [self.local_command()];
+        let (seed, out) = (reproduction.seed, &reproduction.out);
+        let report = [Job::Reproduce(reproduction.clone())];
         let submitted = std::time::SystemTime::now();
         let mut round = 0;
         let report_job = loop {
-            let lines = pipeline::export_jobs(&data, plan, self.seed, &self.out, &self.exe)?;
-            if lines.is_empty() {
-                break submit(slurm, "report", &report, &self.exe, &logs, None, progress)?;
+            let train = pipeline::export_jobs(&data, plan, seed, out)?;
+            if train.is_empty() {
+                break submit(slurm, "report", &report, task, &logs, None, progress)?;
             }
             // Once both tunings are done, this round (Experiments 1 and 2) is the last: the
             // report task is queued behind it at once.
-            let last = pipeline::tunings_finished(plan, &self.out);
+            let last = pipeline::tunings_finished(plan, out);
             round += 1;
             let stage = format!("train-{round}");
-            let job = submit(slurm, &stage, &lines, &self.exe, &logs, None, progress)?;
+            let job = submit(slurm, &stage, &train, task, &logs, None, progress)?;
             let report_job = if last {
                 let after = Some(&job);
                 Some(submit(
-                    slurm, "report", &report, &self.exe, &logs, after, progress,
+                    slurm, "report", &report, task, &logs, after, progress,
                 )?)
             } else {
                 None
             };
             slurm.wait(&job, progress)?;
-            let left = pipeline::export_jobs(&data, plan, self.seed, &self.out, &self.exe)?;
-            let unfinished: Vec<usize> = (0..lines.len())
-                .filter(|&k| left.contains(&lines[k]))
+            let left = pipeline::export_jobs(&data, plan, seed, out)?;
+            let unfinished: Vec<usize> = (0..train.len())
+                .filter(|&k| left.contains(&train[k]))
                 .collect();
             if let Err(e) = check(slurm, &stage, &job, &unfinished, &logs) {
                 // A report behind a failed array would wait forever (DependencyNeverSatisfied).
@@ -369,7 +320,7 @@ impl Reproduction {
             }
         };
         slurm.wait(&report_job, progress)?;
-        let written = std::fs::metadata(self.out.join("report.md"))
+        let written = std::fs::metadata(out.join("report.md"))
             .and_then(|m| m.modified())
             .is_ok_and(|t| t >= submitted);
         check(
@@ -386,18 +337,18 @@ impl Reproduction {
 fn submit(
     slurm: &Slurm,
     stage: &str,
-    lines: &[String],
-    exe: &str,
+    jobs: &[Job],
+    task: &dyn Fn(&Path) -> String,
     logs: &Path,
     after: Option<&ArrayJob>,
     progress: &dyn Progress,
 ) -> Result<ArrayJob, Error> {
-    let job = slurm.submit(stage, lines, exe, logs, after)?;
-    progress.stage(Stage::SlurmTasks, lines.len() as u64);
+    let job = slurm.submit(stage, jobs, task, logs, after)?;
+    progress.stage(Stage::SlurmTasks, jobs.len() as u64);
     let behind = after.map_or(String::new(), |a| format!(" after job {}", a.id));
     progress.message(&format!(
         "`{stage}`: {} task(s) submitted as Slurm job {}{behind}",
-        lines.len(),
+        jobs.len(),
         job.id
     ));
     Ok(job)

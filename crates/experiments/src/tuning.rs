@@ -4,13 +4,14 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
-use crate::jobs;
+use crate::dataset::Dataset;
+use crate::job::TrainJob;
 use crate::plan::{self, Plan};
 use crate::results::{Mae, Tuning, TuningRun};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
-use crate::training::{self, Error, TrainSpec};
+use crate::training::{Error, TrainSpec};
 use evtac_learn::ModelBundle;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
@@ -59,14 +60,28 @@ pub fn run_dir(out: &Path, kind: Kind, config: &ReprConfig) -> PathBuf {
         .join(config.cache_key())
 }
 
-/// The training job of one grid point.
-pub fn spec(config: ReprConfig, plan: &Plan, seed: u64) -> TrainSpec {
-    TrainSpec {
-        repr: config,
-        seed,
-        epochs: plan.tuning_epochs,
-        sampling: Sampling::MOTION,
-        phases: vec![Phase::Motion],
+/// The training job of one grid point of `kind` on `ds` (splits and weights from `seed`), in
+/// its folder under the models folder `out`.
+pub fn job(
+    ds: &Dataset,
+    kind: Kind,
+    config: ReprConfig,
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> TrainJob {
+    TrainJob {
+        dataset: ds.dir.clone(),
+        inputs: ds.inputs,
+        splits_seed: seed,
+        spec: TrainSpec {
+            repr: config,
+            seed,
+            epochs: plan.tuning_epochs,
+            sampling: Sampling::MOTION,
+            phases: vec![Phase::Motion],
+        },
+        out: run_dir(out, kind, &config),
     }
 }
 
@@ -91,21 +106,11 @@ pub fn tune(
         progress.finished(reused)
     })?;
     progress.stage(Stage::Tuning(kind), points.len() as u64);
-    jobs::run_all(
-        &points,
-        |p| run_dir(out, kind, &p.config),
-        |p| {
-            training::train_job(
-                cache,
-                splits,
-                &spec(p.config, plan, seed),
-                &run_dir(out, kind, &p.config),
-                |_| {},
-            )
-            .map(|_| ())
-        },
-        |skipped| progress.finished(skipped),
-    )?;
+    let jobs: Vec<TrainJob> = points
+        .iter()
+        .map(|p| job(ds, kind, p.config, plan, seed, out))
+        .collect();
+    crate::exp1::train_all(cache, splits, &jobs, progress)?;
     let mut runs = Vec::new();
     for p in &points {
         let bundle = ModelBundle::load(&run_dir(out, kind, &p.config))?;

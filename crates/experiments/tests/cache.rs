@@ -64,7 +64,7 @@ fn second_run_computes_no_features_and_loads_the_same() {
 /// halves are the static and dynamic configs' own features.
 #[test]
 fn stacked_and_late_share_features_that_are_static_then_dynamic() {
-    use evtac_repr::ReprConfig;
+    use evtac_repr::{ReprConfig, ReprKind};
     let dir = tempfile::tempdir().unwrap();
     simulate(dir.path(), Protocol::Exp1, 2);
     let ds = Dataset::open(dir.path(), Inputs::FROM_FILES).unwrap();
@@ -75,14 +75,8 @@ fn stacked_and_late_share_features_that_are_static_then_dynamic() {
         plan::dynamic_config(640.0, 0),
     );
     let (static_part, dynamic_part) = (*st.static_part().unwrap(), *dy.dynamic_part().unwrap());
-    let stacked = ReprConfig::Stacked {
-        static_part,
-        dynamic_part,
-    };
-    let late = ReprConfig::Late {
-        static_part,
-        dynamic_part,
-    };
+    let [stacked, late] =
+        [ReprKind::Stacked, ReprKind::Late].map(|k| k.config(static_part, dynamic_part));
     let stats = cache
         .ensure(&trials, &[stacked, late], Sampling::MOTION, &|_| {})
         .unwrap();

@@ -824,12 +824,8 @@ pub fn imu_offset_whole(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyn
         samples: samples.len(),
     };
     let pieces = commanded(log);
-    let Bounds {
-        lo,
-        hi,
-        log_from,
-        log_to,
-    } = bounds(session, log, &pieces, &span)?;
+    let within = bounds(session, log, &pieces, &span)?;
+    let (lo, hi, log_span) = (within.lo, within.hi, (within.log_from, within.log_to));
     let rate = Integral::new(&samples);
     let correlation = |o: i64| -> f64 {
         pieces
@@ -873,9 +869,9 @@ pub fn imu_offset_whole(session: &Path, log: &RobotLog) -> Result<ImuFit, ImuSyn
         REFINE_US / 20,
     );
     let squares: Vec<(i64, f64)> = samples.iter().map(|&(t, g)| (t, g * g)).collect();
-    let g2 = Integral::new(&squares).between(log_from + best, log_to + best);
+    let g2 = Integral::new(&squares).between(log_span.0 + best, log_span.1 + best);
     let c = correlation(best);
-    Ok(fit(&pieces, (log_from, log_to), best, c, g2))
+    Ok(fit(&pieces, log_span, best, c, g2))
 }
 
 fn no_imu(session: &Path, samples: usize) -> ImuSyncError {

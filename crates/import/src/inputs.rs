@@ -55,19 +55,6 @@ impl Inputs {
         }
     }
 
-    /// The command-line flags that ask for these inputs (`--identity-calibration`, `--no-mask`),
-    /// for job lines that must open the dataset the same way.
-    pub fn flags(&self) -> Vec<String> {
-        let mut flags = Vec::new();
-        if self.calibration == CalibrationSource::Identity {
-            flags.push(format!("--{IDENTITY_CALIBRATION_FLAG}"));
-        }
-        if self.mask == MaskSource::Unmasked {
-            flags.push(format!("--{NO_MASK_FLAG}"));
-        }
-        flags
-    }
-
     /// The calibration in words, for the report.
     pub fn calibration_text(&self) -> String {
         match self.calibration {
@@ -92,12 +79,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn flags_round_trip_through_from_flags() {
+    fn each_flag_opts_out_of_its_own_input() {
         for (c, m) in [(false, false), (true, false), (false, true), (true, true)] {
             let inputs = Inputs::from_flags(c, m);
-            let flags = inputs.flags();
-            assert_eq!(flags.contains(&"--identity-calibration".to_string()), c);
-            assert_eq!(flags.contains(&"--no-mask".to_string()), m);
+            assert_eq!(inputs.calibration == CalibrationSource::Identity, c);
+            assert_eq!(inputs.mask == MaskSource::Unmasked, m);
         }
         assert_eq!(Inputs::from_flags(false, false), Inputs::FROM_FILES);
     }

@@ -277,14 +277,35 @@ pub struct BundleConfig {
     pub metrics: BundleMetrics,
 }
 
-/// `config.json` with its representation not yet interpreted (it depends on the version).
+/// `config.json` with its representation in either shape it has had (which is allowed depends
+/// on the version).
 #[derive(Deserialize)]
 struct RawConfig {
     format_version: u32,
     architecture: Vec<usize>,
     training: TrainConfig,
-    representation: serde_json::Value,
+    #[serde(deserialize_with = "either_shape")]
+    representation: Result<RawRepresentation, String>,
     metrics: BundleMetrics,
+}
+
+/// The representation as format 2 writes it, or a bare config (format 1 also wrote those: online
+/// tests, hand-made bundles).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawRepresentation {
+    Typed(Representation),
+    Bare(ReprConfig),
+}
+
+/// Reads the representation, keeping a shape that is neither as an error for
+/// [`RawConfig::typed`] to name with the file (an untagged enum reads the whole value before
+/// trying its shapes, so the rest of the file still parses).
+fn either_shape<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Result<RawRepresentation, String>, D::Error> {
+    Ok(RawRepresentation::deserialize(d)
+        .map_err(|_| "neither the representation object nor a representation config".to_string()))
 }
 
 impl RawConfig {
@@ -294,16 +315,17 @@ impl RawConfig {
             path: path.to_path_buf(),
             reason,
         };
-        let value = self.representation;
-        let representation = match serde_json::from_value::<Representation>(value.clone()) {
-            Ok(r) => r,
-            Err(typed) if self.format_version == 1 => {
-                // Format 1 also wrote a bare config (online tests, hand-made bundles).
-                serde_json::from_value::<ReprConfig>(value)
-                    .map(Representation::new)
-                    .map_err(|bare| invalid(format!("{typed}; as a bare config: {bare}")))?
+        let representation = match self.representation.map_err(invalid)? {
+            RawRepresentation::Typed(r) => r,
+            RawRepresentation::Bare(config) if self.format_version == 1 => {
+                Representation::new(config)
             }
-            Err(typed) => return Err(invalid(typed.to_string())),
+            RawRepresentation::Bare(_) => {
+                return Err(invalid(format!(
+                    "a bare config is format 1's; this file is format {}",
+                    self.format_version
+                )));
+            }
         };
         if representation.frame != CROP {
             return Err(Error::Frame {
@@ -759,14 +781,8 @@ mod tests {
     fn two_frame_networks_round_trip_and_must_match_the_representation() {
         let dir = tempfile::tempdir().expect("tempdir");
         let (static_part, dynamic_part) = Default::default();
-        let stacked = ReprConfig::Stacked {
-            static_part,
-            dynamic_part,
-        };
-        let late = ReprConfig::Late {
-            static_part,
-            dynamic_part,
-        };
+        let [stacked, late] = [evtac_repr::ReprKind::Stacked, evtac_repr::ReprKind::Late]
+            .map(|k| k.config(static_part, dynamic_part));
         for config in [stacked, late] {
             let b = ModelBundle::untrained(3, Representation::new(config), None);
             assert_eq!(b.parameters.architecture, Architecture::for_repr(&config));

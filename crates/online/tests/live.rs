@@ -5,10 +5,8 @@
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
-use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::{Backoff, Estimate, Estimator, Notice};
 use std::io::{BufRead, BufReader, Write};
-use std::ops::ControlFlow;
 use std::process::{Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
@@ -124,19 +122,9 @@ fn estimates_arrive_while_a_dv_network_writer_streams() {
     assert_eq!(opened.resolution, Some(SENSOR));
     let estimator = Estimator::for_model(&model, SENSOR, 1000).unwrap();
     let mut estimates: Vec<(Estimate, f64)> = Vec::new();
-    let summary = pipeline::run(
-        opened.source,
-        estimator,
-        &PipelineConfig::default(),
-        |out| {
-            match out {
-                Output::Estimate(e) => estimates.push((e, unix_now())),
-                Output::Notice(n) => notices.push(n),
-            }
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
+    let summary = support::run_to_end(opened.source, estimator, &mut notices, |e| {
+        estimates.push((e, unix_now()))
+    });
     let status = server.wait().unwrap();
     assert!(status.success(), "the Python server failed: {status}");
     let mut times = std::collections::HashMap::new();

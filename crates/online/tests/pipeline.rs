@@ -106,19 +106,9 @@ fn run_tcp(
     let opened = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap();
     let estimator = Estimator::for_model(model, opened.resolution.unwrap(), 1000).unwrap();
     let mut estimates = Vec::new();
-    let summary = pipeline::run(
-        opened.source,
-        estimator,
-        &PipelineConfig::default(),
-        |out| {
-            match out {
-                Output::Estimate(e) => estimates.push(e),
-                Output::Notice(n) => notices.push(n),
-            }
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
+    let summary = support::run_to_end(opened.source, estimator, &mut notices, |e| {
+        estimates.push(e)
+    });
     (estimates, notices, summary)
 }
 

@@ -3,7 +3,7 @@
 //! into a GIF, and into an MP4 when `ffmpeg` is on the PATH. Faster than real time when one
 //! iteration takes under 1 s.
 //!
-//! `nice cargo bench -p evtac-experiments --bench render -- --warm-up-time 1 --measurement-time 5`
+//! `nice cargo bench -p evtac-report --bench render -- --warm-up-time 1 --measurement-time 5`
 
 use criterion::Criterion;
 use evtac_events::Event;

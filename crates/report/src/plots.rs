@@ -139,10 +139,11 @@ where
         .map_err(draw_err(path))
 }
 
-/// The color of a representation (one per [`ReprKind::ALL`], in that order).
+/// The color of a representation (one per [`ReprKind::ALL`], in that order; a kind added later
+/// reuses the palette from the start until it gets a colour of its own).
 pub(crate) fn repr_color(kind: ReprKind) -> RGBColor {
     // The enum's variants are declared in `ALL`'s order, so its discriminant is the index.
-    REPR_COLORS[kind as usize]
+    REPR_COLORS[kind as usize % REPR_COLORS.len()]
 }
 
 /// A tick label: at most three decimals, without trailing zeros (`5.5`, `100`, `0.25`).

@@ -456,14 +456,8 @@ mod tests {
     #[test]
     fn stacked_and_late_share_their_features_key_and_have_two_frames() {
         let (static_part, dynamic_part) = (StaticConfig::default(), DynamicConfig::default());
-        let stacked = ReprConfig::Stacked {
-            static_part,
-            dynamic_part,
-        };
-        let late = ReprConfig::Late {
-            static_part,
-            dynamic_part,
-        };
+        let [stacked, late] = [crate::ReprKind::Stacked, crate::ReprKind::Late]
+            .map(|k| k.config(static_part, dynamic_part));
         assert_eq!(stacked.cache_key(), late.cache_key());
         assert_ne!(stacked.cache_key(), ReprConfig::default().cache_key());
         assert_eq!((stacked.frames(), late.frames()), (2, 2));

@@ -1,15 +1,20 @@
-//! `evtac jobs`: run one line of a jobs file, as a Slurm array task (or any scheduler) does.
+//! `evtac jobs`: run one job of a jobs file, as a Slurm array task (or any scheduler) does.
 //!
-//! A jobs file holds one shell command line per job, as `evtac reproduce --export-jobs` and
-//! `--executor slurm` write them. `evtac jobs run FILE --index $SLURM_ARRAY_TASK_ID` runs line
-//! `index` (counted from 0, as array task ids are) through `/bin/sh -c`, and exits with its
-//! status, so a user's own `sbatch --array=0-(N-1)` script needs nothing else (see
-//! `docs/cluster.md`).
+//! A jobs file (`evtac_experiments::job`) holds one typed job per line, as `evtac reproduce
+//! --export-jobs` and `--executor slurm` write them. `evtac jobs run FILE --index
+//! $SLURM_ARRAY_TASK_ID` runs job `index` (counted from 0, as array task ids are) in this
+//! process, as `evtac simulate`, `evtac train` or `evtac reproduce` would, so a user's own
+//! `sbatch --array=0-(N-1)` script needs nothing else (see `docs/cluster.md`). `evtac jobs show`
+//! prints each job as the command it equals.
 
-use std::path::PathBuf;
-use std::process::Command;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use evtac_experiments::job::{self, Job, ReproduceJob, TrainJob};
+use evtac_experiments::jobs::command_line;
+use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, MaskSource, NO_MASK_FLAG};
+use evtac_labels::CalibrationSource;
+use evtac_sim::Scale;
 
 /// Arguments of `evtac jobs`.
 #[derive(Debug, clap::Args)]
@@ -21,11 +26,11 @@ pub struct Args {
 /// What to do with a jobs file.
 #[derive(Debug, clap::Subcommand)]
 pub enum Action {
-    /// Run one job (line) of a jobs file; exits with the job's status.
+    /// Run one job of a jobs file (quietly, as an array task); exits non-zero if it fails.
     Run {
-        /// The jobs file: one shell command line per job.
+        /// The jobs file (`reproduce --export-jobs`, or `OUT/slurm/<stage>.jobs`).
         file: PathBuf,
-        /// The line to run, from 0 (e.g. `$SLURM_ARRAY_TASK_ID`).
+        /// The job to run, from 0 (e.g. `$SLURM_ARRAY_TASK_ID`).
         #[arg(long)]
         index: usize,
     },
@@ -34,29 +39,29 @@ pub enum Action {
         /// The jobs file.
         file: PathBuf,
     },
-}
-
-/// The job lines of `file` (blank lines are not jobs).
-fn lines(file: &PathBuf) -> anyhow::Result<Vec<String>> {
-    let text = std::fs::read_to_string(file)
-        .with_context(|| format!("reading the jobs file {}", file.display()))?;
-    Ok(text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(str::to_string)
-        .collect())
+    /// Print each job as the `evtac` command it equals, one per line.
+    Show {
+        /// The jobs file.
+        file: PathBuf,
+    },
 }
 
 /// Runs `evtac jobs`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     match args.action {
         Action::Count { file } => {
-            println!("{}", lines(&file)?.len());
+            println!("{}", job::read(&file)?.len());
+            Ok(())
+        }
+        Action::Show { file } => {
+            for job in job::read(&file)? {
+                println!("{}", command_line(&equivalent_command("evtac", &job)));
+            }
             Ok(())
         }
         Action::Run { file, index } => {
-            let jobs = lines(&file)?;
-            let Some(line) = jobs.get(index) else {
+            let jobs = job::read(&file)?;
+            let Some(job) = jobs.get(index) else {
                 bail!(
                     "{} holds {} jobs (indices 0 to {}); there is no job {index}",
                     file.display(),
@@ -64,19 +69,120 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     jobs.len().saturating_sub(1)
                 );
             };
+            let line = command_line(&equivalent_command("evtac", job));
             eprintln!("job {index} of {}: {line}", file.display());
-            let status = Command::new("/bin/sh")
-                .arg("-c")
-                .arg(line)
-                .status()
-                .with_context(|| format!("starting /bin/sh for job {index}"))?;
-            if !status.success() {
-                bail!(
-                    "job {index} of {} failed ({status}): {line}",
-                    file.display()
-                );
-            }
-            Ok(())
+            run_job(job).with_context(|| format!("job {index} of {} failed", file.display()))
         }
     }
+}
+
+/// Runs `job` in this process.
+fn run_job(job: &Job) -> anyhow::Result<()> {
+    match job {
+        Job::Simulate(j) => j.run(|| {})?,
+        Job::Train(j) => {
+            if !evtac_experiments::jobs::is_done(&j.out) {
+                j.run(&|_| {}, |_| {})?;
+            }
+        }
+        Job::Reproduce(j) => super::reproduce::run(reproduce_args(j))?,
+    }
+    Ok(())
+}
+
+/// The `evtac reproduce` arguments of `job`, run locally on one thread (a task has one CPU).
+fn reproduce_args(job: &ReproduceJob) -> super::reproduce::Args {
+    super::reproduce::Args::for_job(job)
+}
+
+/// The opt-out flags of `inputs`.
+fn input_flags(inputs: Inputs) -> Vec<String> {
+    let mut flags = Vec::new();
+    if inputs.calibration == CalibrationSource::Identity {
+        flags.push(format!("--{IDENTITY_CALIBRATION_FLAG}"));
+    }
+    if inputs.mask == MaskSource::Unmasked {
+        flags.push(format!("--{NO_MASK_FLAG}"));
+    }
+    flags
+}
+
+fn path(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// `--scale S --seed N --out DIR --jobs 1`: what `simulate` and `reproduce` share (a task has
+/// one CPU).
+fn one_thread(scale: Scale, seed: u64, out: &Path) -> [String; 8] {
+    [
+        "--scale".into(),
+        scale.name().into(),
+        "--seed".into(),
+        seed.to_string(),
+        "--out".into(),
+        path(out),
+        "--jobs".into(),
+        "1".into(),
+    ]
+}
+
+/// The `exe ...` command `job` equals (for people reading a jobs file, and for logs). A training
+/// job's representation is shown by the flags the experiments vary (tau, threshold, window,
+/// count threshold); the jobs file holds its whole config.
+pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
+    let mut args: Vec<String> = vec![exe.into()];
+    match job {
+        Job::Simulate(j) => {
+            args.extend([
+                "simulate".into(),
+                "--protocol".into(),
+                j.protocol.name().into(),
+            ]);
+            args.extend(one_thread(j.scale, j.seed, &j.out));
+        }
+        Job::Train(j) => args.extend(train_args(j)),
+        Job::Reproduce(j) => {
+            args.push("reproduce".into());
+            args.extend(one_thread(j.scale, j.seed, &j.out));
+            if let Some(data) = &j.data {
+                args.extend(["--data".into(), path(data)]);
+            }
+            args.extend(input_flags(j.inputs));
+            if let Some(levels) = &j.noise_levels {
+                let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
+                args.extend(["--noise-levels".into(), levels.join(",")]);
+            }
+            if !j.fusions {
+                args.push("--no-fusions".into());
+            }
+        }
+    }
+    args
+}
+
+/// `train DATASET ...` for a training job.
+fn train_args(j: &TrainJob) -> Vec<String> {
+    let mut args = vec!["train".into(), path(&j.dataset)];
+    let spec = &j.spec;
+    args.extend(["--repr".into(), spec.repr.kind().name().into()]);
+    if let Some(s) = spec.repr.static_part() {
+        args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);
+        args.extend(["--threshold".into(), s.threshold.to_string()]);
+    }
+    if let Some(d) = spec.repr.dynamic_part() {
+        args.extend(["--window-ms".into(), d.window_ms.to_string()]);
+        args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
+    }
+    args.extend(["--epochs".into(), spec.epochs.to_string()]);
+    args.extend(["--seed".into(), spec.seed.to_string()]);
+    args.extend(["--splits-seed".into(), j.splits_seed.to_string()]);
+    if spec.sampling == evtac_experiments::sampling::Sampling::WITH_STOP {
+        args.push("--stop-samples".into());
+        if spec.phases.len() > 1 {
+            args.push("--train-on-stop".into());
+        }
+    }
+    args.extend(input_flags(j.inputs));
+    args.extend(["--out".into(), path(&j.out), "--quiet".into()]);
+    args
 }

@@ -6,10 +6,12 @@
 
 use crate::progress::Bars;
 use anyhow::Context;
+use evtac_experiments::job::{self, ReproduceJob};
+use evtac_experiments::jobs::shell_quote;
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
 use evtac_experiments::progress::Progress;
-use evtac_experiments::slurm::{Reproduction, Slurm};
+use evtac_experiments::slurm::Slurm;
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
 use evtac_sim::Scale;
@@ -50,9 +52,9 @@ pub struct Args {
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
-    /// Write the training jobs that are ready (not finished) to FILE, one `evtac train` command
-    /// per line (for a Slurm array or GNU parallel), and stop. Run them, then run `evtac
-    /// reproduce` again with the same arguments: it resumes from the finished jobs.
+    /// Write the training jobs that are ready (not finished) to the jobs file FILE, one job per
+    /// line, and stop. Run them (`evtac jobs run FILE --index K`, e.g. as a Slurm array), then
+    /// run `evtac reproduce` again with the same arguments: it resumes from the finished jobs.
     #[arg(long)]
     pub export_jobs: Option<PathBuf>,
     /// Where the jobs run: `local` (this machine's threads) or `slurm` (each stage's jobs as a
@@ -63,6 +65,26 @@ pub struct Args {
     /// Extra `sbatch` arguments for every Slurm job, e.g. "--partition=cpu --time=4:00:00".
     #[arg(long, allow_hyphen_values = true)]
     pub slurm_args: Option<String>,
+}
+
+impl Args {
+    /// The arguments that run `job` on this machine with one worker thread (the last task of a
+    /// Slurm reproduction, whose task has one CPU).
+    pub fn for_job(job: &ReproduceJob) -> Args {
+        Args {
+            scale: job.scale,
+            data: job.data.clone(),
+            inputs: crate::inputs::InputArgs::of(job.inputs),
+            seed: job.seed,
+            out: job.out.clone(),
+            noise_levels: job.noise_levels.clone(),
+            no_fusions: !job.fusions,
+            workers: crate::workers::Workers { jobs: Some(1) },
+            export_jobs: None,
+            executor: Executor::Local,
+            slurm_args: None,
+        }
+    }
 }
 
 /// Where the jobs of a reproduction run.
@@ -260,15 +282,20 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
     let started = Instant::now();
     let exe = std::env::current_exe().context("finding the evtac binary the tasks run")?;
     let absolute = |p: &PathBuf| std::path::absolute(p).with_context(|| p.display().to_string());
-    let run = Reproduction {
-        exe: exe.display().to_string(),
+    let run = ReproduceJob {
         scale: args.scale,
         seed: args.seed,
         out: absolute(&args.out)?,
         data: args.data.as_ref().map(absolute).transpose()?,
         inputs: args.inputs.inputs(),
         noise_levels: args.noise_levels.clone(),
-        no_fusions: args.no_fusions,
+        fusions: !args.no_fusions,
+    };
+    // Each task runs one job of its array's jobs file with this same binary.
+    let exe = shell_quote(&exe.display().to_string());
+    let task = |file: &std::path::Path| {
+        let file = shell_quote(&file.display().to_string());
+        format!("{exe} jobs run {file} --index \"$SLURM_ARRAY_TASK_ID\"")
     };
     let slurm = Slurm {
         sbatch_args: args
@@ -281,7 +308,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         ..Slurm::default()
     };
     let bars = Bars::default();
-    run.run(&slurm, plan, &bars)?;
+    slurm.reproduce(&run, plan, &task, &bars)?;
     bars.finish();
     println!("{}", run.out.join("report.md").display());
     eprintln!(
@@ -349,21 +376,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         data_dir.display()
     );
     if let Some(file) = &args.export_jobs {
-        let exe = std::env::current_exe()
-            .map(|p| p.display().to_string())
-            .unwrap_or_else(|_| "evtac".into());
-        let lines = pipeline::export_jobs(&data, &plan, args.seed, &args.out, &exe)?;
-        let mut text = lines.join("\n");
-        if !text.is_empty() {
-            text.push('\n');
-        }
-        crate::outputs::write_text(file, &text)?;
+        let jobs = pipeline::export_jobs(&data, &plan, args.seed, &args.out)?;
+        crate::outputs::write_text(file, &job::to_text(&jobs))?;
         bars.finish();
+        let f = file.display();
         eprintln!(
-            "wrote {} training jobs to {}; run them (e.g. `parallel < {}`), then run this command again without --export-jobs",
-            lines.len(),
-            file.display(),
-            file.display()
+            "wrote {} training jobs to {f}; run each with `evtac jobs run {f} --index K` (K from 0 \
+             to `evtac jobs count {f}` - 1; `evtac jobs show {f}` lists them), then run this \
+             command again without --export-jobs",
+            jobs.len(),
         );
         return Ok(());
     }

@@ -3,11 +3,10 @@
 //! bundle.
 
 use anyhow::Context;
-use evtac_experiments::cache::FeatureCache;
-use evtac_experiments::dataset::Dataset;
+use evtac_experiments::job::TrainJob;
 use evtac_experiments::jobs;
 use evtac_experiments::sampling::{Phase, Sampling};
-use evtac_experiments::training::{self, TrainSpec};
+use evtac_experiments::training::TrainSpec;
 use evtac_learn::TrainConfig;
 use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use std::path::PathBuf;
@@ -111,11 +110,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         return Ok(());
     }
-    let repr = args.repr.config()?;
-    let ds = Dataset::open(&args.dataset, args.inputs.inputs())
-        .with_context(|| format!("opening dataset {}", args.dataset.display()))?;
-    let splits = ds.splits(args.splits_seed)?;
-    let cache = FeatureCache::new(&ds)?;
     let sampling = if args.stop_samples {
         Sampling::WITH_STOP
     } else {
@@ -126,25 +120,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         vec![Phase::Motion]
     };
-    let spec = TrainSpec {
-        repr,
-        seed: args.seed,
-        epochs: args.epochs,
-        sampling,
-        phases,
+    let job = TrainJob {
+        dataset: args.dataset.clone(),
+        inputs: args.inputs.inputs(),
+        splits_seed: args.splits_seed,
+        spec: TrainSpec {
+            repr: args.repr.config()?,
+            seed: args.seed,
+            epochs: args.epochs,
+            sampling,
+            phases,
+        },
+        out: args.out.clone(),
     };
-    let trials = ds.manifest.trials.iter().collect::<Vec<_>>();
+    let trials =
+        evtac_events::manifest::Manifest::read(&args.dataset).map_or(0, |m| m.trials.len() as u64);
+    let hidden = || indicatif::ProgressBar::hidden();
     let fbar = if args.quiet {
-        indicatif::ProgressBar::hidden()
+        hidden()
     } else {
-        crate::progress::bar(trials.len() as u64, "features")
+        crate::progress::bar(trials, "features")
     };
-    cache.ensure(&trials, std::slice::from_ref(&repr), sampling, &|_| {
-        fbar.inc(1)
-    })?;
-    fbar.finish_and_clear();
     let bar = if args.quiet {
-        indicatif::ProgressBar::hidden()
+        hidden()
     } else {
         crate::progress::bar(args.epochs as u64, "training")
     };
@@ -154,14 +152,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bar.set_style(style);
     }
     let started = std::time::Instant::now();
-    let val = training::train_job(&cache, &splits, &spec, &args.out, |r| {
-        bar.set_message(format!(
-            "loss {:.4} val MAE {:.3} deg",
-            r.train_loss, r.val_mae
-        ));
-        bar.inc(1);
-    })
-    .with_context(|| format!("training into {}", args.out.display()))?;
+    let val = job
+        .run(&|_| fbar.inc(1), |r| {
+            fbar.finish_and_clear();
+            bar.set_message(format!(
+                "loss {:.4} val MAE {:.3} deg",
+                r.train_loss, r.val_mae
+            ));
+            bar.inc(1);
+        })
+        .with_context(|| format!("training into {}", args.out.display()))?;
     bar.finish_and_clear();
     if !args.quiet {
         eprintln!(

@@ -183,3 +183,21 @@ impl EventSource for Synthetic {
         Ok(Some(ChunkInfo::default()))
     }
 }
+
+/// Runs `source` through the pipeline with the default settings until it ends: each estimate
+/// goes to `on_estimate`, each notice into `notices`.
+pub fn run_to_end(
+    source: Box<dyn evtac_online::input::EventSource>,
+    estimator: Estimator,
+    notices: &mut Vec<Notice>,
+    mut on_estimate: impl FnMut(Estimate),
+) -> evtac_online::Summary {
+    pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
+        match out {
+            Output::Estimate(e) => on_estimate(e),
+            Output::Notice(n) => notices.push(n),
+        }
+        ControlFlow::Continue(())
+    })
+    .unwrap()
+}

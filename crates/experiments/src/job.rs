@@ -1,0 +1,369 @@
+//! [`Job`]: one unit of a reproduction's work, as data. The local pipeline runs its training as
+//! [`TrainJob`]s, `evtac reproduce --export-jobs` writes the ready ones to a jobs file, the Slurm
+//! executor writes one jobs file per array, and `evtac jobs run FILE --index K` runs job `K` of a
+//! file: all four share this type, so a job means the same thing wherever it runs, and no
+//! library code spells a command line that clap would have to parse back.
+//!
+//! A jobs file is JSON Lines: one job per line (line `K` is array task `K`), each object carrying
+//! the file format's version and the job's kind:
+//!
+//! ```text
+//! {"format":1,"job":"train","dataset":"data/exp1","inputs":{...},"splits_seed":0,"spec":{...},"out":"out/models/..."}
+//! ```
+//!
+//! Files written before jobs were typed held shell command lines; reading one is an error that
+//! says to export the jobs again.
+
+use std::path::{Path, PathBuf};
+
+use evtac_events::IoError;
+use evtac_import::inputs::Inputs;
+use evtac_learn::EpochRecord;
+use evtac_sim::{Protocol, Scale};
+use serde::{Deserialize, Serialize};
+
+use crate::cache::FeatureCache;
+use crate::dataset::Dataset;
+use crate::error::Error;
+use crate::results::Mae;
+use crate::splits::Splits;
+use crate::training::{self, TrainSpec};
+
+/// The version of the jobs-file format this build writes and reads.
+pub const FORMAT: u32 = 1;
+
+/// One unit of work.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "job", rename_all = "kebab-case")]
+pub enum Job {
+    /// Simulate one dataset.
+    Simulate(SimulateJob),
+    /// Train one model.
+    Train(TrainJob),
+    /// A whole reproduction on one machine, resuming from every finished job (the Slurm
+    /// executor's last task: evaluation, Experiment 3, latency and the report).
+    Reproduce(ReproduceJob),
+}
+
+impl Job {
+    /// The folder the job writes (finished when it holds a `done` marker).
+    pub fn out(&self) -> &Path {
+        match self {
+            Job::Simulate(j) => &j.out,
+            Job::Train(j) => &j.out,
+            Job::Reproduce(j) => &j.out,
+        }
+    }
+}
+
+/// Simulating one dataset of a protocol with the simulator's defaults (what `evtac simulate`
+/// does without `--params` or `--session`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimulateJob {
+    /// The protocol.
+    pub protocol: Protocol,
+    /// How many trials.
+    pub scale: Scale,
+    /// Master seed.
+    pub seed: u64,
+    /// The dataset folder to write.
+    pub out: PathBuf,
+}
+
+impl SimulateJob {
+    /// Simulates the dataset (nothing when it is done already), calling `on_trial` after each
+    /// trial, and marks it done.
+    pub fn run(&self, on_trial: impl Fn() + Sync) -> Result<(), Error> {
+        if crate::jobs::is_done(&self.out) {
+            return Ok(());
+        }
+        let config = evtac_sim::DatasetConfig::new(self.protocol, self.scale, self.seed);
+        evtac_sim::simulate_dataset(&config, &self.out, |_| on_trial()).map_err(|source| {
+            Error::Simulation {
+                protocol: self.protocol,
+                dir: self.out.clone(),
+                source: Box::new(source),
+            }
+        })?;
+        crate::jobs::mark_done(&self.out)?;
+        Ok(())
+    }
+
+    /// How many trials the dataset has (for a progress bar).
+    pub fn trials(&self) -> usize {
+        let config = evtac_sim::DatasetConfig::new(self.protocol, self.scale, self.seed);
+        evtac_sim::plan(
+            self.protocol,
+            self.scale,
+            self.seed,
+            &config.params.timeline,
+        )
+        .len()
+    }
+}
+
+/// Training one model on a dataset's training split, selected on its validation split (what
+/// `evtac train` does).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainJob {
+    /// The dataset folder.
+    pub dataset: PathBuf,
+    /// Whether its calibration and mask are used or opted out of.
+    pub inputs: Inputs,
+    /// Seed of the train/validation/test split, used when `splits.json` is missing.
+    pub splits_seed: u64,
+    /// What to train.
+    pub spec: TrainSpec,
+    /// The model folder to write.
+    pub out: PathBuf,
+}
+
+impl TrainJob {
+    /// Trains with `cache` (of the job's dataset) and its `splits`: how the local pipeline runs
+    /// many jobs over one opened dataset.
+    pub fn run_on(
+        &self,
+        cache: &FeatureCache<'_>,
+        splits: &Splits,
+        on_epoch: impl FnMut(&EpochRecord),
+    ) -> Result<Mae, training::Error> {
+        training::train_job(cache, splits, &self.spec, &self.out, on_epoch)
+    }
+
+    /// Opens the dataset, makes its splits when missing and the features the job needs
+    /// (`on_trial(reused)` after each trial), then trains (`on_epoch` after each epoch).
+    /// Returns the best validation MAE.
+    pub fn run(
+        &self,
+        on_trial: &(dyn Fn(bool) + Sync),
+        on_epoch: impl FnMut(&EpochRecord),
+    ) -> Result<Mae, Error> {
+        let ds = Dataset::open(&self.dataset, self.inputs)?;
+        let splits = ds.splits(self.splits_seed)?;
+        let cache = FeatureCache::new(&ds)?;
+        let trials: Vec<_> = ds.manifest.trials.iter().collect();
+        cache.ensure(
+            &trials,
+            std::slice::from_ref(&self.spec.repr),
+            self.spec.sampling,
+            on_trial,
+        )?;
+        Ok(self.run_on(&cache, &splits, on_epoch)?)
+    }
+}
+
+/// A reproduction's settings: those of the `evtac reproduce` it stands for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReproduceJob {
+    /// How many trials (and which plan).
+    pub scale: Scale,
+    /// Master seed.
+    pub seed: u64,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Existing datasets, or `None`: simulated into `out/data`.
+    pub data: Option<PathBuf>,
+    /// Where the datasets' calibration and mask come from.
+    pub inputs: Inputs,
+    /// The noise levels Experiment 1 is repeated at, or `None` for the plan's default.
+    pub noise_levels: Option<Vec<f64>>,
+    /// Whether the learned fusions are trained beside the paper's three.
+    pub fusions: bool,
+}
+
+/// Errors reading or writing a jobs file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FileError {
+    /// The file could not be read or written.
+    #[error(transparent)]
+    Io(#[from] IoError),
+    /// The file holds shell command lines, the format before jobs were typed.
+    #[error(
+        "{path}:{line}: this jobs file holds command lines, the format of an earlier evtac; \
+         export the jobs again with this evtac (`evtac reproduce ... --export-jobs FILE`)"
+    )]
+    CommandLines {
+        /// The file.
+        path: PathBuf,
+        /// The first such line (from 1).
+        line: usize,
+    },
+    /// A line is not a job of this format.
+    #[error("{path}:{line}: not a job: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The line (from 1).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A line was written by a newer evtac.
+    #[error(
+        "{path}:{line}: jobs file format {found}, but this evtac reads format {FORMAT}; run the \
+         jobs with the evtac that wrote them, or export them again"
+    )]
+    Version {
+        /// The file.
+        path: PathBuf,
+        /// The line (from 1).
+        line: usize,
+        /// The version found.
+        found: u32,
+    },
+}
+
+/// One line of a jobs file.
+#[derive(Serialize, Deserialize)]
+struct Line<J> {
+    format: u32,
+    #[serde(flatten)]
+    job: J,
+}
+
+/// The version of a line, read before its job (so a newer job kind reports the version).
+#[derive(Deserialize)]
+struct Version {
+    format: u32,
+}
+
+/// `jobs` as the text of a jobs file.
+pub fn to_text(jobs: &[Job]) -> String {
+    let mut text = String::new();
+    for job in jobs {
+        let line = Line {
+            format: FORMAT,
+            job,
+        };
+        // A job is plain data (paths, numbers, enums): it always serializes.
+        let json =
+            serde_json::to_string(&line).unwrap_or_else(|e| unreachable!("a job serializes: {e}"));
+        text.push_str(&json);
+        text.push('\n');
+    }
+    text
+}
+
+/// Writes `jobs` to the jobs file `path`, whole or not at all.
+pub fn write(path: &Path, jobs: &[Job]) -> Result<(), FileError> {
+    crate::jobs::write_atomic(path, to_text(jobs).as_bytes()).map_err(IoError::at(path))?;
+    Ok(())
+}
+
+/// The jobs of a jobs file's `text` (blank lines are not jobs), `path` naming it in errors.
+pub fn parse(path: &Path, text: &str) -> Result<Vec<Job>, FileError> {
+    let mut jobs = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let (line, raw) = (i + 1, raw.trim());
+        if raw.is_empty() {
+            continue;
+        }
+        if !raw.starts_with('{') {
+            return Err(FileError::CommandLines {
+                path: path.to_path_buf(),
+                line,
+            });
+        }
+        let invalid = |e: serde_json::Error| FileError::Invalid {
+            path: path.to_path_buf(),
+            line,
+            message: e.to_string(),
+        };
+        let version: Version = serde_json::from_str(raw).map_err(invalid)?;
+        if version.format != FORMAT {
+            return Err(FileError::Version {
+                path: path.to_path_buf(),
+                line,
+                found: version.format,
+            });
+        }
+        let parsed: Line<Job> = serde_json::from_str(raw).map_err(invalid)?;
+        jobs.push(parsed.job);
+    }
+    Ok(jobs)
+}
+
+/// Reads the jobs file `path`.
+pub fn read(path: &Path) -> Result<Vec<Job>, FileError> {
+    let text = std::fs::read_to_string(path).map_err(IoError::at(path))?;
+    parse(path, &text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{Phase, Sampling};
+    use evtac_repr::{DynamicConfig, ReprKind, StaticConfig};
+
+    fn jobs() -> Vec<Job> {
+        let spec = TrainSpec {
+            repr: ReprKind::Late.config(StaticConfig::default(), DynamicConfig::default()),
+            seed: 3,
+            epochs: 7,
+            sampling: Sampling::WITH_STOP,
+            phases: vec![Phase::Motion, Phase::Stop],
+        };
+        vec![
+            Job::Simulate(SimulateJob {
+                protocol: Protocol::Exp2,
+                scale: Scale::Tiny,
+                seed: 1,
+                out: "data/exp2".into(),
+            }),
+            Job::Train(TrainJob {
+                dataset: "data with spaces/exp1".into(),
+                inputs: Inputs::from_flags(true, false),
+                splits_seed: 1,
+                spec,
+                out: "out/models/exp1/late/seed3".into(),
+            }),
+            Job::Reproduce(ReproduceJob {
+                scale: Scale::Paper,
+                seed: 0,
+                out: "out".into(),
+                data: None,
+                inputs: Inputs::FROM_FILES,
+                noise_levels: Some(vec![0.0, 2.5]),
+                fusions: false,
+            }),
+        ]
+    }
+
+    #[test]
+    fn a_jobs_file_reads_back_the_jobs_it_was_written_from() {
+        let jobs = jobs();
+        let text = to_text(&jobs);
+        assert_eq!(text.lines().count(), jobs.len());
+        assert!(
+            text.lines().all(|l| l.starts_with("{\"format\":1,")),
+            "{text}"
+        );
+        assert_eq!(parse(Path::new("x.jobs"), &text).expect("reads"), jobs);
+        // Blank lines are not jobs.
+        let spaced = text.replace('\n', "\n\n");
+        assert_eq!(parse(Path::new("x.jobs"), &spaced).expect("reads"), jobs);
+    }
+
+    #[test]
+    fn older_and_newer_files_and_broken_lines_are_named() {
+        let path = Path::new("tuning.jobs");
+        let old = "evtac train data/exp1 --repr static --out m --quiet\n";
+        let err = parse(path, old).expect_err("command lines");
+        assert!(
+            err.to_string()
+                .starts_with("tuning.jobs:1: this jobs file holds command lines")
+                && err.to_string().contains("--export-jobs"),
+            "{err}"
+        );
+        let newer = "{\"format\":2,\"job\":\"teleport\"}\n";
+        let err = parse(path, newer).expect_err("newer");
+        assert!(err.to_string().contains("format 2"), "{err}");
+        let text = to_text(&jobs()).replace("\"splits_seed\":1", "\"splits_seed\":\"one\"");
+        let err = parse(path, &text).expect_err("wrong type");
+        assert!(
+            err.to_string().starts_with("tuning.jobs:2: not a job"),
+            "{err}"
+        );
+    }
+}
