@@ -17,7 +17,7 @@ S = sys.argv[1]
 R = sys.argv[2] if len(sys.argv) > 2 else os.path.join(
     os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "fixtures", "real"
 )
-for target in ("aedat", "evt2", "evt3", "csv", "npy"):
+for target in ("aedat", "evt2", "evt3", "csv", "npy", "neurotac"):
     os.makedirs(os.path.join(S, target), exist_ok=True)
 rng = np.random.default_rng(7)
 # NPY: the event record in several forms numpy writes
@@ -109,3 +109,26 @@ for kind, name in (
 b = open(f"{R}/dvxplorer_320x240_imu.aedat4", "rb").read()
 for n in (4096, 16384, 65536):
     open(f"{S}/aedat/real_{n}.aedat4", "wb").write(b[:n])
+
+# NeuroTac: the lab's per-pixel pickles, small grids, every protocol, both index orders, NPY
+import pickle
+for h, w in ((3, 4), (2, 2), (5, 1)):
+    a = np.empty((h, w), dtype=object)
+    for y in range(h):
+        for x in range(w):
+            a[y, x] = [round(float(v), 3) for v in np.sort(rng.uniform(0, 50, rng.integers(0, 3)))]
+    lists = [[list(a[y, x]) for y in range(h)] for x in range(w)]
+    for protocol in (2, 3, 4, 5):
+        with open(os.path.join(S, "neurotac", f"array_{h}x{w}_p{protocol}"), "wb") as f:
+            pickle.dump(a, f, protocol=protocol)
+        with open(os.path.join(S, "neurotac", f"lists_{h}x{w}_p{protocol}"), "wb") as f:
+            pickle.dump(lists, f, protocol=protocol)
+    np.save(os.path.join(S, "neurotac", f"npy_{h}x{w}.npy"), a, allow_pickle=True)
+    cells = np.empty((h, w), dtype=object)
+    for y in range(h):
+        for x in range(w):
+            cells[y, x] = np.array(a[y, x], dtype=np.float64)
+    with open(os.path.join(S, "neurotac", f"numeric_cells_{h}x{w}"), "wb") as f:
+        pickle.dump(cells, f, protocol=4)
+with open(os.path.join(S, "neurotac", "dict"), "wb") as f:
+    pickle.dump({"events": [1.0, 2.5], "n": 2}, f, protocol=4)

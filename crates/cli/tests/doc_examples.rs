@@ -157,6 +157,15 @@ fn real_data_setup(dir: &Path) -> Option<()> {
     ] {
         std::fs::copy(sim.join(name), dir.join(name)).ok()?;
     }
+    // The NeuroTac lab's pickles of one trial, as its collection script writes them.
+    evtac_testkit::run_python(
+        "import pickle, sys, numpy as np\n\
+         for pol, n in (('on', 3), ('off', 2)):\n\
+         \x20   a = np.empty((480, 640), dtype=object)\n\
+         \x20   for i in range(a.size): a.flat[i] = [i % 997 + k * 0.25 for k in range(n)] if i % 13 == 0 else []\n\
+         \x20   pickle.dump(a, open(sys.argv[1] + f'/trial_07_events_{pol}.pickle', 'wb'))",
+        &[s(dir)],
+    )?;
     Some(())
 }
 

@@ -118,6 +118,14 @@ pub enum Error {
         /// What is wrong.
         error: NpyError,
     },
+    /// A NeuroTac pickle (or its pair) is not the lab's structure, or is broken.
+    #[error("{error}")]
+    Neurotac {
+        /// The file opened.
+        path: PathBuf,
+        /// What is wrong (naming the file of the pair it is in).
+        error: Box<crate::neurotac::NeurotacError>,
+    },
     /// An event read from the file is invalid (outside the sensor, or earlier than its
     /// predecessor).
     #[error("{}: {error}", path.display())]

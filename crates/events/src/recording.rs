@@ -44,6 +44,9 @@ pub enum Format {
     Csv,
     /// NPY with the record dtype `t <i8, x <i2, y <i2, p u1` (`.npy`).
     Npy,
+    /// The NeuroTac lab's per-pixel event times (a pickle, or an NPY of Python objects), read
+    /// only (see [`crate::neurotac`]).
+    Neurotac,
 }
 
 impl Format {
@@ -59,6 +62,7 @@ impl Format {
             Self::Evt3 => "EVT3",
             Self::Csv => "CSV",
             Self::Npy => "NPY",
+            Self::Neurotac => "NeuroTac pickle",
         }
     }
 
@@ -77,6 +81,10 @@ impl Format {
             "raw" => Err(Error::NotWritable {
                 path: path.to_path_buf(),
                 format: Self::Evt3,
+            }),
+            "pickle" | "pkl" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::Neurotac,
             }),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
@@ -99,6 +107,9 @@ impl Format {
             .map_err(io)?;
         if head.starts_with(crate::aedat::MAGIC) {
             return Ok(Self::Aedat4);
+        }
+        if crate::neurotac::sniff(&head) {
+            return Ok(Self::Neurotac);
         }
         if head.starts_with(crate::npy::MAGIC) {
             return Ok(Self::Npy);
@@ -198,6 +209,34 @@ enum Inner {
     Evt(Box<EvtReader<File>>),
     Csv(Box<CsvReader<BufReader<File>>>),
     Npy(Box<NpyReader<File>>),
+    Memory(Box<MemoryEvents>),
+}
+
+/// A recording read whole (the NeuroTac pickles, which must be parsed whole), handed out in
+/// chunks like the streaming readers'.
+struct MemoryEvents {
+    events: Vec<Event>,
+    next: usize,
+    resolution: Resolution,
+    check: EventCheck,
+    /// Bytes of the files, for positions: all read at once.
+    len: u64,
+}
+
+impl MemoryEvents {
+    /// Events per chunk, as the file readers hand them out.
+    const CHUNK: usize = 1 << 16;
+
+    fn next_chunk(&mut self) -> Result<Option<&[Event]>, crate::check::CheckError> {
+        if self.next >= self.events.len() {
+            return Ok(None);
+        }
+        let end = (self.next + Self::CHUNK).min(self.events.len());
+        let chunk = &self.events[self.next..end];
+        self.check.check(chunk)?;
+        self.next = end;
+        Ok(Some(chunk))
+    }
 }
 
 /// A streaming reader of any supported event file (see [`open`]).
@@ -205,6 +244,9 @@ pub struct EventReader {
     path: PathBuf,
     format: Format,
     source: Option<String>,
+    /// What a user should know about the file that its counts do not say (a NeuroTac pickle's
+    /// millisecond times and missing polarity).
+    note: Option<String>,
     len: u64,
     inner: Inner,
     /// Validation of AEDAT4 events (the other readers validate their own).
@@ -266,6 +308,7 @@ pub fn open_with(
     }
     // The AEDAT4 event stream's size, which the reader checks events against.
     let mut resolution = None;
+    let mut note = None;
     let (inner, source) = match format {
         Format::Aedat4 => {
             let mut r = AedatReader::open(path).map_err(|error| Error::Aedat {
@@ -318,12 +361,28 @@ pub fn open_with(
             })?;
             (Inner::Npy(Box::new(r)), None)
         }
+        Format::Neurotac => {
+            let file = crate::neurotac::read_pair(path).map_err(|error| Error::Neurotac {
+                path: path.to_path_buf(),
+                error: Box::new(error),
+            })?;
+            note = Some(file.note());
+            let r = MemoryEvents {
+                check: EventCheck::new(Some(file.resolution)),
+                resolution: file.resolution,
+                events: file.events,
+                next: 0,
+                len,
+            };
+            (Inner::Memory(Box::new(r)), None)
+        }
     };
     let aedat_check = EventCheck::new(resolution);
     Ok(EventReader {
         path: path.to_path_buf(),
         format,
         source,
+        note,
         len,
         inner,
         aedat_check,
@@ -358,7 +417,14 @@ impl EventReader {
             Inner::Evt(r) => r.resolution(),
             Inner::Csv(r) => r.resolution(),
             Inner::Npy(r) => r.resolution(),
+            Inner::Memory(r) => Some(r.resolution),
         }
+    }
+
+    /// What a user should know about the file that its counts do not say (for a NeuroTac
+    /// pickle: its index order, ON-only, and that its times are milliseconds).
+    pub fn note(&self) -> Option<&str> {
+        self.note.as_deref()
     }
 
     /// Declares the sensor size (needed for CSV and NPY, which do not store it): events from now
@@ -380,6 +446,8 @@ impl EventReader {
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
+            // Its own size, checked above.
+            Inner::Memory(_) => {}
         }
         Ok(())
     }
@@ -397,6 +465,13 @@ impl EventReader {
             Inner::Evt(r) => r.position(),
             Inner::Csv(r) => r.position(),
             Inner::Npy(r) => r.position(),
+            Inner::Memory(r) => {
+                if r.next > 0 {
+                    r.len
+                } else {
+                    0
+                }
+            }
         }
     }
 
@@ -592,6 +667,18 @@ fn next_unfiltered<'a>(
                 })
             })
             .map_err(|error| Error::Npy {
+                path: path.to_path_buf(),
+                error,
+            }),
+        Inner::Memory(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|events| Chunk {
+                    events,
+                    ..Chunk::default()
+                })
+            })
+            .map_err(|error| Error::Event {
                 path: path.to_path_buf(),
                 error,
             }),

@@ -78,6 +78,10 @@ pub struct Summary {
     /// none chosen (the streams' own rows still count everything).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub selection: Option<String>,
+    /// What the counts do not say about the file (a NeuroTac pickle's index order, missing
+    /// polarity and millisecond times).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 impl Summary {
@@ -100,6 +104,7 @@ impl Summary {
             triggers: 0,
             streams: Vec::new(),
             selection: None,
+            note: reader.note().map(str::to_string),
         };
         while let Some(chunk) = reader.next_chunk()? {
             if let (Some(first), Some(last)) = (chunk.events.first(), chunk.events.last()) {
@@ -249,6 +254,7 @@ impl Summary {
             triggers: triggers.map_or(0, |r| r.count),
             streams: Vec::new(),
             selection: note,
+            note: None,
         };
         s.set_imu_rate();
         s.streams = rows;

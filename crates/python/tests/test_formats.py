@@ -1,5 +1,6 @@
-"""The formats without a real fixture: AEDAT 2.0 (jAER), AEDAT 3.1 (cAER) and Prophesee EVT 2.1,
-written here from the format descriptions (as evtac-events' own tests write them). `read` and
+"""The formats without a real fixture: AEDAT 2.0 (jAER), AEDAT 3.1 (cAER), Prophesee EVT 2.1,
+written here from the format descriptions (as evtac-events' own tests write them), and the
+NeuroTac lab's per-pixel pickles, written by Python's pickle as its collection scripts do. `read` and
 `open` give the events, IMU samples and triggers the writer encoded, and the events of the CLI's
 `evtac convert`."""
 
@@ -100,8 +101,31 @@ def _evt21(path):
     return events, [], triggers, (240, 180), "EVT21"
 
 
+def _neurotac(path):
+    """The lab's pair: `<trial>_events_on` / `_events_off`, each a numpy object array [y, x] of
+    per-pixel lists of millisecond times (microsecond resolution)."""
+    import pickle
+    rng = random.Random(5)
+    w, h = 240, 180
+    events = []
+    for pol, name in ((1, path.name), (0, path.name.replace("events_on", "events_off"))):
+        cells = np.empty((h, w), dtype=object)
+        for i in range(w * h):
+            cells.flat[i] = []
+        for _ in range(3000):
+            x, y = rng.randrange(w), rng.randrange(h)
+            t_us = rng.randrange(10_000_000)
+            cells[y, x].append(t_us / 1000)
+            events.append((t_us, x, y, pol))
+        with open(path.with_name(name), "wb") as f:
+            pickle.dump(cells, f, protocol=5)
+    events.sort(key=lambda e: (e[0], e[2], e[1], e[3]))
+    return events, [], [], (w, h), "NeuroTac pickle"
+
+
 @pytest.mark.parametrize("name,writer", [("aedat2.aedat", _aedat2), ("aedat31.aedat", _aedat31),
-                                         ("evt21.raw", _evt21)])
+                                         ("evt21.raw", _evt21),
+                                         ("trial_events_on.pickle", _neurotac)])
 def test_read_and_open_give_what_was_written_and_the_clis_events(cli, tmp_path, name, writer):
     path = tmp_path / name
     events, imu, triggers, resolution, fmt = writer(path)

@@ -69,6 +69,9 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     if s.triggers > 0 {
         out += &format!("triggers:    {}\n", s.triggers);
     }
+    if let Some(note) = &s.note {
+        out += &format!("note:        {note}\n");
+    }
     if let Some(why) = &s.selection {
         out += &format!(
             "note:        {why}; the counts above are empty, the streams below are whole\n"

@@ -10,5 +10,6 @@ mod common;
 mod csv;
 mod evt;
 mod evt21;
+mod neurotac;
 mod npy;
 mod recording;
