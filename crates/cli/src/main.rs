@@ -9,6 +9,7 @@ mod inputs;
 mod kinds;
 mod outputs;
 mod progress;
+mod sensor;
 mod streams;
 mod workers;
 

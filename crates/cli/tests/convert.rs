@@ -23,7 +23,8 @@ fn aedat4_to_csv_to_npy_to_aedat4_is_identical() {
         dir.path().join("imu.csv"),
     );
     run_ok(&["convert", s(&src), s(&csv), "--imu", s(&imu)]);
-    run_ok(&["convert", s(&csv), s(&npy), "--resolution", "320x240"]);
+    run_ok(&["convert", s(&csv), s(&npy), "--sensor", "320x240"]);
+    // `--resolution`, the flag's name before `--sensor`, still works.
     run_ok(&["convert", s(&npy), s(&back), "--resolution", "320x240"]);
     let original = read_recording(&src).unwrap();
     let round = read_recording(&back).unwrap();
@@ -95,9 +96,9 @@ fn missing_or_wrong_resolution_is_a_clear_error() {
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--resolution"), "{err}");
+    assert!(err.contains("--sensor"), "{err}");
     let out = evtac()
-        .args(["convert", s(&csv), s(&out_path), "--resolution", "640x480"])
+        .args(["convert", s(&csv), s(&out_path), "--sensor", "640x480"])
         .output()
         .unwrap();
     assert!(!out.status.success());
@@ -251,7 +252,7 @@ fn time_range_of_the_real_recording_and_of_a_csv() {
     assert_eq!(read_recording(&out).unwrap(), expected);
     // A format without an index is cut the same way, without a warning.
     run_ok(&["convert", s(&src), s(&csv)]);
-    let err = convert_range(&csv, &csv_cut, from, to, &["--resolution", "320x240"]);
+    let err = convert_range(&csv, &csv_cut, from, to, &["--sensor", "320x240"]);
     assert!(!err.contains("warning"), "{err}");
     assert_eq!(read_recording(&csv_cut).unwrap().events, expected.events);
 }

@@ -64,7 +64,7 @@ fn convert_refuses_to_write_over_its_input_by_path_or_through_links() {
     let csv = dir.path().join("x.csv");
     run_ok(&["convert", s(&input), s(&csv)]);
     let csv_bytes = std::fs::read(&csv).unwrap();
-    let err = run_err(&["convert", s(&csv), s(&csv), "--resolution", "64x48"]);
+    let err = run_err(&["convert", s(&csv), s(&csv), "--sensor", "64x48"]);
     assert!(err.contains("refusing to write over it"), "{err}");
     assert_eq!(std::fs::read(&csv).unwrap(), csv_bytes);
 }

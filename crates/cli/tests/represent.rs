@@ -59,7 +59,7 @@ fn features_equal_the_library_and_frames_have_the_crop_shape() {
         s(&events_path),
         "--samples".into(),
         s(&samples_path),
-        "--resolution".into(),
+        "--sensor".into(),
         "32x24".into(),
         "--roi".into(),
         "none".into(),
@@ -132,7 +132,7 @@ fn default_roi_is_the_centered_240_crop_and_masks_apply() {
             events_path.to_str().unwrap().into(),
             "--samples".into(),
             samples_path.to_str().unwrap().into(),
-            "--resolution".into(),
+            "--sensor".into(),
             "640x480".into(),
             "--repr".into(),
             "static".into(),
@@ -202,16 +202,16 @@ fn bad_inputs_fail_with_clear_messages() {
         assert!(!o.status.success(), "{extra:?} should fail");
         String::from_utf8_lossy(&o.stderr).into_owned()
     };
-    let err = run(&["--resolution", "32x24", "--roi", "none"]);
+    let err = run(&["--sensor", "32x24", "--roi", "none"]);
     assert!(err.contains("line 2") && err.contains("before"), "{err}");
 
     std::fs::write(&samples_path, "100\n").unwrap();
-    let err = run(&["--resolution", "32x24"]);
+    let err = run(&["--sensor", "32x24"]);
     assert!(err.contains("does not fit"), "{err}");
     let err = run(&["--roi", "none"]);
-    assert!(err.contains("--resolution"), "{err}");
+    assert!(err.contains("--sensor"), "{err}");
     let err = run(&[
-        "--resolution",
+        "--sensor",
         "32x24",
         "--roi",
         "none",
@@ -221,8 +221,8 @@ fn bad_inputs_fail_with_clear_messages() {
         "potential",
     ]);
     assert!(err.contains("potential"), "{err}");
-    let err = run(&["--resolution", "32x24", "--roi", "none", "--tau-ms", "0"]);
+    let err = run(&["--sensor", "32x24", "--roi", "none", "--tau-ms", "0"]);
     assert!(err.contains("tau_ms"), "{err}");
-    let err = run(&["--resolution", "30x24", "--roi", "none"]);
+    let err = run(&["--sensor", "30x24", "--roi", "none"]);
     assert!(err.contains("multiples of 8"), "{err}");
 }

@@ -27,10 +27,8 @@ pub struct Args {
     /// Also write the IMU samples to this CSV file (t,ax,ay,az,gx,gy,gz,temperature).
     #[arg(long, value_name = "IMU_OUT.csv")]
     pub imu: Option<PathBuf>,
-    /// Sensor size WIDTHxHEIGHT; required for inputs that do not store it (CSV, NPY), and
-    /// checked against every event.
-    #[arg(long, value_name = "WxH")]
-    pub resolution: Option<Resolution>,
+    #[command(flatten)]
+    pub sensor: crate::sensor::SensorArgs,
     /// Keep only the centered WIDTHxHEIGHT region: events outside are dropped, coordinates are
     /// shifted into it, and the output's resolution is the region's.
     #[arg(long, value_name = "WxH")]
@@ -80,7 +78,7 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         refuse_input(imu, &[&args.input, &args.output])?;
     }
     let mut reader = evtac_events::open_with(&args.input, &args.streams.selection())?;
-    if let Some(resolution) = args.resolution {
+    if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }
     if args.from_us.is_some() || args.to_us.is_some() {
@@ -104,7 +102,7 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
     }
     let Some(sensor) = reader.resolution() else {
         bail!(
-            "{} is {} and does not store the sensor size: pass --resolution WIDTHxHEIGHT",
+            "{} is {} and does not store the sensor size: pass --sensor WIDTHxHEIGHT",
             args.input.display(),
             reader.format()
         );

@@ -6,7 +6,6 @@
 //! instead and says that latency needs `--realtime`.
 
 use anyhow::Context;
-use evtac_events::Resolution;
 use evtac_events::output::{OutputFile, refuse_input};
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
@@ -42,9 +41,8 @@ pub struct Args {
     /// absent.
     #[arg(long)]
     pub output: Option<PathBuf>,
-    /// Sensor size `WIDTHxHEIGHT` for inputs that do not state it (CSV, NPY).
-    #[arg(long)]
-    pub sensor: Option<Resolution>,
+    #[command(flatten)]
+    pub sensor: crate::sensor::SensorArgs,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
     /// Chunks the queue between ingestion and estimation holds.
@@ -117,7 +115,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let options = OpenOptions {
         realtime: args.realtime,
         slice_us: args.slice_us,
-        sensor: args.sensor,
+        sensor: args.sensor.sensor,
         network: NetworkOptions {
             backoff: Backoff {
                 initial: Duration::from_millis(args.reconnect_initial_ms),

@@ -95,9 +95,8 @@ pub struct Args {
     /// no-contact mask (instead of --repr, the settings, --roi and --mask).
     #[arg(long, value_name = "MODEL_DIR", conflicts_with = "settings")]
     pub model: Option<PathBuf>,
-    /// Sensor resolution WIDTHxHEIGHT (needed when the file does not say; overrides it).
-    #[arg(long)]
-    pub resolution: Option<Resolution>,
+    #[command(flatten)]
+    pub sensor: crate::sensor::SensorArgs,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
     /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
@@ -225,7 +224,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let samples = read_samples(&args.samples)?;
 
-    let (sensor, events) = read_events(&args.events, args.resolution, &args.streams)?;
+    let (sensor, events) = read_events(&args.events, args.sensor.sensor, &args.streams)?;
     let roi = match &model {
         Some(m) => Roi::centered(sensor, m.representation().frame).with_context(|| {
             format!(
@@ -306,7 +305,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Reads a recording and its sensor resolution (`--resolution` wins over the file's).
+/// Reads a recording and its sensor size: the file's, which `--sensor` must agree with, or
+/// `--sensor` for a file that states none.
 fn read_events(
     path: &Path,
     resolution: Option<Resolution>,
@@ -315,9 +315,16 @@ fn read_events(
     let rec = evtac_events::open_with(path, &streams.selection())
         .and_then(evtac_events::EventReader::into_recording)
         .with_context(|| format!("reading events from {}", path.display()))?;
+    if let (Some(given), Some(found)) = (resolution, rec.resolution) {
+        ensure!(
+            given == found,
+            "{} states a {found} sensor, but --sensor says {given}",
+            path.display()
+        );
+    }
     let sensor = resolution.or(rec.resolution).with_context(|| {
         format!(
-            "{} does not state its sensor resolution: pass --resolution WIDTHxHEIGHT",
+            "{} does not state its sensor resolution: pass --sensor WIDTHxHEIGHT",
             path.display()
         )
     })?;
@@ -390,7 +397,7 @@ fn read_mask(
     let Some(static_config) = config.static_part() else {
         bail!("--mask applies to the static part: it needs --repr static or combined");
     };
-    let (sensor, events) = read_events(path, args.resolution, &args.streams)
+    let (sensor, events) = read_events(path, args.sensor.sensor, &args.streams)
         .with_context(|| format!("reading the no-contact recording {}", path.display()))?;
     let roi = parse_roi(args.roi.as_deref(), sensor)?;
     Mask::from_recording(&roi, static_config, &events)
