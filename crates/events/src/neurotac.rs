@@ -254,7 +254,7 @@ fn push_events(pixels: &PixelTimes, polarity: bool, out: &mut Vec<Event>) {
 /// The bytes of one file (a pickle, or an object NPY) as per-pixel times.
 fn decode(path: &Path, bytes: &[u8]) -> Result<PixelTimes, NeurotacError> {
     let start = npy_pickle_offset(bytes).unwrap_or(0);
-    let (value, _) = pickle::read(&bytes[start..]).map_err(|error| NeurotacError::Pickle {
+    let (pickle, _) = pickle::read(&bytes[start..]).map_err(|error| NeurotacError::Pickle {
         path: path.to_path_buf(),
         error,
     })?;
@@ -263,7 +263,7 @@ fn decode(path: &Path, bytes: &[u8]) -> Result<PixelTimes, NeurotacError> {
         what,
     };
     let mut budget = Budget::new(bytes.len());
-    pixel_times(&value, &mut budget).map_err(structure)
+    pixel_times(&pickle.value, &mut budget).map_err(structure)
 }
 
 /// How many values the walk may visit: a few per input byte. A pickle that refers to its own

@@ -14,7 +14,10 @@
 //! Bounded: every length is checked against the bytes left before anything is allocated, the
 //! memo is a map (an index in the stream cannot make a huge table), and containers are shared
 //! (`Rc`), as Python shares them, so a stream of `n` bytes builds at most `O(n)` values; walking
-//! a tree that refers to itself is the caller's to bound ([`Value`]'s depth).
+//! a tree that refers to itself is the caller's to bound. A pickle can make a list contain
+//! itself, which shared `Rc`s would never free: every mutable container the stream creates is
+//! registered, and emptied when the [`Pickle`] (or a failed read) is dropped, which breaks
+//! every cycle (one found by fuzzing: a list appended to itself through the memo).
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -49,6 +52,44 @@ pub enum Value {
     /// The result of calling `callable` with `args` (`REDUCE`, `NEWOBJ`), with the state a
     /// later `BUILD` gave it.
     Object(Rc<RefCell<Object>>),
+}
+
+/// Every mutable container a stream created (only those can close a cycle: a tuple holds values
+/// made before it), emptied on drop so that reference cycles free.
+#[derive(Default)]
+struct Registry(Vec<Value>);
+
+impl Drop for Registry {
+    fn drop(&mut self) {
+        for container in &self.0 {
+            match container {
+                Value::List(l) => l.borrow_mut().clear(),
+                Value::Dict(d) => d.borrow_mut().clear(),
+                Value::Object(o) => {
+                    let mut o = o.borrow_mut();
+                    o.args = Value::None;
+                    o.state = None;
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// A pickle read: its value, valid while this lives (dropping it frees every container the
+/// stream made, cycles included).
+pub struct Pickle {
+    /// The pickled value.
+    pub value: Value,
+    _containers: Registry,
+}
+
+impl std::fmt::Debug for Pickle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pickle")
+            .field("value", &self.value.describe())
+            .finish_non_exhaustive()
+    }
 }
 
 /// A call recorded by [`Value::Object`].
@@ -131,23 +172,29 @@ struct Machine<'a> {
     stack: Vec<Value>,
     marks: Vec<usize>,
     memo: HashMap<u32, Value>,
+    containers: Registry,
 }
 
-/// Reads one pickle from the start of `data`; returns its value and the offset just past its
-/// `STOP` opcode.
-pub fn read(data: &[u8]) -> Result<(Value, usize), PickleError> {
+/// Reads one pickle from the start of `data`; returns it and the offset just past its `STOP`
+/// opcode.
+pub fn read(data: &[u8]) -> Result<(Pickle, usize), PickleError> {
     let mut m = Machine {
         data,
         pos: 0,
         stack: Vec::new(),
         marks: Vec::new(),
         memo: HashMap::new(),
+        containers: Registry::default(),
     };
     loop {
         let at = m.pos;
         let op = m.byte()?;
         if let Some(value) = m.step(op, at)? {
-            return Ok((value, m.pos));
+            let pickle = Pickle {
+                value,
+                _containers: std::mem::take(&mut m.containers),
+            };
+            return Ok((pickle, m.pos));
         }
         if m.stack.len() > MAX_STACK || m.marks.len() > MAX_STACK {
             return Err(m.malformed(at, "the stack grows past a million entries".into()));
@@ -300,12 +347,18 @@ impl Machine<'_> {
     fn call(&mut self, at: usize) -> Result<(), PickleError> {
         let args = self.pop(at)?;
         let callable = self.pop(at)?;
-        self.stack.push(Value::Object(Rc::new(RefCell::new(Object {
+        self.push_container(Value::Object(Rc::new(RefCell::new(Object {
             callable,
             args,
             state: None,
         }))));
         Ok(())
+    }
+
+    /// Pushes a new mutable container, registered to be emptied on drop.
+    fn push_container(&mut self, container: Value) {
+        self.containers.0.push(container.clone());
+        self.stack.push(container);
     }
 
     fn int_text(&mut self, at: usize) -> Result<(), PickleError> {
@@ -420,12 +473,12 @@ impl Machine<'_> {
                 self.push_bytes(n)?;
             }
             0x97 | 0x98 => return Err(unsupported("out-of-band buffers")),
-            b']' => self.stack.push(Value::List(Rc::default())),
+            b']' => self.push_container(Value::List(Rc::default())),
             b')' => self.stack.push(Value::Tuple(Rc::from(Vec::new()))),
-            b'}' => self.stack.push(Value::Dict(Rc::default())),
+            b'}' => self.push_container(Value::Dict(Rc::default())),
             b'l' => {
                 let items = self.pop_mark(at)?;
-                self.stack.push(Value::List(Rc::new(RefCell::new(items))));
+                self.push_container(Value::List(Rc::new(RefCell::new(items))));
             }
             b't' => {
                 let items = self.pop_mark(at)?;
@@ -433,7 +486,7 @@ impl Machine<'_> {
             }
             b'd' => {
                 let items = self.pop_mark(at)?;
-                self.stack.push(Value::Dict(Rc::default()));
+                self.push_container(Value::Dict(Rc::default()));
                 self.set_items(items, at)?;
             }
             0x85..=0x87 => {
@@ -541,6 +594,25 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_list_that_contains_itself_is_freed() {
+        // EMPTY_LIST, BINPUT 0, BINGET 0, APPEND, STOP: `l = []; l.append(l)`.
+        let (pickle, _) = read(&[b']', b'q', 0, b'h', 0, b'a', b'.']).expect("reads");
+        let Value::List(list) = &pickle.value else {
+            panic!("a list")
+        };
+        let weak = Rc::downgrade(list);
+        assert!(Rc::ptr_eq(
+            list,
+            match &list.borrow()[0] {
+                Value::List(inner) => inner,
+                _ => panic!("itself"),
+            }
+        ));
+        drop(pickle);
+        assert!(weak.upgrade().is_none(), "the cycle kept the list alive");
+    }
+
+    #[test]
     fn a_list_of_floats_and_a_memoized_reference() {
         // pickle.dumps([1.5, [], 2], protocol=2) with the inner list referenced twice by hand:
         // PROTO 2, EMPTY_LIST, BINPUT 0, MARK, BINFLOAT 1.5, EMPTY_LIST, BINPUT 1, BININT1 2,
@@ -548,9 +620,9 @@ mod tests {
         let mut p = vec![0x80, 2, b']', b'q', 0, b'(', b'G'];
         p.extend_from_slice(&1.5f64.to_be_bytes());
         p.extend_from_slice(&[b']', b'q', 1, b'K', 2, b'h', 1, b'e', b'.']);
-        let (v, end) = read(&p).expect("reads");
+        let (pickle, end) = read(&p).expect("reads");
         assert_eq!(end, p.len());
-        let Value::List(list) = v else {
+        let Value::List(list) = &pickle.value else {
             panic!("a list")
         };
         let list = list.borrow();
@@ -590,8 +662,8 @@ mod tests {
     #[test]
     fn a_global_is_a_name_not_a_call() {
         // `os.system('echo')` in protocol 0: read as a recorded call, never made.
-        let (v, _) = read(b"cos\nsystem\n(VEcho\ntR.").expect("reads as data");
-        let Value::Object(o) = v else {
+        let (pickle, _) = read(b"cos\nsystem\n(VEcho\ntR.").expect("reads as data");
+        let Value::Object(o) = &pickle.value else {
             panic!("a recorded call")
         };
         assert_eq!(

@@ -61,7 +61,8 @@ pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
         };
         if !allowed {
             return Err(error::value(format!(
-                "`{key}` is not a setting of a {kind} representation"
+                "`{key}` is not a setting of a {} representation",
+                kind.name()
             )));
         }
         part.insert(key, value);
