@@ -1,16 +1,16 @@
 //! What a reproduction shows, from its [`evtac_experiments::results::Results`]: `report.md`
 //! (tables with the paper's numbers beside ours, the values evtac chose, stage times),
-//! `results.json` and the PNG figures ([`write`]), and `evtac render`'s animations of a
+//! `results.json` and the PNG figures ([`write()`]), and `evtac render`'s animations of a
 //! recording ([`render`]). Both draw with one plotting stack ([`plots`]: the embedded font,
 //! colours, canvases and charts), so a rendered frame is the report's Fig. 2 at another time.
 //!
-//! - [`write`] and [`markdown`]: the report's files and its Markdown, section by section (the
+//! - [`write()`] and [`markdown()`]: the report's files and its Markdown, section by section (the
 //!   learned-fusion verdicts in `markdown/fusion.rs`, the label check in `markdown/labels.rs`).
 //! - [`plots`]: one figure family per submodule.
 //! - [`render`]: frames of a recording as GIF, MP4 or PNG sheet.
 //!
 //! The crate reads results; it runs nothing. `evtac reproduce` runs the pipeline
-//! (`evtac-experiments`), then calls [`write`].
+//! (`evtac-experiments`), then calls [`write()`].
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
