@@ -76,18 +76,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
 }
 
-/// Runs `job` in this process.
+/// Runs `job` in this process, on one worker thread: an array task has one CPU, and the
+/// node's other cores are other tasks' (what `--jobs 1` said in the command lines).
 fn run_job(job: &Job) -> anyhow::Result<()> {
-    match job {
-        Job::Simulate(j) => j.run(|| {})?,
-        Job::Train(j) => {
-            if !evtac_experiments::jobs::is_done(&j.out) {
-                j.run(&|_| {}, |_| {})?;
+    let pool = crate::workers::Workers { jobs: Some(1) }.pool()?;
+    pool.install(|| {
+        match job {
+            Job::Simulate(j) => j.run(|| {})?,
+            Job::Train(j) => {
+                if !evtac_experiments::jobs::is_done(&j.out) {
+                    j.run(&|_| {}, |_| {})?;
+                }
             }
+            Job::Reproduce(j) => super::reproduce::run(reproduce_args(j))?,
         }
-        Job::Reproduce(j) => super::reproduce::run(reproduce_args(j))?,
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// The `evtac reproduce` arguments of `job`, run locally on one thread (a task has one CPU).
