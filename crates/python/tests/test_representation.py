@@ -161,5 +161,5 @@ def test_bad_arguments_are_value_errors(recording):
     rep.push(e[500:])
     with pytest.raises(ValueError, match="out of time order"):
         rep.push(e[:10])
-    with pytest.raises(ValueError, match="the mask is 10x10 but the crop is 240x240"):
+    with pytest.raises(ValueError, match="mask is 10x10 but the frame is 240x240"):
         evtac.Representation("static", mask=np.zeros((10, 10)))
