@@ -19,6 +19,18 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
+    /// These flags as command-line words (`--identity-calibration`, `--no-mask`).
+    pub fn words(&self) -> Vec<String> {
+        let mut flags = Vec::new();
+        if self.identity_calibration {
+            flags.push(format!("--{IDENTITY_CALIBRATION_FLAG}"));
+        }
+        if self.no_mask {
+            flags.push(format!("--{NO_MASK_FLAG}"));
+        }
+        flags
+    }
+
     /// The flags that ask for `inputs`.
     pub fn of(inputs: Inputs) -> InputArgs {
         InputArgs {

@@ -142,33 +142,26 @@ fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
 
 /// Reads a recording's events, cropped to the centered [`CROP`], in time order.
 pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
+    Ok(read_in_crop(path)?.1)
+}
+
+/// A recording's centered [`CROP`] on its sensor, and its events cropped to it.
+fn read_in_crop(path: &Path) -> Result<(Roi, Vec<Event>), Error> {
     let (sensor, events) = read_full(path)?;
     let roi = crop_of(sensor, path)?;
     let mut cropped = Vec::with_capacity(events.len());
     roi.crop_into(&events, &mut cropped);
-    Ok(cropped)
+    Ok((roi, cropped))
 }
 
-/// A dataset's no-contact recording as read once for every config's mask: its events on the
-/// full sensor, and the centered [`CROP`] the masks are built on.
+/// A dataset's no-contact recording, read and cropped once for every config's mask.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NoContact {
-    /// The sensor's size.
-    pub sensor: Resolution,
-    /// The crop the masks cover.
+    /// The crop of the sensor the events were cut to (what `Mask::from_recording` cuts).
     pub roi: Roi,
-    /// The events, sensor coordinates, time order.
-    pub events: Vec<Event>,
-}
-
-impl NoContact {
-    /// How many of the events fall inside the crop (the background the representations see).
-    pub fn events_in_crop(&self) -> usize {
-        self.events
-            .iter()
-            .filter(|&&e| self.roi.map(e).is_some())
-            .count()
-    }
+    /// The events in the crop, crop coordinates, time order: the background the
+    /// representations see.
+    pub cropped: Vec<Event>,
 }
 
 impl Dataset {
@@ -327,14 +320,8 @@ impl Dataset {
         if self.inputs.mask == MaskSource::Unmasked {
             return Ok(None);
         }
-        let path = self.dir.join(NO_CONTACT_FILE);
-        let (sensor, events) = read_full(&path)?;
-        let roi = crop_of(sensor, &path)?;
-        Ok(Some(NoContact {
-            sensor,
-            roi,
-            events,
-        }))
+        let (roi, cropped) = read_in_crop(&self.dir.join(NO_CONTACT_FILE))?;
+        Ok(Some(NoContact { roi, cropped }))
     }
 
     /// The no-contact mask for `config` (built with its static part's settings: evtac's choice,
@@ -348,7 +335,8 @@ impl Dataset {
         let (Some(s), Some(no_contact)) = (config.static_part(), no_contact) else {
             return Ok(None);
         };
-        Mask::from_recording(&no_contact.roi, s, &no_contact.events)
+        // Cropped once for every config (`Mask::from_recording` would crop again each time).
+        Mask::from_no_contact(no_contact.roi.size, s, &no_contact.cropped)
             .map(Some)
             .map_err(|source| Error::Mask {
                 path: self.dir.join(NO_CONTACT_FILE),

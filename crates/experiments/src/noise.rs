@@ -52,7 +52,7 @@ fn simulate(sim: &Simulated, level: f64, dir: &Path, run: &RunContext<'_>) -> Re
 
 /// Events per second in the crop of `ds`'s no-contact recording, which lasts `seconds`.
 fn background_rate(ds: &Dataset, seconds: f64) -> Result<f64, Error> {
-    let n = ds.no_contact()?.map_or(0, |nc| nc.events_in_crop());
+    let n = ds.no_contact()?.map_or(0, |nc| nc.cropped.len());
     Ok(if seconds > 0.0 {
         n as f64 / seconds
     } else {

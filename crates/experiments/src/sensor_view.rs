@@ -11,7 +11,9 @@ use crate::cache::Error;
 use crate::dataset::{self, Dataset};
 use crate::results::{SensorKind, SensorPanel, SensorView};
 use evtac_events::Resolution;
+use evtac_events::layout::NO_CONTACT_FILE;
 use evtac_events::manifest::TrialMeta;
+use evtac_import::inputs::MaskSource;
 use evtac_sim::{Simulator, SkinPose};
 
 /// The sensor at rest and in contact with `meta`'s depth and direction at `theta_deg` of tilt:
@@ -97,8 +99,8 @@ fn count_image(resolution: Resolution, events: &[evtac_events::Event]) -> Vec<f3
 fn recorded(ds: &Dataset, meta: &TrialMeta) -> Result<SensorView, Error> {
     let (resolution, events) = dataset::read_full(&ds.dir.join(&meta.file))?;
     let mut panels = Vec::new();
-    if let Some(no_contact) = ds.no_contact()? {
-        let (rest_resolution, rest) = (no_contact.sensor, no_contact.events);
+    if ds.inputs.mask == MaskSource::NoContact {
+        let (rest_resolution, rest) = dataset::read_full(&ds.dir.join(NO_CONTACT_FILE))?;
         if rest_resolution == resolution {
             let seconds = rest
                 .first()

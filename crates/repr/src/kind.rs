@@ -234,7 +234,7 @@ mod tests {
     fn report_order_is_the_papers_then_the_fusions() {
         use ReprKind::*;
         assert_eq!(
-            in_order_of([Late, Static, Late, Combined]),
+            ReprKind::in_order([Late, Static, Late, Combined]),
             [Static, Combined, Late]
         );
         assert_eq!(
@@ -243,9 +243,5 @@ mod tests {
         );
         assert!(ReprKind::FUSIONS.iter().all(|k| k.is_fusion()));
         assert!(!ReprKind::PAPER.iter().any(|k| k.is_fusion()));
-    }
-
-    fn in_order_of<const N: usize>(kinds: [ReprKind; N]) -> Vec<ReprKind> {
-        ReprKind::in_order(kinds)
     }
 }

@@ -72,9 +72,10 @@ impl Mask {
     }
 
     /// The mask of a no-contact recording on the crop `roi` of its sensor: its events (sensor
-    /// coordinates, time order) cropped to `roi`, then [`Mask::from_no_contact`]. The one way
-    /// `evtac represent`, the experiments' datasets and the Python package build a mask from a
-    /// recording, so the three cannot crop differently.
+    /// coordinates, time order) cropped to `roi` ([`Roi::crop_into`]), then
+    /// [`Mask::from_no_contact`]: how `evtac represent` and the Python package build a mask from
+    /// a recording. The experiments' datasets, which build one mask per config, crop once with
+    /// the same `Roi::crop_into` and call [`Mask::from_no_contact`] for each.
     pub fn from_recording(
         roi: &Roi,
         config: &StaticConfig,

@@ -9,11 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::inputs::InputArgs;
 use anyhow::{Context, bail};
-use evtac_experiments::job::{self, Job, ReproduceJob, TrainJob};
+use evtac_experiments::job::{self, Job, TrainJob};
 use evtac_experiments::jobs::command_line;
-use evtac_import::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, MaskSource, NO_MASK_FLAG};
-use evtac_labels::CalibrationSource;
 use evtac_sim::Scale;
 
 /// Arguments of `evtac jobs`.
@@ -88,27 +87,10 @@ fn run_job(job: &Job) -> anyhow::Result<()> {
                     j.run(&|_| {}, |_| {})?;
                 }
             }
-            Job::Reproduce(j) => super::reproduce::run(reproduce_args(j))?,
+            Job::Reproduce(j) => super::reproduce::run(super::reproduce::Args::for_job(j))?,
         }
         Ok(())
     })
-}
-
-/// The `evtac reproduce` arguments of `job`, run locally on one thread (a task has one CPU).
-fn reproduce_args(job: &ReproduceJob) -> super::reproduce::Args {
-    super::reproduce::Args::for_job(job)
-}
-
-/// The opt-out flags of `inputs`.
-fn input_flags(inputs: Inputs) -> Vec<String> {
-    let mut flags = Vec::new();
-    if inputs.calibration == CalibrationSource::Identity {
-        flags.push(format!("--{IDENTITY_CALIBRATION_FLAG}"));
-    }
-    if inputs.mask == MaskSource::Unmasked {
-        flags.push(format!("--{NO_MASK_FLAG}"));
-    }
-    flags
 }
 
 fn path(p: &Path) -> String {
@@ -151,7 +133,7 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if let Some(data) = &j.data {
                 args.extend(["--data".into(), path(data)]);
             }
-            args.extend(input_flags(j.inputs));
+            args.extend(InputArgs::of(j.inputs).words());
             if let Some(levels) = &j.noise_levels {
                 let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
                 args.extend(["--noise-levels".into(), levels.join(",")]);
@@ -186,7 +168,7 @@ fn train_args(j: &TrainJob) -> Vec<String> {
             args.push("--train-on-stop".into());
         }
     }
-    args.extend(input_flags(j.inputs));
+    args.extend(InputArgs::of(j.inputs).words());
     args.extend(["--out".into(), path(&j.out), "--quiet".into()]);
     args
 }
