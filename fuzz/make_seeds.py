@@ -17,7 +17,7 @@ S = sys.argv[1]
 R = sys.argv[2] if len(sys.argv) > 2 else os.path.join(
     os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "fixtures", "real"
 )
-for target in ("aedat", "evt2", "evt3", "csv", "npy", "neurotac"):
+for target in ("aedat", "evt2", "evt3", "csv", "npy", "npz", "neurotac"):
     os.makedirs(os.path.join(S, target), exist_ok=True)
 rng = np.random.default_rng(7)
 # NPY: the event record in several forms numpy writes
@@ -30,15 +30,32 @@ forms = {
     "be": np.dtype([("t", ">i8"), ("x", ">i2"), ("y", ">i2"), ("p", "u1")]),
     "f8t": np.dtype([("t", "<f8"), ("x", "<i2"), ("y", "<i2"), ("p", "u1")]),
     "missing": np.dtype([("t", "<i8"), ("x", "<i2"), ("y", "<i2")]),
+    # other tools' names and types: dv-processing's EventStore.numpy(), the aedat package's
+    "dv": np.dtype({"names": ["timestamp", "x", "y", "polarity"],
+                    "formats": ["<i8", "<i2", "<i2", "i1"], "offsets": [0, 8, 10, 12],
+                    "itemsize": 16}),
+    "aedat_pkg": np.dtype([("t", "<u8"), ("x", "<u2"), ("y", "<u2"), ("on", "?")]),
+    "i4": np.dtype([("ts", "<i4"), ("xs", "<u4"), ("ys", "<i8"), ("ps", "i1")]),
 }
 for name, dt in forms.items():
     for n in (0, 1, 5, 40):
         a = np.zeros(n, dtype=dt)
         if n:
-            a["t"] = np.cumsum(rng.integers(0, 4, n)) + 1000
-            a["x"] = rng.integers(0, 320, n); a["y"] = rng.integers(0, 240, n)
-            if "p" in dt.names: a["p"] = rng.integers(0, 2, n)
+            values = {"t": np.cumsum(rng.integers(0, 4, n)) + 1000,
+                      "x": rng.integers(0, 320, n), "y": rng.integers(0, 240, n),
+                      "p": rng.integers(0, 2, n)}
+            for field in dt.names:
+                a[field] = values[{"timestamp": "t", "ts": "t", "xs": "x", "ys": "y",
+                                   "ps": "p", "polarity": "p", "on": "p"}.get(field, field)]
         np.save(f"{S}/npy/{name}_{n}.npy", a)
+        if n in (1, 40):
+            # NPZ: the record array stored, and one array per field compressed
+            np.savez(f"{S}/npz/{name}_{n}.npz", events=a)
+            if len(dt.names) == 4:
+                np.savez_compressed(f"{S}/npz/cols_{name}_{n}.npz",
+                                    **{k: a[k] for k in dt.names})
+np.savez(f"{S}/npz/two.npz", a=np.zeros(2, dtype=np.dtype(base)), b=np.zeros(1, dtype=np.dtype(base)))
+np.savez(f"{S}/npz/ragged.npz", t=np.arange(3), x=np.arange(2), y=np.arange(3), p=np.arange(3) % 2)
 for n, dt in [(4, "<f8"), (3, "<i8")]:
     np.save(f"{S}/npy/scalar_{dt[1:]}.npy", np.arange(n, dtype=dt))
 np.save(f"{S}/npy/2d.npy", np.zeros((3, 2), dtype=np.dtype(base)))
@@ -62,6 +79,8 @@ for n in (0, 1, 10, 50):
             f.write(f"{t},{rng.integers(0,700)},{rng.integers(0,500)},{rng.integers(0,2)}\n")
 open(f"{S}/csv/crlf.csv", "w").write("t,x,y,p\r\n1,2,3,1\r\n2,3,4,0\r\n")
 open(f"{S}/csv/back.csv", "w").write("t,x,y,p\n5,1,1,1\n3,1,1,0\n")
+open(f"{S}/csv/headerless.csv", "w").write("1,2,3,1\n2,3,4,0\n3,4,5,-1\n")
+open(f"{S}/csv/named.csv", "w").write("x,y,polarity,timestamp\n2,3,1,1\n3,4,0,2\n")
 open(f"{S}/csv/neg.csv", "w").write("t,x,y,p\n-5,1,1,1\n3,-1,1,0\n4,1,1,2\n")
 # AEDAT4 written by dv-processing: every compression, small packets
 for comp in ("NONE", "LZ4", "LZ4_HIGH", "ZSTD", "ZSTD_HIGH"):

@@ -4,6 +4,12 @@
 //! declares no sensor size, so callers that know it pass it to
 //! [`CsvReader::set_resolution`] and events are then checked against it.
 //!
+//! Other tools' CSV files read too: a header line names the four columns in any order and under
+//! any name [`Field`] accepts (`timestamp,x,y,polarity`, as DV's exporter writes), and a file
+//! without a header line (its first line four integers) is read as `t,x,y,p`, which
+//! [`CsvReader::headerless`] reports so that `evtac info` can say so. Polarity may be written as
+//! -1 for OFF.
+//!
 //! ```
 //! use evtac_events::csv::{CsvReader, CsvWriter};
 //! use evtac_events::Event;
@@ -22,6 +28,7 @@ use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::Path;
 
 use crate::check::{CheckError, EventCheck};
+use crate::columns::{Field, Slots};
 use crate::{Event, ImuSample, Resolution};
 
 /// The event CSV header line.
@@ -41,11 +48,17 @@ pub enum CsvError {
     /// The file has no header line.
     #[error("the file is empty (expected the header `{EVENT_HEADER}`)")]
     Empty,
-    /// The first line is not the expected header.
-    #[error("the header (line 1) is `{found}`, expected `{EVENT_HEADER}`")]
+    /// The first line is neither a header naming the four event columns nor four integers.
+    #[error(
+        "the header (line 1) is `{found}`: {reason} (expected `{EVENT_HEADER}`, the columns in \
+         any order named {accepted}, or no header line)",
+        accepted = Field::accepted()
+    )]
     BadHeader {
         /// The first line as found.
         found: String,
+        /// What is wrong with it.
+        reason: String,
     },
     /// A data line could not be parsed.
     #[error("line {line} (byte offset {offset}): {reason}")]
@@ -91,6 +104,12 @@ pub struct CsvReader<R> {
     /// line (blank lines make it differ from the event index).
     places: Vec<(u64, u64)>,
     check: EventCheck,
+    /// The column holding `t`, `x`, `y` and `p`.
+    columns: [usize; 4],
+    /// Whether the file has no header line: its first line, still in `line_buf`, is data.
+    headerless: bool,
+    /// Whether the first line of a headerless file is yet to be handed out.
+    first_pending: bool,
 }
 
 impl CsvReader<BufReader<File>> {
@@ -127,19 +146,24 @@ fn parse_int(field: &[u8]) -> Option<i64> {
     Some(if negative { -value } else { value })
 }
 
-/// Parses one data line (without its line break) into an event.
-fn parse_event(line: &[u8]) -> Result<Event, String> {
-    let mut fields = line.split(|&b| b == b',');
-    let mut next = |name: &str| {
-        fields
-            .next()
-            .map(|f| f.trim_ascii())
-            .ok_or_else(|| format!("missing field `{name}` (expected `{EVENT_HEADER}`)"))
-    };
-    let (t, x, y, p) = (next("t")?, next("x")?, next("y")?, next("p")?);
-    if fields.next().is_some() {
-        return Err(format!("more than 4 fields (expected `{EVENT_HEADER}`)"));
+/// Parses one data line (without its line break) into an event, its fields in `columns`.
+fn parse_event(line: &[u8], columns: [usize; 4]) -> Result<Event, String> {
+    let mut fields: [&[u8]; 4] = [&[]; 4];
+    let mut n = 0;
+    for field in line.split(|&b| b == b',') {
+        if n == 4 {
+            return Err(format!("more than 4 fields (expected `{EVENT_HEADER}`)"));
+        }
+        fields[n] = field.trim_ascii();
+        n += 1;
     }
+    if n < 4 {
+        let missing = Field::ALL[columns.iter().position(|&c| c >= n).unwrap_or(3)];
+        return Err(format!(
+            "missing field `{missing}` (expected `{EVENT_HEADER}`)"
+        ));
+    }
+    let [t, x, y, p] = columns.map(|c| fields[c]);
     let text = |f: &[u8]| String::from_utf8_lossy(f).into_owned();
     let t = parse_int(t).ok_or_else(|| format!("t = `{}` is not an integer", text(t)))?;
     let coordinate = |f: &[u8], name: &str| {
@@ -150,40 +174,72 @@ fn parse_event(line: &[u8]) -> Result<Event, String> {
     let (x, y) = (coordinate(x, "x")?, coordinate(y, "y")?);
     let polarity = match p {
         b"1" => true,
-        b"0" => false,
-        _ => return Err(format!("p = `{}` is neither 0 nor 1", text(p))),
+        b"0" | b"-1" => false,
+        _ => {
+            return Err(format!("p = `{}` is not 1 (ON), 0 or -1 (OFF)", text(p)));
+        }
     };
     Ok(Event { t, x, y, polarity })
 }
 
+/// The columns a first line names, or `None` when it is data (four integers: no header line).
+fn header_columns(line: &str) -> Result<Option<[usize; 4]>, String> {
+    let names: Vec<&str> = line.split(',').map(str::trim).collect();
+    if names.len() == 4 && names.iter().all(|n| parse_int(n.as_bytes()).is_some()) {
+        return Ok(None);
+    }
+    let mut slots = Slots::default();
+    for (i, name) in names.iter().enumerate() {
+        let field =
+            Field::of(name).ok_or_else(|| format!("column `{name}` is not an event field"))?;
+        slots.set(field, i, name)?;
+    }
+    slots.complete().map(Some)
+}
+
 impl<R: BufRead> CsvReader<R> {
-    /// Reads and checks the header line from `source`.
+    /// Reads the first line from `source`: the header, or the first event of a file without one.
     pub fn new(mut source: R) -> Result<Self, CsvError> {
         let mut line_buf = Vec::with_capacity(64);
         let n = source.read_until(b'\n', &mut line_buf)?;
         if n == 0 {
             return Err(CsvError::Empty);
         }
-        let header = String::from_utf8_lossy(&line_buf);
-        let cleaned: String = header
-            .trim_start_matches('\u{feff}')
-            .chars()
-            .filter(|c| !c.is_whitespace())
-            .collect();
-        if cleaned != EVENT_HEADER {
-            return Err(CsvError::BadHeader {
-                found: header.trim_end().to_string(),
-            });
+        let first = String::from_utf8_lossy(&line_buf);
+        let cleaned = first.trim_start_matches('\u{feff}').trim();
+        let bad = |reason: String| CsvError::BadHeader {
+            found: first.trim_end().to_string(),
+            reason,
+        };
+        let columns = header_columns(cleaned).map_err(bad)?;
+        let headerless = columns.is_none();
+        // A headerless file's first line is data, parsed by `next_chunk` after its byte-order
+        // mark (if any) is skipped.
+        let bom = if line_buf.starts_with("\u{feff}".as_bytes()) {
+            3
+        } else {
+            0
+        };
+        if headerless {
+            line_buf.drain(..bom);
         }
         Ok(Self {
             source,
             line_buf,
-            line: 1,
-            offset: n as u64,
+            line: u64::from(!headerless),
+            offset: if headerless { bom as u64 } else { n as u64 },
             events: Vec::with_capacity(CHUNK),
             places: Vec::with_capacity(CHUNK),
             check: EventCheck::new(None),
+            columns: columns.unwrap_or([0, 1, 2, 3]),
+            headerless,
+            first_pending: headerless,
         })
+    }
+
+    /// Whether the file has no header line (its columns were read as `t,x,y,p`).
+    pub fn headerless(&self) -> bool {
+        self.headerless
     }
 
     /// The sensor size events are checked against, if one was set.
@@ -215,8 +271,12 @@ impl<R: BufRead> CsvReader<R> {
         self.events.clear();
         self.places.clear();
         while self.events.len() < CHUNK {
-            self.line_buf.clear();
-            let n = self.source.read_until(b'\n', &mut self.line_buf)?;
+            let n = if std::mem::take(&mut self.first_pending) {
+                self.line_buf.len()
+            } else {
+                self.line_buf.clear();
+                self.source.read_until(b'\n', &mut self.line_buf)?
+            };
             if n == 0 {
                 break;
             }
@@ -227,7 +287,7 @@ impl<R: BufRead> CsvReader<R> {
             if line.is_empty() {
                 continue;
             }
-            let event = parse_event(line).map_err(|reason| CsvError::BadLine {
+            let event = parse_event(line, self.columns).map_err(|reason| CsvError::BadLine {
                 line: self.line,
                 offset: start,
                 reason,
@@ -386,12 +446,57 @@ mod tests {
         let err = read_all(b"t,x,y,p\n1,2,3\n").unwrap_err();
         assert!(err.to_string().contains("missing field `p`"), "{err}");
         assert!(matches!(read_all(b""), Err(CsvError::Empty)));
-        assert!(matches!(
-            read_all(b"x,y,t,p\n"),
-            Err(CsvError::BadHeader { .. })
-        ));
+        let err = read_all(b"t,x,y,z\n").unwrap_err();
+        assert!(
+            matches!(&err, CsvError::BadHeader { reason, .. } if reason.contains("`z`")),
+            "{err}"
+        );
+        let err = read_all(b"t,x,y,t\n").unwrap_err();
+        assert!(err.to_string().contains("two columns"), "{err}");
         let err = read_all(b"t,x,y,p\n5,0,0,1\n4,0,0,1\n").unwrap_err();
         assert!(err.to_string().contains("backwards at event 1"), "{err}");
+        // Headerless: the first line is line 1.
+        let err = read_all(b"1,2,3,1\n2,2,3,5\n").unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                CsvError::BadLine {
+                    line: 2,
+                    offset: 8,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn other_tools_headers_and_no_header() {
+        let expected = vec![
+            Event {
+                t: 5,
+                x: 1,
+                y: 2,
+                polarity: true,
+            },
+            Event {
+                t: 6,
+                x: 3,
+                y: 4,
+                polarity: false,
+            },
+        ];
+        for text in [
+            &b"timestamp,x,y,polarity\n5,1,2,1\n6,3,4,0\n"[..],
+            b"x, y, polarity, t\r\n1,2,1,5\r\n3,4,-1,6\r\n",
+            b"\xef\xbb\xbf5,1,2,1\n6,3,4,0\n",
+            b"5,1,2,1\n6,3,4,-1",
+        ] {
+            let reader = CsvReader::from_slice(text).unwrap();
+            let headerless = reader.headerless();
+            assert_eq!(headerless, !text.contains(&b't'), "{text:?}");
+            assert_eq!(reader.read_to_end().unwrap(), expected, "{text:?}");
+        }
     }
 
     #[test]

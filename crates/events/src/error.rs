@@ -118,6 +118,14 @@ pub enum Error {
         /// What is wrong.
         error: NpyError,
     },
+    /// An NPZ archive is broken or holds no events.
+    #[error("{}: {error}", path.display())]
+    Npz {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        error: crate::npz::NpzError,
+    },
     /// A NeuroTac pickle (or its pair) is not the lab's structure, or is broken.
     #[error("{error}")]
     Neurotac {

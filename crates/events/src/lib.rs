@@ -33,6 +33,7 @@
 pub mod aedat;
 pub mod aedat_legacy;
 pub mod check;
+pub mod columns;
 pub mod csv;
 mod error;
 pub mod evt;
@@ -41,6 +42,7 @@ pub mod layout;
 pub mod manifest;
 pub mod neurotac;
 pub mod npy;
+pub mod npz;
 pub mod output;
 pub mod pickle;
 mod range;

@@ -2,10 +2,13 @@
 //! `[('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1')]` (us, column, row, 1 = ON).
 //!
 //! The NPY header is parsed by hand: `ndarray-npy` reads plain numeric arrays only, not
-//! structured (record) dtypes. The reader accepts the forms numpy writes for this record: the
-//! fields in any order, padding fields (`('', '|V3')`, written for aligned dtypes),
-//! `x`/`y` as `<u2`, `p` as `|b1`, and format versions 1.0 to 3.0; it rejects anything else
-//! with an error naming the field. The writer writes the packed form above (version 1.0).
+//! structured (record) dtypes. The reader accepts the records other tools write: the fields in
+//! any order and under the names of [`crate::columns::Field`] (dv-processing's `timestamp` and
+//! `polarity`, the `aedat` package's `on`), as any little-endian integer or bool (`t` as `<u8`,
+//! `p` as `|i1` or `|b1`, with -1 read as OFF), padding fields (`('', '|V3')`, written for
+//! aligned dtypes), and format versions 1.0 to 3.0; it rejects anything else with an error
+//! naming the field. The writer writes the packed form above (version 1.0). NPZ archives of
+//! such arrays are read by [`crate::npz`].
 //!
 //! ```
 //! use evtac_events::npy::{NpyReader, NpyWriter};
@@ -21,6 +24,8 @@
 //! ```
 
 mod header;
+
+pub(crate) use header::{coordinates, polarity};
 
 use std::fs::File;
 use std::io::{BufWriter, ErrorKind, Read, Seek, SeekFrom, Write};
@@ -69,9 +74,7 @@ pub enum NpyError {
     #[error("bad header: {0}")]
     BadHeader(String),
     /// The dtype is not the event record.
-    #[error(
-        "unsupported dtype {descr}: {reason} (expected [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1')])"
-    )]
+    #[error("unsupported dtype {descr}: {reason}")]
     UnsupportedDtype {
         /// The header's `descr` as written.
         descr: String,
@@ -188,76 +191,120 @@ impl<'a> NpyReader<&'a [u8]> {
     }
 }
 
+/// Reads an NPY preamble and header from `source`: the parsed header and the offset of the
+/// first data byte.
+pub(crate) fn read_header(source: &mut impl Read) -> Result<(header::Header, u64), NpyError> {
+    let mut preamble = [0u8; 12];
+    let n = read_full(source, &mut preamble[..8])?;
+    if n == 0 {
+        return Err(NpyError::Empty);
+    }
+    if n < 6 || &preamble[..6] != MAGIC {
+        return Err(NpyError::BadMagic);
+    }
+    if n < 8 {
+        return Err(NpyError::TruncatedHeader {
+            offset: n as u64,
+            needed: 10,
+        });
+    }
+    let (major, minor) = (preamble[6], preamble[7]);
+    let len_bytes = match (major, minor) {
+        (1, 0) => 2,
+        (2, 0) | (3, 0) => 4,
+        _ => return Err(NpyError::UnsupportedVersion { major, minor }),
+    };
+    let got = read_full(source, &mut preamble[8..8 + len_bytes])?;
+    if got < len_bytes {
+        return Err(NpyError::TruncatedHeader {
+            offset: (8 + got) as u64,
+            needed: (8 + len_bytes) as u64,
+        });
+    }
+    let header_len = if len_bytes == 2 {
+        u64::from(u16::from_le_bytes([preamble[8], preamble[9]]))
+    } else {
+        u64::from(u32::from_le_bytes([
+            preamble[8],
+            preamble[9],
+            preamble[10],
+            preamble[11],
+        ]))
+    };
+    let start = 8 + len_bytes as u64;
+    // A header this long is not one numpy writes for a record of four fields.
+    if header_len > 1 << 20 {
+        return Err(NpyError::BadHeader(format!(
+            "the header length field (byte offset 8) claims {header_len} bytes"
+        )));
+    }
+    // Read through `take`: the buffer grows with the bytes present, not with the claim.
+    let mut text = Vec::new();
+    let got = source.take(header_len).read_to_end(&mut text)?;
+    if (got as u64) < header_len {
+        return Err(NpyError::TruncatedHeader {
+            offset: start + got as u64,
+            needed: start + header_len,
+        });
+    }
+    let text = std::str::from_utf8(&text).map_err(|e| {
+        NpyError::BadHeader(format!(
+            "the header is not valid UTF-8 text (bad byte at byte offset {})",
+            start + e.valid_up_to() as u64
+        ))
+    })?;
+    Ok((header::parse(text)?, start + header_len))
+}
+
+/// Reads a whole one-dimensional array of integers or bools (one column of an NPZ archive) as
+/// `i64`s: numpy's `np.savez(f, t=t, x=x, y=y, p=p)` writes one such array per field.
+pub(crate) fn read_column(mut source: impl Read) -> Result<Vec<i64>, NpyError> {
+    let (header, data_start) = read_header(&mut source)?;
+    let scalar = header.scalar()?;
+    let declared = header.count;
+    // Grown by the bytes present, so a length the data does not back costs nothing.
+    let mut bytes = Vec::new();
+    let want = declared.saturating_mul(scalar.width as u64);
+    let got = (&mut source).take(want).read_to_end(&mut bytes)? as u64;
+    if got < want {
+        return Err(NpyError::Truncated {
+            declared,
+            complete: got / scalar.width as u64,
+            offset: data_start + got,
+        });
+    }
+    let mut probe = [0u8; 1];
+    if read_full(&mut source, &mut probe)? > 0 {
+        return Err(NpyError::TrailingData {
+            declared,
+            offset: data_start + got,
+        });
+    }
+    bytes
+        .chunks_exact(scalar.width)
+        .enumerate()
+        .map(|(i, v)| {
+            scalar.load(v).ok_or_else(|| NpyError::BadRecord {
+                index: i as u64,
+                offset: data_start + (i * scalar.width) as u64,
+                reason: "the value is larger than 2^63 - 1".into(),
+            })
+        })
+        .collect()
+}
+
 impl<R: Read> NpyReader<R> {
     /// Reads and checks the header from `source`.
     pub fn new(mut source: R) -> Result<Self, NpyError> {
-        let mut preamble = [0u8; 12];
-        let n = read_full(&mut source, &mut preamble[..8])?;
-        if n == 0 {
-            return Err(NpyError::Empty);
-        }
-        if n < 6 || &preamble[..6] != MAGIC {
-            return Err(NpyError::BadMagic);
-        }
-        if n < 8 {
-            return Err(NpyError::TruncatedHeader {
-                offset: n as u64,
-                needed: 10,
-            });
-        }
-        let (major, minor) = (preamble[6], preamble[7]);
-        let len_bytes = match (major, minor) {
-            (1, 0) => 2,
-            (2, 0) | (3, 0) => 4,
-            _ => return Err(NpyError::UnsupportedVersion { major, minor }),
-        };
-        let got = read_full(&mut source, &mut preamble[8..8 + len_bytes])?;
-        if got < len_bytes {
-            return Err(NpyError::TruncatedHeader {
-                offset: (8 + got) as u64,
-                needed: (8 + len_bytes) as u64,
-            });
-        }
-        let header_len = if len_bytes == 2 {
-            u64::from(u16::from_le_bytes([preamble[8], preamble[9]]))
-        } else {
-            u64::from(u32::from_le_bytes([
-                preamble[8],
-                preamble[9],
-                preamble[10],
-                preamble[11],
-            ]))
-        };
-        let start = 8 + len_bytes as u64;
-        // A header this long is not one numpy writes for a record of four fields.
-        if header_len > 1 << 20 {
-            return Err(NpyError::BadHeader(format!(
-                "the header length field (byte offset 8) claims {header_len} bytes"
-            )));
-        }
-        // Read through `take`: the buffer grows with the bytes present, not with the claim.
-        let mut text = Vec::new();
-        let got = (&mut source).take(header_len).read_to_end(&mut text)?;
-        if (got as u64) < header_len {
-            return Err(NpyError::TruncatedHeader {
-                offset: start + got as u64,
-                needed: start + header_len,
-            });
-        }
-        let text = std::str::from_utf8(&text).map_err(|e| {
-            NpyError::BadHeader(format!(
-                "the header is not valid UTF-8 text (bad byte at byte offset {})",
-                start + e.valid_up_to() as u64
-            ))
-        })?;
-        let (layout, declared) = header::parse(text)?;
+        let (header, data_start) = read_header(&mut source)?;
+        let layout = header.layout()?;
         Ok(Self {
             source,
             buf: Vec::new(),
             layout,
-            declared,
+            declared: header.count,
             done: 0,
-            data_start: start + header_len,
+            data_start,
             events: Vec::with_capacity(CHUNK),
             check: EventCheck::new(None),
         })

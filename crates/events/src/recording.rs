@@ -42,8 +42,12 @@ pub enum Format {
     Evt3,
     /// `t,x,y,p` CSV (`.csv`).
     Csv,
-    /// NPY with the record dtype `t <i8, x <i2, y <i2, p u1` (`.npy`).
+    /// NPY with an event record dtype, `t <i8, x <i2, y <i2, p u1` as evtac writes it (`.npy`;
+    /// other names and integer types read, see [`crate::npy`]).
     Npy,
+    /// NPZ: numpy's zip of NPY arrays, one event record array or one array per field
+    /// (`.npz`), read only (see [`crate::npz`]).
+    Npz,
     /// The NeuroTac lab's per-pixel event times (a pickle, or an NPY of Python objects), read
     /// only (see [`crate::neurotac`]).
     Neurotac,
@@ -51,7 +55,7 @@ pub enum Format {
 
 impl Format {
     /// The short name shown to users (`AEDAT4`, `AEDAT2`, `AEDAT3.1`, `EVT2`, `EVT21`, `EVT3`,
-    /// `CSV`, `NPY`).
+    /// `CSV`, `NPY`, `NPZ`, `NeuroTac pickle`).
     pub const fn name(self) -> &'static str {
         match self {
             Self::Aedat4 => "AEDAT4",
@@ -62,13 +66,14 @@ impl Format {
             Self::Evt3 => "EVT3",
             Self::Csv => "CSV",
             Self::Npy => "NPY",
+            Self::Npz => "NPZ",
             Self::Neurotac => "NeuroTac pickle",
         }
     }
 
-    /// Whether the format carries the sensor resolution itself (CSV and NPY do not).
+    /// Whether the format carries the sensor resolution itself (CSV, NPY and NPZ do not).
     pub const fn has_resolution(self) -> bool {
-        !matches!(self, Self::Csv | Self::Npy)
+        !matches!(self, Self::Csv | Self::Npy | Self::Npz)
     }
 
     /// The format an output path's extension asks for: `.aedat4`, `.csv` or `.npy`.
@@ -85,6 +90,10 @@ impl Format {
             "pickle" | "pkl" => Err(Error::NotWritable {
                 path: path.to_path_buf(),
                 format: Self::Neurotac,
+            }),
+            "npz" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::Npz,
             }),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
@@ -139,15 +148,22 @@ impl Format {
             };
         }
         let extension = extension(path);
+        // A zip archive is an NPZ when its name says so (a zip may hold anything else).
+        if extension == "npz"
+            && (head.starts_with(b"PK\x03\x04") || head.starts_with(b"PK\x05\x06"))
+        {
+            return Ok(Self::Npz);
+        }
         match extension.as_str() {
             "csv" => Ok(Self::Csv),
             _ if head.is_empty() => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
                 reason: "the file is empty".into(),
             }),
-            "aedat4" | "aedat" | "npy" | "raw" => {
+            "aedat4" | "aedat" | "npy" | "npz" | "raw" => {
                 let signature = match extension.as_str() {
                     "npy" => "the NPY magic `\\x93NUMPY`",
+                    "npz" => "the zip magic `PK\\x03\\x04`",
                     "raw" => "a `%` EVT text header line",
                     _ => "the AEDAT 4.0 magic `#!AER-DAT4.0\\r\\n`",
                 };
@@ -212,12 +228,12 @@ enum Inner {
     Memory(Box<MemoryEvents>),
 }
 
-/// A recording read whole (the NeuroTac pickles, which must be parsed whole), handed out in
-/// chunks like the streaming readers'.
+/// A recording read whole (NeuroTac pickles and NPZ archives, which must be parsed whole),
+/// handed out in chunks like the streaming readers'.
 struct MemoryEvents {
     events: Vec<Event>,
     next: usize,
-    resolution: Resolution,
+    /// Checks the events against the sensor size (the file's own, or the one declared).
     check: EventCheck,
     /// Bytes of the files, for positions: all read at once.
     len: u64,
@@ -245,7 +261,8 @@ pub struct EventReader {
     format: Format,
     source: Option<String>,
     /// What a user should know about the file that its counts do not say (a NeuroTac pickle's
-    /// millisecond times and missing polarity).
+    /// millisecond times and missing polarity, a CSV file's missing header line, the members an
+    /// NPZ archive's events came from).
     note: Option<String>,
     len: u64,
     inner: Inner,
@@ -352,6 +369,13 @@ pub fn open_with(
                 path: path.to_path_buf(),
                 error,
             })?;
+            if r.headerless() {
+                note = Some(
+                    "no header line: the columns were read as t,x,y,p (microseconds, column, \
+                     row, polarity)"
+                        .to_string(),
+                );
+            }
             (Inner::Csv(Box::new(r)), None)
         }
         Format::Npy => {
@@ -369,7 +393,20 @@ pub fn open_with(
             note = Some(file.note());
             let r = MemoryEvents {
                 check: EventCheck::new(Some(file.resolution)),
-                resolution: file.resolution,
+                events: file.events,
+                next: 0,
+                len,
+            };
+            (Inner::Memory(Box::new(r)), None)
+        }
+        Format::Npz => {
+            let file = crate::npz::read(path).map_err(|error| Error::Npz {
+                path: path.to_path_buf(),
+                error,
+            })?;
+            note = Some(file.note());
+            let r = MemoryEvents {
+                check: EventCheck::new(None),
                 events: file.events,
                 next: 0,
                 len,
@@ -417,7 +454,7 @@ impl EventReader {
             Inner::Evt(r) => r.resolution(),
             Inner::Csv(r) => r.resolution(),
             Inner::Npy(r) => r.resolution(),
-            Inner::Memory(r) => Some(r.resolution),
+            Inner::Memory(r) => r.check.resolution(),
         }
     }
 
@@ -446,8 +483,8 @@ impl EventReader {
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
-            // Its own size, checked above.
-            Inner::Memory(_) => {}
+            // A pickle's own size was checked above; an NPZ takes the declared one.
+            Inner::Memory(r) => r.check.set_resolution(Some(resolution)),
         }
         Ok(())
     }

@@ -7,6 +7,7 @@
 
 use super::NpyError;
 use crate::Event;
+use crate::columns::{Field, Slots};
 
 /// A parsed Python literal.
 #[derive(Debug, Clone, PartialEq)]
@@ -137,65 +138,222 @@ impl Parser<'_> {
     }
 }
 
-/// How a record's coordinate field is stored.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Coordinate {
-    /// `<i2`: negative values are rejected.
-    I16,
-    /// `<u2`.
-    U16,
-}
-
 /// The largest record accepted, padding included: numpy pads the 13-byte event record to 16
 /// when aligned; anything near this size is not an event record, and a padding field declaring
 /// gigabytes must not decide how much the reader allocates.
 const MAX_RECORD: usize = 1 << 12;
 
-/// Where the four event fields sit in one record.
+/// A numpy scalar type that can hold an event field: a little-endian integer of 1, 2, 4 or 8
+/// bytes, or a bool (numpy's `?`, one byte that is 0 or 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scalar {
+    /// Bytes per value.
+    pub width: usize,
+    /// Whether values are two's-complement signed.
+    pub signed: bool,
+}
+
+impl Scalar {
+    /// Parses a numpy type string (`<i8`, `|u1`, `?`, `b1`); `None` for what is not a
+    /// little-endian integer or bool (floats, big-endian, strings), which the caller names.
+    pub fn parse(typestr: &str) -> Option<Self> {
+        let (order, code) = match typestr.as_bytes().first()? {
+            o @ (b'<' | b'>' | b'|' | b'=') => (*o, &typestr[1..]),
+            _ => (b'|', typestr),
+        };
+        let (signed, width) = match code {
+            "?" | "b1" => {
+                return Some(Self {
+                    width: 1,
+                    signed: false,
+                });
+            }
+            c if c.len() == 2 => match (c.as_bytes()[0], c.as_bytes()[1]) {
+                (b'i', w @ (b'1' | b'2' | b'4' | b'8')) => (true, usize::from(w - b'0')),
+                (b'u', w @ (b'1' | b'2' | b'4' | b'8')) => (false, usize::from(w - b'0')),
+                _ => return None,
+            },
+            _ => return None,
+        };
+        // `|` (not applicable) and `=` (native, little-endian on every machine evtac builds
+        // for) are only right for one byte and for native order; `>` never.
+        match order {
+            b'>' if width > 1 => None,
+            b'|' if width > 1 => None,
+            _ => Some(Self { width, signed }),
+        }
+    }
+
+    /// The value at the start of `bytes` as an `i64`; `None` for an unsigned 8-byte value above
+    /// `i64::MAX`.
+    #[inline]
+    pub fn load(self, bytes: &[u8]) -> Option<i64> {
+        let mut le = [0u8; 8];
+        le[..self.width].copy_from_slice(&bytes[..self.width]);
+        let raw = u64::from_le_bytes(le);
+        if self.signed {
+            let shift = 64 - 8 * self.width as u32;
+            Some(((raw << shift) as i64) >> shift)
+        } else {
+            i64::try_from(raw).ok()
+        }
+    }
+}
+
+/// Where the four event fields sit in one record, and their types.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Layout {
     /// Bytes per record (padding included).
     pub itemsize: usize,
-    t: usize,
-    x: usize,
-    y: usize,
-    p: usize,
-    coordinate: Coordinate,
+    /// Offset and type of `t`, `x`, `y`, `p` (evtac's order, whatever the file's).
+    fields: [(usize, Scalar); 4],
 }
 
 impl Layout {
     /// Decodes one record of `itemsize` bytes.
     #[inline]
     pub(super) fn decode(&self, r: &[u8]) -> Result<Event, String> {
-        let t = i64::from_le_bytes([
-            r[self.t],
-            r[self.t + 1],
-            r[self.t + 2],
-            r[self.t + 3],
-            r[self.t + 4],
-            r[self.t + 5],
-            r[self.t + 6],
-            r[self.t + 7],
-        ]);
-        let x = u16::from_le_bytes([r[self.x], r[self.x + 1]]);
-        let y = u16::from_le_bytes([r[self.y], r[self.y + 1]]);
-        if self.coordinate == Coordinate::I16 && (x > i16::MAX as u16 || y > i16::MAX as u16) {
-            return Err(format!(
-                "negative coordinate (x={}, y={})",
-                x as i16, y as i16
-            ));
-        }
-        let polarity = match r[self.p] {
-            0 => false,
-            1 => true,
-            p => return Err(format!("p = {p} is neither 0 nor 1")),
-        };
-        Ok(Event { t, x, y, polarity })
+        let [t, x, y, p] = self
+            .fields
+            .map(|(offset, scalar)| scalar.load(&r[offset..]));
+        let t = t.ok_or_else(|| "t is larger than 2^63 - 1 microseconds".to_string())?;
+        let (x, y) = coordinates(x, y)?;
+        Ok(Event {
+            t,
+            x,
+            y,
+            polarity: polarity(p)?,
+        })
     }
 }
 
-/// Parses the header text into the record layout and the record count.
-pub(super) fn parse(text: &str) -> Result<(Layout, u64), NpyError> {
+/// A pixel's column and row from two loaded values: 0 to 65535 each.
+#[inline]
+pub(crate) fn coordinates(x: Option<i64>, y: Option<i64>) -> Result<(u16, u16), String> {
+    match (x.map(u16::try_from), y.map(u16::try_from)) {
+        (Some(Ok(x)), Some(Ok(y))) => Ok((x, y)),
+        _ if x.is_some_and(|v| v < 0) || y.is_some_and(|v| v < 0) => Err(format!(
+            "negative coordinate (x={}, y={})",
+            x.unwrap_or_default(),
+            y.unwrap_or_default()
+        )),
+        _ => Err(format!(
+            "coordinate beyond 65535 (x={:?}, y={:?})",
+            x.unwrap_or(i64::MAX),
+            y.unwrap_or(i64::MAX)
+        )),
+    }
+}
+
+/// A polarity from a loaded value: 1 is ON, 0 OFF, and -1 OFF too (tools that store the sign
+/// of the brightness change write -1; it cannot mean ON).
+#[inline]
+pub(crate) fn polarity(p: Option<i64>) -> Result<bool, String> {
+    match p {
+        Some(1) => Ok(true),
+        Some(0 | -1) => Ok(false),
+        p => Err(format!(
+            "p = {} is not 1 (ON), 0 or -1 (OFF)",
+            p.unwrap_or(i64::MAX)
+        )),
+    }
+}
+
+/// An NPY header: the array's element type and its length.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Header {
+    /// The `descr` value: a type string for a plain array, a list of fields for a record array.
+    descr: Value,
+    /// The `descr` as written, for error messages.
+    descr_text: String,
+    /// Number of elements.
+    pub count: u64,
+}
+
+impl Header {
+    /// The element type of a plain (not record) array, or an error naming what it is.
+    pub fn scalar(&self) -> Result<Scalar, NpyError> {
+        match &self.descr {
+            Value::Str(typestr) => Scalar::parse(typestr).ok_or_else(|| {
+                self.unsupported(format!(
+                    "`{typestr}` is not a little-endian integer or bool (event fields are \
+                     integer microseconds, pixels and 0/1 polarities)"
+                ))
+            }),
+            _ => Err(self.unsupported("a record (structured) dtype, not a plain array".into())),
+        }
+    }
+
+    fn unsupported(&self, reason: String) -> NpyError {
+        NpyError::UnsupportedDtype {
+            descr: self.descr_text.clone(),
+            reason,
+        }
+    }
+
+    /// The record layout of a record array of events.
+    pub fn layout(&self) -> Result<Layout, NpyError> {
+        let Value::Seq(fields) = &self.descr else {
+            return Err(self.unsupported("not a record (structured) dtype".into()));
+        };
+        let unsupported = |reason: String| self.unsupported(reason);
+        let mut offset = 0usize;
+        let mut slots = Slots::default();
+        for field in fields {
+            let (name, kind) = match field {
+                Value::Seq(parts) => match parts.as_slice() {
+                    [Value::Str(n), Value::Str(k)] => (n.as_str(), k.as_str()),
+                    [Value::Str(n), _, _] => {
+                        return Err(unsupported(format!("field `{n}` is a sub-array")));
+                    }
+                    _ => return Err(unsupported("a field is not a (name, type) pair".into())),
+                },
+                _ => return Err(unsupported("a field is not a (name, type) pair".into())),
+            };
+            let size = if name.is_empty() && kind.trim_start_matches('|').starts_with('V') {
+                kind.trim_start_matches('|')[1..]
+                    .parse::<usize>()
+                    .ok()
+                    .filter(|&n| n <= MAX_RECORD)
+                    .ok_or_else(|| {
+                        unsupported(format!(
+                            "padding field of type `{kind}` is not a size of at most \
+                             {MAX_RECORD} bytes"
+                        ))
+                    })?
+            } else {
+                let Some(field) = Field::of(name) else {
+                    return Err(unsupported(format!(
+                        "unexpected field `{name}` (event fields are named {})",
+                        Field::accepted()
+                    )));
+                };
+                let scalar = Scalar::parse(kind)
+                    .ok_or_else(|| unsupported(format!("field `{name}` has type `{kind}`")))?;
+                slots
+                    .set(field, (offset, scalar), name)
+                    .map_err(&unsupported)?;
+                scalar.width
+            };
+            offset += size;
+            // Each field adds at most MAX_RECORD bytes, so the sum cannot overflow before this.
+            if offset > MAX_RECORD {
+                return Err(unsupported(format!(
+                    "the fields make records of more than {MAX_RECORD} bytes (the event record \
+                     takes 13)"
+                )));
+            }
+        }
+        let fields = slots.complete().map_err(&unsupported)?;
+        Ok(Layout {
+            itemsize: offset,
+            fields,
+        })
+    }
+}
+
+/// Parses the header text: the element type and the length of a one-dimensional C-order array.
+pub(super) fn parse(text: &str) -> Result<Header, NpyError> {
     let mut parser = Parser {
         text: text.as_bytes(),
         pos: 0,
@@ -255,108 +413,36 @@ pub(super) fn parse(text: &str) -> Result<(Layout, u64), NpyError> {
         .trim_end_matches(',')
         .trim()
         .to_string();
-    let unsupported = |reason: String| NpyError::UnsupportedDtype {
-        descr: descr_text.clone(),
-        reason,
-    };
-    let Value::Seq(fields) = get("descr")? else {
-        return Err(unsupported("not a record (structured) dtype".into()));
-    };
-    let mut offset = 0usize;
-    let (mut t, mut x, mut y, mut p) = (None, None, None, None);
-    let mut coordinate = None;
-    for field in fields {
-        let (name, kind) = match field {
-            Value::Seq(parts) => match parts.as_slice() {
-                [Value::Str(n), Value::Str(k)] => (n.as_str(), k.as_str()),
-                [Value::Str(n), _, _] => {
-                    return Err(unsupported(format!("field `{n}` is a sub-array")));
-                }
-                _ => return Err(unsupported("a field is not a (name, type) pair".into())),
-            },
-            _ => return Err(unsupported("a field is not a (name, type) pair".into())),
-        };
-        let size = match (name, kind) {
-            ("", k) if k.starts_with("|V") || k.starts_with("V") => k.trim_start_matches('|')[1..]
-                .parse::<usize>()
-                .ok()
-                .filter(|&n| n <= MAX_RECORD)
-                .ok_or_else(|| {
-                    unsupported(format!(
-                        "padding field of type `{k}` is not a size of at most {MAX_RECORD} bytes"
-                    ))
-                })?,
-            ("t", "<i8") => set(&mut t, offset, name, &unsupported)? + 8,
-            ("x" | "y", "<i2" | "<u2") => {
-                let c = if kind == "<i2" {
-                    Coordinate::I16
-                } else {
-                    Coordinate::U16
-                };
-                if coordinate.is_some_and(|old| old != c) {
-                    return Err(unsupported("x and y have different types".into()));
-                }
-                coordinate = Some(c);
-                let slot = if name == "x" { &mut x } else { &mut y };
-                set(slot, offset, name, &unsupported)? + 2
-            }
-            ("p", "|u1" | "u1" | "|b1" | "b1" | "?") => {
-                set(&mut p, offset, name, &unsupported)? + 1
-            }
-            ("t" | "x" | "y" | "p", k) => {
-                return Err(unsupported(format!("field `{name}` has type `{k}`")));
-            }
-            (n, _) => return Err(unsupported(format!("unexpected field `{n}`"))),
-        };
-        offset += size;
-        // Each field adds at most MAX_RECORD bytes, so the sum cannot overflow before this.
-        if offset > MAX_RECORD {
-            return Err(unsupported(format!(
-                "the fields make records of more than {MAX_RECORD} bytes (the event record \
-                 takes 13)"
-            )));
-        }
-    }
-    let missing = |name: &str| unsupported(format!("field `{name}` is missing"));
-    let layout = Layout {
-        itemsize: offset,
-        t: t.ok_or_else(|| missing("t"))?,
-        x: x.ok_or_else(|| missing("x"))?,
-        y: y.ok_or_else(|| missing("y"))?,
-        p: p.ok_or_else(|| missing("p"))?,
-        coordinate: coordinate.unwrap_or(Coordinate::I16),
-    };
-    Ok((layout, count))
-}
-
-/// Records a field's offset, rejecting a second field of the same name; returns 0 so the caller
-/// adds the field size.
-fn set(
-    slot: &mut Option<usize>,
-    offset: usize,
-    name: &str,
-    unsupported: &impl Fn(String) -> NpyError,
-) -> Result<usize, NpyError> {
-    if slot.is_some() {
-        return Err(unsupported(format!("field `{name}` appears twice")));
-    }
-    *slot = Some(offset);
-    Ok(0)
+    Ok(Header {
+        descr: get("descr")?.clone(),
+        descr_text,
+        count,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The layout and length of a record array's header, or the error.
+    fn parse_layout(text: &str) -> Result<(Layout, u64), NpyError> {
+        let header = parse(text)?;
+        Ok((header.layout()?, header.count))
+    }
+
+    fn offsets(l: &Layout) -> [usize; 4] {
+        l.fields.map(|(offset, _)| offset)
+    }
+
     #[test]
     fn packed_and_padded_records() {
-        let (l, n) = parse(
+        let (l, n) = parse_layout(
             "{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1')], \
              'fortran_order': False, 'shape': (7,), }",
         )
         .unwrap();
-        assert_eq!((l.itemsize, l.t, l.x, l.y, l.p, n), (13, 0, 8, 10, 12, 7));
-        let (l, n) = parse(
+        assert_eq!((l.itemsize, offsets(&l), n), (13, [0, 8, 10, 12], 7));
+        let (l, n) = parse_layout(
             "{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1'), ('', '|V3')], \
              'fortran_order': False, 'shape': (219596,), }",
         )
@@ -365,18 +451,80 @@ mod tests {
     }
 
     #[test]
-    fn other_orders_and_types() {
-        let (l, _) = parse(
+    fn other_orders_names_and_types() {
+        let (l, _) = parse_layout(
             "{'descr': [('p', '|b1'), ('x', '<u2'), ('y', '<u2'), ('t', '<i8')], \
              'fortran_order': False, 'shape': (0,)}",
         )
         .unwrap();
-        assert_eq!((l.p, l.x, l.y, l.t, l.itemsize), (0, 1, 3, 5, 13));
+        assert_eq!((offsets(&l), l.itemsize), ([5, 1, 3, 0], 13));
+        // dv-processing's EventStore.numpy() and the `aedat` package's event arrays.
+        let (l, _) = parse_layout(
+            "{'descr': [('timestamp', '<i8'), ('x', '<i2'), ('y', '<i2'), ('polarity', '|i1'), \
+             ('', '|V3')], 'fortran_order': False, 'shape': (1,)}",
+        )
+        .unwrap();
+        assert_eq!((offsets(&l), l.itemsize), ([0, 8, 10, 12], 16));
+        let (l, _) = parse_layout(
+            "{'descr': [('t', '<u8'), ('x', '<u2'), ('y', '<u2'), ('on', '|b1')], \
+             'fortran_order': False, 'shape': (1,)}",
+        )
+        .unwrap();
+        assert_eq!(
+            l.fields[0].1,
+            Scalar {
+                width: 8,
+                signed: false
+            }
+        );
+    }
+
+    #[test]
+    fn scalars_load_sign_and_range() {
+        let s = |t: &str| Scalar::parse(t).unwrap();
+        assert_eq!(s("|i1").load(&[0xff]), Some(-1));
+        assert_eq!(s("<i2").load(&[0xfe, 0xff]), Some(-2));
+        assert_eq!(s("<u2").load(&[0xfe, 0xff]), Some(65534));
+        assert_eq!(s("<i4").load(&(-7i32).to_le_bytes()), Some(-7));
+        assert_eq!(s("<u8").load(&u64::MAX.to_le_bytes()), None);
+        assert_eq!(s("<u8").load(&5u64.to_le_bytes()), Some(5));
+        for bad in [">i8", "<f8", "|i2", "<i3", "S4", ""] {
+            assert_eq!(Scalar::parse(bad), None, "{bad}");
+        }
+        assert_eq!(polarity(Some(-1)), Ok(false));
+        assert!(polarity(Some(2)).unwrap_err().contains("p = 2"));
+        assert!(
+            coordinates(Some(-1), Some(0))
+                .unwrap_err()
+                .contains("negative")
+        );
+        assert!(
+            coordinates(Some(70_000), Some(0))
+                .unwrap_err()
+                .contains("65535")
+        );
+    }
+
+    #[test]
+    fn plain_arrays_give_their_scalar() {
+        let h = parse("{'descr': '<u4', 'fortran_order': False, 'shape': (3,)}").unwrap();
+        assert_eq!(
+            (h.scalar().unwrap(), h.count),
+            (
+                Scalar {
+                    width: 4,
+                    signed: false
+                },
+                3
+            )
+        );
+        let h = parse("{'descr': '<f8', 'fortran_order': False, 'shape': (3,)}").unwrap();
+        assert!(h.scalar().unwrap_err().to_string().contains("`<f8` is not"));
     }
 
     #[test]
     fn rejections_name_the_problem() {
-        let err = |h: &str| parse(h).unwrap_err().to_string();
+        let err = |h: &str| parse_layout(h).unwrap_err().to_string();
         assert!(
             err("{'descr': '<f8', 'fortran_order': False, 'shape': (3,)}").contains("not a record")
         );
@@ -386,7 +534,11 @@ mod tests {
         );
         assert!(
             err("{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2')], 'fortran_order': False, 'shape': (3,)}")
-                .contains("field `p` is missing")
+                .contains("field `p`")
+        );
+        assert!(
+            err("{'descr': [('t', '<i8'), ('timestamp', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1')], 'fortran_order': False, 'shape': (3,)}")
+                .contains("two columns")
         );
         assert!(
             err("{'descr': [('t', '<i8'), ('x', '<i2'), ('y', '<i2'), ('p', '|u1')], 'fortran_order': False, 'shape': (3, 2)}")

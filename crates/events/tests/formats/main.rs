@@ -12,4 +12,5 @@ mod evt;
 mod evt21;
 mod neurotac;
 mod npy;
+mod other_tools;
 mod recording;

@@ -3,11 +3,11 @@
 //! back event for event; and what is not the lab's structure (an `os.system` call, a dict, a
 //! ragged grid, a truncated file) refused with the file and the place named, nothing run.
 
-use std::path::Path;
-
 use evtac_events::neurotac::PixelOrder;
-use evtac_events::{Error, Event, Format, Resolution, Summary};
+use evtac_events::{Error, Format, Resolution, Summary};
 use evtac_testkit::run_python;
+
+use crate::common::read_expected_csv;
 
 /// Writes the test files into `dir`: sets `a` (object arrays [y, x], ON and OFF, protocol 5),
 /// `b` (nested lists [x][y], ON only, protocol 4), `c` (`np.save(allow_pickle=True)`, ON and
@@ -75,22 +75,6 @@ with open(os.path.join(d, "cut_events_on.pickle"), "wb") as f:
     f.write(whole[: len(whole) // 2])
 "#;
 
-fn expected(path: &Path) -> Vec<Event> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .map(|l| {
-            let v: Vec<i64> = l.split(',').map(|f| f.parse().unwrap()).collect();
-            Event {
-                t: v[0],
-                x: v[1] as u16,
-                y: v[2] as u16,
-                polarity: v[3] == 1,
-            }
-        })
-        .collect()
-}
-
 fn written() -> Option<tempfile::TempDir> {
     let dir = tempfile::tempdir().unwrap();
     run_python(WRITE, &[dir.path().to_str().unwrap()])?;
@@ -121,7 +105,7 @@ fn the_labs_pickles_read_event_for_event() {
         assert_eq!(Format::detect(&path).unwrap(), Format::Neurotac, "{file}");
         let rec = evtac_events::read_recording(&path).unwrap();
         assert_eq!(rec.resolution, Some(Resolution::new(64, 48)), "{file}");
-        let want = expected(&d.join(format!("{set}.expected.csv")));
+        let want = read_expected_csv(&d.join(format!("{set}.expected.csv")));
         assert!(want.len() > 100, "{file}: {} events", want.len());
         assert_eq!(rec.events.len(), want.len(), "{file}");
         assert!(rec.events == want, "{file}: the events differ");
