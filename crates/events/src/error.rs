@@ -118,6 +118,14 @@ pub enum Error {
         /// What is wrong.
         error: NpyError,
     },
+    /// An HDF5 event file is broken or holds no event datasets.
+    #[error("{}: {error}", path.display())]
+    Hdf5 {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        error: crate::hdf5::Hdf5Error,
+    },
     /// An NPZ archive is broken or holds no events.
     #[error("{}: {error}", path.display())]
     Npz {

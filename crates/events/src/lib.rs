@@ -37,6 +37,7 @@ pub mod columns;
 pub mod csv;
 mod error;
 pub mod evt;
+pub mod hdf5;
 mod io_error;
 pub mod layout;
 pub mod manifest;

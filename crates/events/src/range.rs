@@ -21,6 +21,14 @@ pub enum RangeIndex {
         /// Packets in the file.
         total: usize,
     },
+    /// An HDF5 file's `ms_to_idx` (DSEC's index of each millisecond's first event) located the
+    /// events: only `events` of the file's `total` are read.
+    EventIndex {
+        /// Events read (those of the milliseconds the range touches).
+        events: u64,
+        /// Events in the file.
+        total: u64,
+    },
     /// The file is read from its start and every packet outside the range is dropped.
     Scan(ScanReason),
 }

@@ -20,6 +20,7 @@ use crate::aedat_legacy::{self, LegacyReader};
 use crate::check::EventCheck;
 use crate::csv::{CsvReader, CsvWriter};
 use crate::evt::{EvtReader, EvtVersion};
+use crate::hdf5::Hdf5Reader;
 use crate::npy::{NpyReader, NpyWriter};
 use crate::output::OutputFile;
 use crate::range::{RangeIndex, ScanReason, within};
@@ -48,6 +49,9 @@ pub enum Format {
     /// NPZ: numpy's zip of NPY arrays, one event record array or one array per field
     /// (`.npz`), read only (see [`crate::npz`]).
     Npz,
+    /// HDF5 with one dataset per event field (event_utils' and the NeuroTac code's layout, and
+    /// DSEC's), read only (see [`crate::hdf5`]).
+    Hdf5,
     /// The NeuroTac lab's per-pixel event times (a pickle, or an NPY of Python objects), read
     /// only (see [`crate::neurotac`]).
     Neurotac,
@@ -67,13 +71,15 @@ impl Format {
             Self::Csv => "CSV",
             Self::Npy => "NPY",
             Self::Npz => "NPZ",
+            Self::Hdf5 => "HDF5",
             Self::Neurotac => "NeuroTac pickle",
         }
     }
 
-    /// Whether the format carries the sensor resolution itself (CSV, NPY and NPZ do not).
+    /// Whether the format carries the sensor resolution itself (CSV, NPY and NPZ do not; HDF5
+    /// does when it has a `sensor_resolution` attribute, which DSEC's files do not).
     pub const fn has_resolution(self) -> bool {
-        !matches!(self, Self::Csv | Self::Npy | Self::Npz)
+        !matches!(self, Self::Csv | Self::Npy | Self::Npz | Self::Hdf5)
     }
 
     /// The format an output path's extension asks for: `.aedat4`, `.csv` or `.npy`.
@@ -94,6 +100,10 @@ impl Format {
             "npz" => Err(Error::NotWritable {
                 path: path.to_path_buf(),
                 format: Self::Npz,
+            }),
+            "h5" | "hdf5" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::Hdf5,
             }),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
@@ -116,6 +126,9 @@ impl Format {
             .map_err(io)?;
         if head.starts_with(crate::aedat::MAGIC) {
             return Ok(Self::Aedat4);
+        }
+        if head.starts_with(b"\x89HDF\r\n\x1a\n") {
+            return Ok(Self::Hdf5);
         }
         if crate::neurotac::sniff(&head) {
             return Ok(Self::Neurotac);
@@ -160,8 +173,9 @@ impl Format {
                 path: path.to_path_buf(),
                 reason: "the file is empty".into(),
             }),
-            "aedat4" | "aedat" | "npy" | "npz" | "raw" => {
+            "aedat4" | "aedat" | "npy" | "npz" | "h5" | "hdf5" | "raw" => {
                 let signature = match extension.as_str() {
+                    "h5" | "hdf5" => "the HDF5 signature `\\x89HDF\\r\\n\\x1a\\n`",
                     "npy" => "the NPY magic `\\x93NUMPY`",
                     "npz" => "the zip magic `PK\\x03\\x04`",
                     "raw" => "a `%` EVT text header line",
@@ -225,6 +239,7 @@ enum Inner {
     Evt(Box<EvtReader<File>>),
     Csv(Box<CsvReader<BufReader<File>>>),
     Npy(Box<NpyReader<File>>),
+    Hdf5(Box<Hdf5Reader>),
     Memory(Box<MemoryEvents>),
 }
 
@@ -399,6 +414,14 @@ pub fn open_with(
             };
             (Inner::Memory(Box::new(r)), None)
         }
+        Format::Hdf5 => {
+            let r = Hdf5Reader::open(path).map_err(|error| Error::Hdf5 {
+                path: path.to_path_buf(),
+                error,
+            })?;
+            note = Some(r.note());
+            (Inner::Hdf5(Box::new(r)), None)
+        }
         Format::Npz => {
             let file = crate::npz::read(path).map_err(|error| Error::Npz {
                 path: path.to_path_buf(),
@@ -454,6 +477,7 @@ impl EventReader {
             Inner::Evt(r) => r.resolution(),
             Inner::Csv(r) => r.resolution(),
             Inner::Npy(r) => r.resolution(),
+            Inner::Hdf5(r) => r.resolution(),
             Inner::Memory(r) => r.check.resolution(),
         }
     }
@@ -477,8 +501,19 @@ impl EventReader {
                 found,
             });
         }
+        if let Inner::Hdf5(r) = &self.inner
+            && !r.accepts(resolution)
+            && let Some(found) = r.resolution()
+        {
+            return Err(Error::ResolutionMismatch {
+                path: self.path.clone(),
+                declared: resolution,
+                found,
+            });
+        }
         match &mut self.inner {
             Inner::Aedat(_) => self.aedat_check.set_resolution(Some(resolution)),
+            Inner::Hdf5(r) => r.set_resolution(resolution),
             Inner::Legacy(r) => r.set_resolution(resolution),
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
@@ -502,6 +537,10 @@ impl EventReader {
             Inner::Evt(r) => r.position(),
             Inner::Csv(r) => r.position(),
             Inner::Npy(r) => r.position(),
+            // Elements, not bytes (chunks and filters hide the bytes): scaled to the file.
+            Inner::Hdf5(r) => {
+                (self.len as f64 * r.position() as f64 / r.len().max(1) as f64) as u64
+            }
             Inner::Memory(r) => {
                 if r.next > 0 {
                     r.len
@@ -534,6 +573,16 @@ impl EventReader {
                     path: self.path.clone(),
                     error,
                 })
+            }
+            Inner::Hdf5(r) => {
+                self.range = Some((from, to));
+                let index = r.select_range(from, to).map_err(|error| Error::Hdf5 {
+                    path: self.path.clone(),
+                    error,
+                })?;
+                Ok(index.unwrap_or(RangeIndex::Scan(ScanReason::NotIndexed {
+                    format: "HDF5 (without ms_to_idx)",
+                })))
             }
             _ => {
                 self.range = Some((from, to));
@@ -704,6 +753,18 @@ fn next_unfiltered<'a>(
                 })
             })
             .map_err(|error| Error::Npy {
+                path: path.to_path_buf(),
+                error,
+            }),
+        Inner::Hdf5(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|events| Chunk {
+                    events,
+                    ..Chunk::default()
+                })
+            })
+            .map_err(|error| Error::Hdf5 {
                 path: path.to_path_buf(),
                 error,
             }),

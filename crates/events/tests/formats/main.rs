@@ -10,6 +10,7 @@ mod common;
 mod csv;
 mod evt;
 mod evt21;
+mod hdf5;
 mod neurotac;
 mod npy;
 mod other_tools;
