@@ -17,7 +17,7 @@ S = sys.argv[1]
 R = sys.argv[2] if len(sys.argv) > 2 else os.path.join(
     os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "fixtures", "real"
 )
-for target in ("aedat", "evt2", "evt3", "csv", "npy", "npz", "neurotac"):
+for target in ("aedat", "evt2", "evt3", "csv", "npy", "npz", "hdf5", "neurotac"):
     os.makedirs(os.path.join(S, target), exist_ok=True)
 rng = np.random.default_rng(7)
 # NPY: the event record in several forms numpy writes
@@ -151,3 +151,24 @@ for h, w in ((3, 4), (2, 2), (5, 1)):
         pickle.dump(cells, f, protocol=4)
 with open(os.path.join(S, "neurotac", "dict"), "wb") as f:
     pickle.dump({"events": [1.0, 2.5], "n": 2}, f, protocol=4)
+# HDF5 written by h5py: event_utils' layout (float seconds, bool p, attributes), DSEC's (t_offset,
+# ms_to_idx), gzip-compressed and contiguous, and a few broken ones
+import h5py
+def h5(name, t, x, y, p, names=("ts", "xs", "ys", "ps"), gzip=False, dsec=False, attrs=True):
+    with h5py.File(os.path.join(S, "hdf5", name + ".h5"), "w") as f:
+        for k, v in zip(names, (t, x, y, p)):
+            f.create_dataset("events/" + k, data=v, compression="gzip" if gzip else None)
+        if attrs:
+            f.attrs["num_events"] = len(x); f.attrs["sensor_resolution"] = (240, 320)
+        if dsec:
+            f.create_dataset("t_offset", data=np.int64(1000))
+            f.create_dataset("ms_to_idx", data=np.searchsorted(t, np.arange(0, 8) * 1000).astype(np.uint64))
+for n in (0, 1, 30):
+    t = np.sort(rng.integers(0, 8000, n)); x = rng.integers(0, 320, n).astype(np.int16)
+    y = rng.integers(0, 240, n).astype(np.int16); p = rng.integers(0, 2, n)
+    h5(f"eu_{n}", t / 1e6, x, y, p.astype(bool))
+    h5(f"eu_gzip_{n}", t / 1e6, x, y, p.astype(bool), gzip=True)
+    h5(f"dsec_{n}", t.astype(np.uint32), x.astype(np.uint16), y.astype(np.uint16),
+       p.astype(np.uint8), names=("t", "x", "y", "p"), dsec=True, attrs=False)
+h5("ragged", np.arange(3) / 1e6, np.arange(2), np.arange(3), np.arange(3) % 2)
+h5("string", np.arange(3) / 1e6, np.array([b"a"] * 3), np.arange(3), np.arange(3) % 2)
