@@ -1,6 +1,7 @@
 """The formats without a real fixture: AEDAT 2.0 (jAER), AEDAT 3.1 (cAER), Prophesee EVT 2.1,
 written here from the format descriptions (as evtac-events' own tests write them), and the
-NeuroTac lab's per-pixel pickles, written by Python's pickle as its collection scripts do. `read` and
+NeuroTac lab's per-pixel pickles, written by Python's pickle as its collection scripts do, and
+event_utils' HDF5, written by h5py. `read` and
 `open` give the events, IMU samples and triggers the writer encoded, and the events of the CLI's
 `evtac convert`."""
 
@@ -123,9 +124,28 @@ def _neurotac(path):
     return events, [], [], (w, h), "NeuroTac pickle"
 
 
+def _hdf5(path):
+    """event_utils' layout, written by h5py: `events/xs, ys` int16, `ts` float seconds, `ps`
+    bool, `sensor_resolution` as [height, width]."""
+    import h5py
+    rng = np.random.default_rng(6)
+    w, h, n = 240, 180, 5000
+    t = np.sort(rng.integers(1_700_000_000_000_000, 1_700_000_010_000_000, n))
+    x, y, p = rng.integers(0, w, n), rng.integers(0, h, n), rng.integers(0, 2, n)
+    with h5py.File(path, "w") as f:
+        f.create_dataset("events/xs", data=x.astype(np.int16), compression="gzip")
+        f.create_dataset("events/ys", data=y.astype(np.int16))
+        f.create_dataset("events/ts", data=t / 1e6)
+        f.create_dataset("events/ps", data=p.astype(bool))
+        f.attrs["sensor_resolution"] = (h, w)
+    events = [(int(a), int(b), int(c), int(d)) for a, b, c, d in zip(t, x, y, p)]
+    return events, [], [], (w, h), "HDF5"
+
+
 @pytest.mark.parametrize("name,writer", [("aedat2.aedat", _aedat2), ("aedat31.aedat", _aedat31),
                                          ("evt21.raw", _evt21),
-                                         ("trial_events_on.pickle", _neurotac)])
+                                         ("trial_events_on.pickle", _neurotac),
+                                         ("event_utils.h5", _hdf5)])
 def test_read_and_open_give_what_was_written_and_the_clis_events(cli, tmp_path, name, writer):
     path = tmp_path / name
     events, imu, triggers, resolution, fmt = writer(path)

@@ -3,29 +3,50 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use evtac_events::Summary;
 use evtac_events::aedat::StreamSelection;
+use evtac_events::{Format, Resolution, Summary};
 
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording to summarise (AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY).
+    /// The recording to summarise (any format evtac reads: AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0
+    /// raw, CSV, NPY, NPZ, HDF5, the NeuroTac lab's pickles).
     pub file: PathBuf,
     /// Print the summary as one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
+    #[command(flatten)]
+    pub sensor: crate::sensor::SensorArgs,
 }
 
 /// Reads the whole file in chunks (with a byte progress bar on a terminal) and summarises it:
-/// every stream of an AEDAT4 file, and the chosen ones at the top level.
-pub fn summarise(path: &std::path::Path, streams: &StreamSelection) -> anyhow::Result<Summary> {
+/// every stream of an AEDAT4 file, and the chosen ones at the top level. A declared `sensor`
+/// is checked against the size the file states, and every event against it.
+pub fn summarise(
+    path: &std::path::Path,
+    streams: &StreamSelection,
+    sensor: Option<Resolution>,
+) -> anyhow::Result<Summary> {
     let len = std::fs::metadata(path)
         .with_context(|| path.display().to_string())?
         .len();
     let bar = crate::progress::bytes(len, "reading");
-    let summary = Summary::of_file_with(path, streams, |position| bar.set_position(position))?;
+    let on_position = |position| bar.set_position(position);
+    let summary = match sensor {
+        // AEDAT4's summary lists every stream; the declared size is checked against the chosen.
+        Some(sensor) if Format::detect(path)? == Format::Aedat4 => {
+            evtac_events::open_with(path, streams)?.set_resolution(sensor)?;
+            Summary::of_file_with(path, streams, on_position)?
+        }
+        Some(sensor) => {
+            let mut reader = evtac_events::open_with(path, streams)?;
+            reader.set_resolution(sensor)?;
+            Summary::read(&mut reader, on_position)?
+        }
+        None => Summary::of_file_with(path, streams, on_position)?,
+    };
     bar.finish_and_clear();
     Ok(summary)
 }
@@ -100,7 +121,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
 
 /// Runs `evtac info`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let summary = summarise(&args.file, &args.streams.selection())?;
+    let summary = summarise(&args.file, &args.streams.selection(), args.sensor.sensor)?;
     if args.json {
         let text = serde_json::to_string_pretty(&summary).context("serialising the summary")?;
         println!("{text}");

@@ -24,8 +24,9 @@ pub struct Args {
     /// Model bundle folder (from `evtac train`): weights, representation settings, mask.
     #[arg(long)]
     pub model: PathBuf,
-    /// Event source: a recording (AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0, CSV, NPY), a live DV
-    /// network stream `tcp://HOST:PORT`, or `-` for standard input (AEDAT4 or CSV).
+    /// Event source: a recording (any format evtac reads: AEDAT, EVT, CSV, NPY, NPZ, HDF5, the
+    /// NeuroTac pickles), a live DV network stream `tcp://HOST:PORT`, or `-` for standard input
+    /// (AEDAT4 or CSV).
     #[arg(long)]
     pub input: String,
     /// Interval between estimates, in milliseconds of event time.
