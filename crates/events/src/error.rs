@@ -123,16 +123,16 @@ pub enum Error {
     Hdf5 {
         /// The file.
         path: PathBuf,
-        /// What is wrong.
-        error: crate::hdf5::Hdf5Error,
+        /// What is wrong (boxed: the error enum stays small).
+        error: Box<crate::hdf5::Hdf5Error>,
     },
     /// An NPZ archive is broken or holds no events.
     #[error("{}: {error}", path.display())]
     Npz {
         /// The file.
         path: PathBuf,
-        /// What is wrong.
-        error: crate::npz::NpzError,
+        /// What is wrong (boxed: the error enum stays small).
+        error: Box<crate::npz::NpzError>,
     },
     /// A NeuroTac pickle (or its pair) is not the lab's structure, or is broken.
     #[error("{error}")]

@@ -417,7 +417,7 @@ pub fn open_with(
         Format::Hdf5 => {
             let r = Hdf5Reader::open(path).map_err(|error| Error::Hdf5 {
                 path: path.to_path_buf(),
-                error,
+                error: Box::new(error),
             })?;
             note = Some(r.note());
             (Inner::Hdf5(Box::new(r)), None)
@@ -425,7 +425,7 @@ pub fn open_with(
         Format::Npz => {
             let file = crate::npz::read(path).map_err(|error| Error::Npz {
                 path: path.to_path_buf(),
-                error,
+                error: Box::new(error),
             })?;
             note = Some(file.note());
             let r = MemoryEvents {
@@ -578,7 +578,7 @@ impl EventReader {
                 self.range = Some((from, to));
                 let index = r.select_range(from, to).map_err(|error| Error::Hdf5 {
                     path: self.path.clone(),
-                    error,
+                    error: Box::new(error),
                 })?;
                 Ok(index.unwrap_or(RangeIndex::Scan(ScanReason::NotIndexed {
                     format: "HDF5 (without ms_to_idx)",
@@ -766,7 +766,7 @@ fn next_unfiltered<'a>(
             })
             .map_err(|error| Error::Hdf5 {
                 path: path.to_path_buf(),
-                error,
+                error: Box::new(error),
             }),
         Inner::Memory(r) => r
             .next_chunk()
