@@ -45,6 +45,7 @@ pub mod output;
 pub mod pickle;
 mod range;
 mod recording;
+pub mod ros;
 mod summary;
 mod text_header;
 mod types;
