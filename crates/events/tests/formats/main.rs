@@ -13,3 +13,4 @@ mod evt21;
 mod neurotac;
 mod npy;
 mod recording;
+mod ros;
