@@ -1,6 +1,9 @@
 //! Event and IMU types for evtac, and readers and writers for the files event-camera users have:
 //! AEDAT 4.0 ([`aedat`]), the older AEDAT 3.1 and 2.0 ([`aedat_legacy`]), Prophesee EVT 2.0 / 2.1 /
-//! 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]).
+//! 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]); and readers for the NeuroTac lab's pickles
+//! ([`neurotac`]) and for ROS bags ([`ros`]: ROS 1 `.bag` and ROS 2 MCAP, with
+//! `dvs_msgs/EventArray` or `event_camera_msgs/EventPacket` events and `sensor_msgs/Imu`, a
+//! topic chosen like an AEDAT4 stream).
 //!
 //! Time is `i64` microseconds everywhere; coordinates are on the full sensor with `x` to the right
 //! and `y` downwards; a [`Roi`] crops them (the paper uses the centered 240x240 region).

@@ -270,8 +270,13 @@ impl Scan<'_> {
             b"none" => r.data,
             b"bz2" | b"lz4" => {
                 // Read at most one byte more than the chunk declares (to notice a longer
-                // stream); the buffer grows with the bytes decompressed, never with the
-                // declared size alone.
+                // stream), and no more than the collector's cap (fuzzing); the buffer grows
+                // with the bytes decompressed, never with the declared size alone.
+                if u64::from(size) > self.c.limit() {
+                    return Err(RosError::TooLarge {
+                        limit: self.c.limit(),
+                    });
+                }
                 let limit = u64::from(size) + 1;
                 let mut out = Vec::new();
                 let read = if compression == b"bz2" {

@@ -4,11 +4,11 @@
 //! Two containers:
 //!
 //! - **ROS 1 `.bag`** (`#ROSBAG V2.0`, [`Format::RosBag`]): records with `name=value` headers;
-//!   messages sit in chunks, uncompressed, bz2 or lz4 ([`bag1`] explains why evtac parses the
-//!   container itself rather than through the `rosbag` crate).
+//!   messages sit in chunks, uncompressed, bz2 or lz4 (the `bag1` module explains why evtac
+//!   parses the container itself rather than through the `rosbag` crate).
 //! - **ROS 2 MCAP** (`\x89MCAP0\r\n`, [`Format::Mcap`]), rosbag2's default storage: a single
 //!   `.mcap` file, or a rosbag2 folder (`metadata.yaml` beside one or more `.mcap` files), read
-//!   with the `mcap` crate ([`mcap2`]).
+//!   with the `mcap` crate (module `mcap2`).
 //!
 //! In a bag, a stream *is* a topic: [`topics`] lists them (name, message type, message count),
 //! and [`open_with`](crate::open_with) reads the event topic a [`StreamSelection`] names
@@ -334,6 +334,11 @@ impl Collector {
             });
         }
         Ok(())
+    }
+
+    /// The cap on the bytes of messages kept (and of any chunk decompressed).
+    pub(crate) fn limit(&self) -> u64 {
+        self.limit
     }
 
     fn infos(&self) -> Vec<TopicInfo> {

@@ -362,3 +362,24 @@ fn an_unknown_packet_encoding_names_topic_message_and_encoding() {
         "{text}"
     );
 }
+
+#[test]
+fn the_fuzz_entry_points_decode_whole_bags() {
+    let Some(dir) = written() else { return };
+    let d = dir.path();
+    let rec = evtac_events::read_recording(d.join("dvs_bz2.bag")).unwrap();
+    let bag = std::fs::read(d.join("dvs_bz2.bag")).unwrap();
+    assert_eq!(
+        evtac_events::ros::fuzz_decode_rosbag(&bag),
+        rec.events.len() + rec.imu.len()
+    );
+    let rec = evtac_events::read_recording(d.join("dvs2_zstd")).unwrap();
+    let mcap = std::fs::read(d.join("dvs2_zstd/dvs2_zstd.mcap")).unwrap();
+    assert_eq!(
+        evtac_events::ros::fuzz_decode_mcap(&mcap),
+        rec.events.len() + rec.imu.len()
+    );
+    // Each entry point refuses the other container.
+    assert_eq!(evtac_events::ros::fuzz_decode_rosbag(&mcap), 0);
+    assert_eq!(evtac_events::ros::fuzz_decode_mcap(&bag), 0);
+}
