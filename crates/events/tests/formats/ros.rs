@@ -200,6 +200,11 @@ fn evt3_packets_decode_as_the_raw_file_across_packet_boundaries() {
     assert_eq!(want.len(), 219_596);
     assert_events("evt3 packets", &rec.events, &want);
     assert_imu("evt3 IMU", &rec.imu, &d.join("evt3.imu.csv"));
+    // The same packets in a ROS 1 bag.
+    let rec = evtac_events::read_recording(d.join("evt3.bag")).unwrap();
+    assert_eq!(rec.format, Format::RosBag);
+    assert_eq!(rec.resolution, Some(Resolution::new(1280, 720)));
+    assert_events("evt3 packets in a ROS 1 bag", &rec.events, &want);
 }
 
 #[test]

@@ -145,6 +145,13 @@ def evt3_bag(raw_path):
     imu, imu_rows = imu_messages(ts2, False, 20, 1_700_000_100)
     write2(os.path.join(d, 'evt3'), [('/prophesee/events', 'event_camera_msgs/msg/EventPacket', packets),
                                     ('/prophesee/imu', 'sensor_msgs/msg/Imu', imu)])
+    # The same packets in a ROS 1 bag (event_camera_msgs builds for ROS 1 too), lz4 chunks.
+    Pkt1 = ts1.types['event_camera_msgs/msg/EventPacket']
+    packets1 = [(t, Pkt1(header=header(ts1, True, *divmod(t, 10**9), m.seq), height=720, width=1280,
+                         seq=m.seq, time_base=0, encoding='evt3', is_bigendian=False, events=m.events))
+                for t, m in packets]
+    write1(os.path.join(d, 'evt3.bag'), [('/prophesee/events', 'event_camera_msgs/msg/EventPacket', packets1)],
+           Writer1.CompressionFormat.LZ4)
     save('evt3.imu.csv', imu_rows)
     with open(os.path.join(d, 'evt3.packets'), 'w') as f:
         f.write(str(len(pieces)))
