@@ -60,5 +60,6 @@ pub use recording::{
     Chunk, EventReader, EventWriter, Events, Format, Recording, open, open_with, read_recording,
     read_recording_range,
 };
+pub use ros::{TopicInfo, topics};
 pub use summary::Summary;
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};
