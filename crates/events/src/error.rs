@@ -142,6 +142,14 @@ pub enum Error {
         /// What is wrong (naming the file of the pair it is in).
         error: Box<crate::neurotac::NeurotacError>,
     },
+    /// A ROS bag (ROS 1 `.bag` or ROS 2 MCAP) is broken, or a message does not decode.
+    #[error("{}: {error}", path.display())]
+    Ros {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, naming the topic and message.
+        error: crate::ros::RosError,
+    },
     /// An event read from the file is invalid (outside the sensor, or earlier than its
     /// predecessor).
     #[error("{}: {error}", path.display())]

@@ -1,6 +1,9 @@
 //! Event and IMU types for evtac, and readers and writers for the files event-camera users have:
 //! AEDAT 4.0 ([`aedat`]), the older AEDAT 3.1 and 2.0 ([`aedat_legacy`]), Prophesee EVT 2.0 / 2.1 /
-//! 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]).
+//! 3.0 ([`evt`]), CSV ([`csv`]) and NPY ([`npy`]); and readers for the NeuroTac lab's pickles
+//! ([`neurotac`]) and for ROS bags ([`ros`]: ROS 1 `.bag` and ROS 2 MCAP, with
+//! `dvs_msgs/EventArray` or `event_camera_msgs/EventPacket` events and `sensor_msgs/Imu`, a
+//! topic chosen like an AEDAT4 stream).
 //!
 //! Time is `i64` microseconds everywhere; coordinates are on the full sensor with `x` to the right
 //! and `y` downwards; a [`Roi`] crops them (the paper uses the centered 240x240 region).
@@ -48,6 +51,7 @@ pub mod output;
 pub mod pickle;
 mod range;
 mod recording;
+pub mod ros;
 mod summary;
 mod text_header;
 mod types;
@@ -59,5 +63,6 @@ pub use recording::{
     Chunk, EventReader, EventWriter, Events, Format, Recording, open, open_with, read_recording,
     read_recording_range,
 };
+pub use ros::{TopicInfo, topics};
 pub use summary::Summary;
 pub use types::{Event, ImuSample, Resolution, Roi, Trigger};

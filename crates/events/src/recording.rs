@@ -3,7 +3,7 @@
 //! format ([`EventWriter`]).
 //!
 //! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, `#!AER-DAT2.0` /
-//! `#!AER-DAT3.1` header, EVT `%` header)
+//! `#!AER-DAT3.1` header, EVT `%` header, ROS 1 bag and MCAP magic; a folder is a rosbag2 bag)
 //! and otherwise by its extension (`.csv`). Every reader validates what it decodes: events
 //! inside the declared resolution and timestamps that never go backwards.
 //!
@@ -55,11 +55,17 @@ pub enum Format {
     /// The NeuroTac lab's per-pixel event times (a pickle, or an NPY of Python objects), read
     /// only (see [`crate::neurotac`]).
     Neurotac,
+    /// A ROS 1 bag (`.bag`): `dvs_msgs/EventArray` or `event_camera_msgs/EventPacket` events and
+    /// `sensor_msgs/Imu`, read only (see [`crate::ros`]).
+    RosBag,
+    /// A ROS 2 bag in MCAP storage (an `.mcap` file or a rosbag2 folder), with the same messages
+    /// as [`Format::RosBag`], read only (see [`crate::ros`]).
+    Mcap,
 }
 
 impl Format {
     /// The short name shown to users (`AEDAT4`, `AEDAT2`, `AEDAT3.1`, `EVT2`, `EVT21`, `EVT3`,
-    /// `CSV`, `NPY`, `NPZ`, `NeuroTac pickle`).
+    /// `CSV`, `NPY`, `NPZ`, `HDF5`, `NeuroTac pickle`, `ROS 1 bag`, `ROS 2 MCAP`).
     pub const fn name(self) -> &'static str {
         match self {
             Self::Aedat4 => "AEDAT4",
@@ -73,6 +79,8 @@ impl Format {
             Self::Npz => "NPZ",
             Self::Hdf5 => "HDF5",
             Self::Neurotac => "NeuroTac pickle",
+            Self::RosBag => "ROS 1 bag",
+            Self::Mcap => "ROS 2 MCAP",
         }
     }
 
@@ -105,6 +113,14 @@ impl Format {
                 path: path.to_path_buf(),
                 format: Self::Hdf5,
             }),
+            "bag" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::RosBag,
+            }),
+            "mcap" => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                format: Self::Mcap,
+            }),
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
                 reason: format!("the extension `{extension}` is not .aedat4, .csv or .npy"),
@@ -113,11 +129,15 @@ impl Format {
     }
 
     /// Recognises the format of the file at `path`: by its first bytes, else by its extension.
+    /// A folder is read as a rosbag2 bag (its `.mcap` files).
     pub fn detect(path: &Path) -> Result<Self, Error> {
         let io = |error| Error::Io {
             path: path.to_path_buf(),
             error,
         };
+        if path.is_dir() {
+            return crate::ros::detect_folder(path);
+        }
         let mut head = Vec::with_capacity(64);
         File::open(path)
             .map_err(io)?
@@ -129,6 +149,13 @@ impl Format {
         }
         if head.starts_with(b"\x89HDF\r\n\x1a\n") {
             return Ok(Self::Hdf5);
+        }
+        // Any `#ROSBAG V` line: the reader names a version other than 2.0.
+        if head.starts_with(b"#ROSBAG V") {
+            return Ok(Self::RosBag);
+        }
+        if head.starts_with(crate::ros::MCAP_MAGIC) {
+            return Ok(Self::Mcap);
         }
         if crate::neurotac::sniff(&head) {
             return Ok(Self::Neurotac);
@@ -173,12 +200,14 @@ impl Format {
                 path: path.to_path_buf(),
                 reason: "the file is empty".into(),
             }),
-            "aedat4" | "aedat" | "npy" | "npz" | "h5" | "hdf5" | "raw" => {
+            "aedat4" | "aedat" | "npy" | "npz" | "h5" | "hdf5" | "raw" | "bag" | "mcap" => {
                 let signature = match extension.as_str() {
                     "h5" | "hdf5" => "the HDF5 signature `\\x89HDF\\r\\n\\x1a\\n`",
                     "npy" => "the NPY magic `\\x93NUMPY`",
                     "npz" => "the zip magic `PK\\x03\\x04`",
                     "raw" => "a `%` EVT text header line",
+                    "bag" => "the ROS 1 bag line `#ROSBAG V2.0`",
+                    "mcap" => "the MCAP magic `\\x89MCAP0\\r\\n`",
                     _ => "the AEDAT 4.0 magic `#!AER-DAT4.0\\r\\n`",
                 };
                 let first = String::from_utf8_lossy(&head[..head.len().min(14)]).into_owned();
@@ -192,7 +221,9 @@ impl Format {
             }
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
-                reason: "no AEDAT4, NPY or EVT signature, and the extension is not .csv".into(),
+                reason: "no AEDAT4, NPY, EVT, ROS bag or MCAP signature, and the extension is not \
+                         .csv"
+                    .into(),
             }),
         }
     }
@@ -216,9 +247,9 @@ fn extension(path: &Path) -> String {
 pub struct Chunk<'a> {
     /// Events, in time order.
     pub events: &'a [Event],
-    /// IMU samples (AEDAT4, AEDAT 3.1).
+    /// IMU samples (AEDAT4, AEDAT 3.1, ROS bags).
     pub imu: &'a [ImuSample],
-    /// Triggers (AEDAT4, AEDAT 3.1, EVT).
+    /// Triggers (AEDAT4, AEDAT 3.1, EVT, ROS bags' EVT3 packets).
     pub triggers: &'a [Trigger],
 }
 
@@ -243,12 +274,20 @@ enum Inner {
     Memory(Box<MemoryEvents>),
 }
 
-/// A recording read whole (NeuroTac pickles and NPZ archives, which must be parsed whole),
+/// A recording read whole (NeuroTac pickles, NPZ archives and ROS bags, which must be parsed
+/// whole),
 /// handed out in chunks like the streaming readers'.
 struct MemoryEvents {
     events: Vec<Event>,
+    /// IMU samples, in time order.
+    imu: Vec<ImuSample>,
+    /// Triggers, in time order.
+    triggers: Vec<Trigger>,
+    /// The next event, IMU sample and trigger to hand out.
     next: usize,
-    /// Checks the events against the sensor size (the file's own, or the one declared).
+    next_imu: usize,
+    next_trigger: usize,
+    /// Checks events against the file's sensor size (or a declared one).
     check: EventCheck,
     /// Bytes of the files, for positions: all read at once.
     len: u64,
@@ -258,14 +297,45 @@ impl MemoryEvents {
     /// Events per chunk, as the file readers hand them out.
     const CHUNK: usize = 1 << 16;
 
-    fn next_chunk(&mut self) -> Result<Option<&[Event]>, crate::check::CheckError> {
-        if self.next >= self.events.len() {
+    fn new(events: Vec<Event>, resolution: Option<Resolution>, len: u64) -> Self {
+        Self {
+            events,
+            imu: Vec::new(),
+            triggers: Vec::new(),
+            next: 0,
+            next_imu: 0,
+            next_trigger: 0,
+            check: EventCheck::new(resolution),
+            len,
+        }
+    }
+
+    /// The next chunk: up to [`Self::CHUNK`] events, with the IMU samples and triggers up to
+    /// the last of them (all that remain with the last events), so that a range read, which
+    /// stops at the first chunk whose events pass the range's end, misses none.
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, crate::check::CheckError> {
+        let done = self.next >= self.events.len();
+        if done && self.next_imu >= self.imu.len() && self.next_trigger >= self.triggers.len() {
             return Ok(None);
         }
         let end = (self.next + Self::CHUNK).min(self.events.len());
-        let chunk = &self.events[self.next..end];
-        self.check.check(chunk)?;
+        let events = &self.events[self.next..end];
+        self.check.check(events)?;
         self.next = end;
+        let upto = match events.last() {
+            Some(last) if end < self.events.len() => last.t,
+            _ => i64::MAX,
+        };
+        let imu_end = self.next_imu + self.imu[self.next_imu..].partition_point(|s| s.t <= upto);
+        let trigger_end =
+            self.next_trigger + self.triggers[self.next_trigger..].partition_point(|t| t.t <= upto);
+        let chunk = Chunk {
+            events,
+            imu: &self.imu[self.next_imu..imu_end],
+            triggers: &self.triggers[self.next_trigger..trigger_end],
+        };
+        self.next_imu = imu_end;
+        self.next_trigger = trigger_end;
         Ok(Some(chunk))
     }
 }
@@ -277,8 +347,10 @@ pub struct EventReader {
     source: Option<String>,
     /// What a user should know about the file that its counts do not say (a NeuroTac pickle's
     /// millisecond times and missing polarity, a CSV file's missing header line, the members an
-    /// NPZ archive's events came from).
+    /// NPZ archive's events came from, a bag's topics read).
     note: Option<String>,
+    /// A ROS bag's topics (empty for the other formats).
+    topics: Vec<crate::ros::TopicInfo>,
     len: u64,
     inner: Inner,
     /// Validation of AEDAT4 events (the other readers validate their own).
@@ -316,8 +388,10 @@ pub fn open(path: impl AsRef<Path>) -> Result<EventReader, Error> {
 }
 
 /// Opens the event file at `path` as [`open`] does, reading the streams `selection` picks from
-/// an AEDAT4 file with several (two cameras, say; see [`StreamSelection`]). A selection naming
-/// a stream is an error for the other formats, which hold one stream of each kind.
+/// an AEDAT4 file with several (two cameras, say; see [`StreamSelection`]), or the topics it
+/// names in a ROS bag (`selection.events` the event topic, `selection.imu` the IMU topic; see
+/// [`crate::ros`]). A selection naming a stream is an error for the other formats, which hold
+/// one stream of each kind.
 pub fn open_with(
     path: impl AsRef<Path>,
     selection: &StreamSelection,
@@ -328,12 +402,19 @@ pub fn open_with(
         path: path.to_path_buf(),
         error,
     };
-    let len = std::fs::metadata(path).map_err(io)?.len();
-    if format != Format::Aedat4 && *selection != StreamSelection::default() {
+    let len = if format == Format::Mcap {
+        // A rosbag2 folder: its files' sizes.
+        crate::ros::bag_len(path)?
+    } else {
+        std::fs::metadata(path).map_err(io)?.len()
+    };
+    let streams = matches!(format, Format::Aedat4 | Format::RosBag | Format::Mcap);
+    if !streams && *selection != StreamSelection::default() {
         return Err(Error::UnknownFormat {
             path: path.to_path_buf(),
             reason: format!(
-                "a stream was chosen, but only AEDAT4 files hold several streams and this is {}",
+                "a stream was chosen, but only AEDAT4 files and ROS bags hold several streams \
+                 and this is {}",
                 format.name()
             ),
         });
@@ -341,6 +422,7 @@ pub fn open_with(
     // The AEDAT4 event stream's size, which the reader checks events against.
     let mut resolution = None;
     let mut note = None;
+    let mut topics = Vec::new();
     let (inner, source) = match format {
         Format::Aedat4 => {
             let mut r = AedatReader::open(path).map_err(|error| Error::Aedat {
@@ -406,12 +488,7 @@ pub fn open_with(
                 error: Box::new(error),
             })?;
             note = Some(file.note());
-            let r = MemoryEvents {
-                check: EventCheck::new(Some(file.resolution)),
-                events: file.events,
-                next: 0,
-                len,
-            };
+            let r = MemoryEvents::new(file.events, Some(file.resolution), len);
             (Inner::Memory(Box::new(r)), None)
         }
         Format::Hdf5 => {
@@ -428,12 +505,16 @@ pub fn open_with(
                 error: Box::new(error),
             })?;
             note = Some(file.note());
-            let r = MemoryEvents {
-                check: EventCheck::new(None),
-                events: file.events,
-                next: 0,
-                len,
-            };
+            let r = MemoryEvents::new(file.events, None, len);
+            (Inner::Memory(Box::new(r)), None)
+        }
+        Format::RosBag | Format::Mcap => {
+            let bag = crate::ros::read(path, format, selection)?;
+            note = Some(bag.note);
+            topics = bag.topics;
+            let mut r = MemoryEvents::new(bag.events, bag.resolution, len);
+            r.imu = bag.imu;
+            r.triggers = bag.triggers;
             (Inner::Memory(Box::new(r)), None)
         }
     };
@@ -443,6 +524,7 @@ pub fn open_with(
         format,
         source,
         note,
+        topics,
         len,
         inner,
         aedat_check,
@@ -483,9 +565,16 @@ impl EventReader {
     }
 
     /// What a user should know about the file that its counts do not say (for a NeuroTac
-    /// pickle: its index order, ON-only, and that its times are milliseconds).
+    /// pickle: its index order, ON-only, and that its times are milliseconds; for a ROS bag:
+    /// the topics read, and the clocks their times come from).
     pub fn note(&self) -> Option<&str> {
         self.note.as_deref()
+    }
+
+    /// A ROS bag's topics, each with its message type and count (empty for the other formats;
+    /// see [`crate::ros::topics`]).
+    pub fn topics(&self) -> &[crate::ros::TopicInfo] {
+        &self.topics
     }
 
     /// Declares the sensor size (needed for CSV and NPY, which do not store it): events from now
@@ -518,7 +607,8 @@ impl EventReader {
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
-            // A pickle's own size was checked above; an NPZ takes the declared one.
+            // A pickle's own size was checked above; an NPZ, or a bag whose messages state
+            // none, takes this one.
             Inner::Memory(r) => r.check.set_resolution(Some(resolution)),
         }
         Ok(())
@@ -768,18 +858,10 @@ fn next_unfiltered<'a>(
                 path: path.to_path_buf(),
                 error: Box::new(error),
             }),
-        Inner::Memory(r) => r
-            .next_chunk()
-            .map(|c| {
-                c.map(|events| Chunk {
-                    events,
-                    ..Chunk::default()
-                })
-            })
-            .map_err(|error| Error::Event {
-                path: path.to_path_buf(),
-                error,
-            }),
+        Inner::Memory(r) => r.next_chunk().map_err(|error| Error::Event {
+            path: path.to_path_buf(),
+            error,
+        }),
     }
 }
 

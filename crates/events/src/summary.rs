@@ -1,5 +1,6 @@
 //! What a recording holds, read in one streaming pass: format, sensor, event and IMU counts,
-//! time spans, IMU rate, triggers, and for AEDAT4 files every stream on its own. `evtac info`
+//! time spans, IMU rate, triggers, for AEDAT4 files every stream on its own, and for ROS bags
+//! every topic. `evtac info`
 //! prints it; `evtac check` compares its time spans with the motion windows of a dataset's
 //! manifest.
 //!
@@ -74,8 +75,12 @@ pub struct Summary {
     /// Every stream of an AEDAT4 file (empty for the other formats, which hold one of each).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub streams: Vec<StreamSummary>,
-    /// Why the top-level counts are empty although the file has streams: several cameras and
-    /// none chosen (the streams' own rows still count everything).
+    /// Every topic of a ROS bag, with its message type and count (empty for the other
+    /// formats).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub topics: Vec<crate::ros::TopicInfo>,
+    /// Why the top-level counts are empty although the file has streams: several cameras (or
+    /// event topics) and none chosen (the streams' own rows still count everything).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub selection: Option<String>,
     /// What the counts do not say about the file (a NeuroTac pickle's index order, missing
@@ -103,6 +108,7 @@ impl Summary {
             last_imu_t_us: None,
             triggers: 0,
             streams: Vec::new(),
+            topics: reader.topics().to_vec(),
             selection: None,
             note: reader.note().map(str::to_string),
         };
@@ -148,10 +154,39 @@ impl Summary {
         on_position: impl FnMut(u64),
     ) -> Result<Self, Error> {
         let path = path.as_ref();
-        if Format::detect(path)? == Format::Aedat4 {
-            Self::of_aedat(path, selection, on_position)
-        } else {
-            Self::read(&mut crate::open_with(path, selection)?, on_position)
+        let format = Format::detect(path)?;
+        if format == Format::Aedat4 {
+            return Self::of_aedat(path, selection, on_position);
+        }
+        match crate::open_with(path, selection) {
+            Ok(mut reader) => Self::read(&mut reader, on_position),
+            // A bag with several event topics and none chosen: the summary lists its topics
+            // and says why it counts nothing (naming a topic it lacks stays an error).
+            Err(Error::Streams { error, .. })
+                if matches!(format, Format::RosBag | Format::Mcap)
+                    && *selection == StreamSelection::default() =>
+            {
+                Ok(Self {
+                    format: format.name().to_string(),
+                    source: None,
+                    width: None,
+                    height: None,
+                    events: 0,
+                    on_events: 0,
+                    first_t_us: None,
+                    last_t_us: None,
+                    imu_samples: 0,
+                    imu_rate_hz: None,
+                    first_imu_t_us: None,
+                    last_imu_t_us: None,
+                    triggers: 0,
+                    streams: Vec::new(),
+                    topics: crate::ros::topics(path)?,
+                    selection: Some(error.reason),
+                    note: None,
+                })
+            }
+            Err(e) => Err(e),
         }
     }
 
@@ -253,6 +288,7 @@ impl Summary {
             last_imu_t_us: imu.and_then(|r| r.last_t_us),
             triggers: triggers.map_or(0, |r| r.count),
             streams: Vec::new(),
+            topics: Vec::new(),
             selection: note,
             note: None,
         };

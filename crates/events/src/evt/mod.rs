@@ -30,6 +30,9 @@ use std::path::Path;
 
 pub use header::{EvtVersion, Header, HeaderError};
 
+/// The EVT 3.0 word decoder, for the ROS bags' `evt3` event packets ([`crate::ros`]).
+pub(crate) use evt3::Evt3Decoder;
+
 use crate::check::{CheckError, EventCheck};
 use crate::text_header::{self, DataBuffer, HeaderReadError};
 use crate::{Event, Resolution, Trigger};

@@ -15,3 +15,4 @@ mod neurotac;
 mod npy;
 mod other_tools;
 mod recording;
+mod ros;
