@@ -265,7 +265,8 @@ impl Hdf5Reader {
     /// Opens the file at `path` and finds its event datasets.
     pub fn open(path: impl AsRef<Path>) -> Result<Self, Hdf5Error> {
         let path = path.as_ref();
-        let file = File::open(path).map_err(library(&path.display().to_string()))?;
+        // The caller names the path; the library's message says what failed.
+        let file = File::open(path).map_err(library("the file"))?;
         let (group, prefix) = match file.group("events") {
             Ok(g) => (g, "events/"),
             Err(_) => ((*file).clone(), ""),

@@ -1,7 +1,7 @@
-//! A folder of per-trial recordings as `evtac import`'s input: each `.aedat4` or `.aedat` file
-//! in it (the formats that carry the IMU the labels need) is one recording, in name order, and
-//! a log's row is cut from the file named after its trial (`<trial>.aedat4`), so that the
-//! trials keep their names and each is cut on its own file's clock.
+//! A folder of per-trial recordings as `evtac import`'s input: each `.aedat4`, `.aedat`, `.bag`
+//! or `.mcap` file in it (the formats that carry the IMU the labels need) is one recording, in
+//! name order, and a log's row is cut from the file named after its trial (`<trial>.aedat4`),
+//! so that the trials keep their names and each is cut on its own file's clock.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -11,7 +11,7 @@ use crate::robot_log::RobotLog;
 use evtac_events::IoError;
 
 /// The extensions of the files a folder of trials is read for.
-pub const TRIAL_EXTENSIONS: [&str; 2] = ["aedat4", "aedat"];
+pub const TRIAL_EXTENSIONS: [&str; 4] = ["aedat4", "aedat", "bag", "mcap"];
 
 /// The recordings in `dir`, in name order (hidden files left out).
 pub fn trial_files(dir: &Path) -> Result<Vec<PathBuf>, ImportError> {
@@ -55,8 +55,8 @@ pub fn split_by_file(log: &RobotLog, files: &[PathBuf]) -> Result<Vec<Part>, Imp
         match by_stem.get(&t.trial) {
             Some(&i) => rows[i].push((*line, t.clone())),
             None => missing.push(format!(
-                "{}:{line}: column `trial`: no file `{}.aedat4` (or .aedat) in the folder of \
-                 trials {}",
+                "{}:{line}: column `trial`: no file `{}.aedat4` (or .aedat, .bag, .mcap) in the \
+                 folder of trials {}",
                 log.path.display(),
                 t.trial,
                 files

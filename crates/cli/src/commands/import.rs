@@ -34,8 +34,8 @@ pub enum SyncMode {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The session recordings (AEDAT4 with a data table is read fastest; any format evtac
-    /// reads), or folders of per-trial files (their .aedat4/.aedat files, a log's rows cut from
-    /// the file named after their trial): all go into one dataset.
+    /// reads), or folders of per-trial files (their .aedat4/.aedat/.bag/.mcap files, a log's
+    /// rows cut from the file named after their trial): all go into one dataset.
     #[arg(required = true, num_args = 1.., value_name = "SESSION")]
     pub sessions: Vec<PathBuf>,
     /// The robot's log: a CSV with the manifest's columns except file and truth, one row per

@@ -98,6 +98,15 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
             "note:        {why}; the counts above are empty, the streams below are whole\n"
         );
     }
+    if !s.topics.is_empty() {
+        out += "topics:\n";
+        for t in &s.topics {
+            out += &format!(
+                "  {}: {}, {} messages\n",
+                t.name, t.message_type, t.messages
+            );
+        }
+    }
     if s.streams.len() > 1 {
         out += "streams:\n";
         for r in &s.streams {

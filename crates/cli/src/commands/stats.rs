@@ -133,7 +133,7 @@ fn render(s: &SensorStats) -> String {
                 "IMU:          {} samples at {:.2} Hz, {} at rest\n\
                  gyroscope:    noise {:.4} deg/s, bias {:.4} deg/s RMS (mean {x:.4}, {y:.4}, \
                  {z:.4}), step {}\n\
-                 accelerometer: noise {:.5} g, step {}\ntemperature:  {:.1} C\n",
+                 accelerometer: noise {:.5} g, step {}\ntemperature:  {}\n",
                 imu.samples,
                 imu.rate_hz,
                 imu.rest_samples,
@@ -145,6 +145,7 @@ fn render(s: &SensorStats) -> String {
                 imu.accel_lsb_g
                     .map_or_else(|| "-".into(), |l| format!("{l:.7} g")),
                 imu.temperature_c
+                    .map_or_else(|| "not in the file".into(), |t| format!("{t:.1} C"))
             );
         }
         None => out += "IMU:          no samples at rest\n",

@@ -126,12 +126,14 @@ pub fn fit(stats: &SensorStats, base: SimParams) -> Fitted {
                 "the smallest step at rest".into(),
             );
         }
-        p.imu.temperature_c = imu.temperature_c;
-        note(
-            "imu.temperature_c",
-            format!("{:.1}", imu.temperature_c),
-            format!("the mean at rest ({at_rest})"),
-        );
+        if let Some(t) = imu.temperature_c {
+            p.imu.temperature_c = t;
+            note(
+                "imu.temperature_c",
+                format!("{t:.1}"),
+                format!("the mean at rest ({at_rest})"),
+            );
+        }
     }
     Fitted {
         params: p,

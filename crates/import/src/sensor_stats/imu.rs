@@ -51,8 +51,9 @@ pub struct ImuStats {
     pub accel_noise_g: f64,
     /// The accelerometer's resolution, g, if it steps at rest.
     pub accel_lsb_g: Option<f64>,
-    /// Mean temperature at rest, degrees Celsius.
-    pub temperature_c: f64,
+    /// Mean temperature at rest, degrees Celsius; `None` when no sample states one (ROS's
+    /// `sensor_msgs/Imu` has no temperature: those samples carry NaN).
+    pub temperature_c: Option<f64>,
 }
 
 /// Differences counted before any is refused as a step.
@@ -115,6 +116,8 @@ pub struct ImuAccumulator {
     accel: Differences,
     rest_samples: u64,
     temperature_sum: f64,
+    /// Samples at rest that state a temperature (not NaN).
+    temperature_samples: u64,
     /// The open window: its start, samples and gyroscope sums.
     window: Option<(i64, u64, [f64; 3])>,
     windows: u64,
@@ -153,7 +156,10 @@ impl ImuAccumulator {
             *total += f64::from(v);
         }
         self.rest_samples += 1;
-        self.temperature_sum += f64::from(s.temperature);
+        if !s.temperature.is_nan() {
+            self.temperature_sum += f64::from(s.temperature);
+            self.temperature_samples += 1;
+        }
         self.previous = Some(*s);
     }
 
@@ -193,7 +199,8 @@ impl ImuAccumulator {
             gyro_lsb_deg_s: self.gyro.smallest_step,
             accel_noise_g: self.accel.noise()?,
             accel_lsb_g: self.accel.smallest_step,
-            temperature_c: self.temperature_sum / self.rest_samples as f64,
+            temperature_c: (self.temperature_samples > 0)
+                .then(|| self.temperature_sum / self.temperature_samples as f64),
         })
     }
 }
@@ -252,7 +259,7 @@ mod tests {
         );
         assert_eq!(s.gyro_lsb_deg_s, Some(1.0 / 32.0));
         assert_eq!(s.accel_lsb_g, Some(1.0 / 4096.0));
-        assert_eq!(s.temperature_c, 31.0);
+        assert_eq!(s.temperature_c, Some(31.0));
         assert_eq!(s.rest_samples, 39_900);
     }
 
