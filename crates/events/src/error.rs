@@ -147,8 +147,8 @@ pub enum Error {
     Ros {
         /// The file.
         path: PathBuf,
-        /// What is wrong, naming the topic and message.
-        error: crate::ros::RosError,
+        /// What is wrong, naming the topic and message (boxed: the error enum stays small).
+        error: Box<crate::ros::RosError>,
     },
     /// An event read from the file is invalid (outside the sensor, or earlier than its
     /// predecessor).

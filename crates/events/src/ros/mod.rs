@@ -378,7 +378,7 @@ fn bag_files(path: &Path) -> Result<Vec<PathBuf>, Error> {
         };
         return Err(Error::Ros {
             path: path.to_path_buf(),
-            error: RosError::Folder { what },
+            error: Box::new(RosError::Folder { what }),
         });
     }
     // Split files end in `_N`: order by N, then by name.
@@ -421,7 +421,10 @@ fn scan(path: &Path, format: Format, keep: bool) -> Result<Collector, Error> {
             Format::RosBag => bag1::scan(&bytes, &mut c),
             _ => mcap2::scan(&bytes, &mut c),
         };
-        scanned.map_err(|error| Error::Ros { path: file, error })?;
+        scanned.map_err(|error| Error::Ros {
+            path: file,
+            error: Box::new(error),
+        })?;
     }
     Ok(c)
 }
@@ -603,7 +606,7 @@ pub(crate) fn read(
         })?;
     let ros = |error| Error::Ros {
         path: path.to_path_buf(),
-        error,
+        error: Box::new(error),
     };
     let events = decode_events(&c.topics[event_topic]).map_err(ros)?;
     let imu = match imu_topic {
