@@ -185,12 +185,19 @@ impl Scalar {
     }
 
     /// The value at the start of `bytes` as an `i64`; `None` for an unsigned 8-byte value above
-    /// `i64::MAX`.
-    #[inline]
+    /// `i64::MAX`. `bytes` holds at least `width` bytes (the layout checked it).
+    #[inline(always)]
     pub fn load(self, bytes: &[u8]) -> Option<i64> {
-        let mut le = [0u8; 8];
-        le[..self.width].copy_from_slice(&bytes[..self.width]);
-        let raw = u64::from_le_bytes(le);
+        // Fixed-size loads per width: a copy of `width` bytes would be a `memcpy` call per field,
+        // which cost NPY decoding most of its speed.
+        let raw = match self.width {
+            1 => u64::from(bytes[0]),
+            2 => u64::from(u16::from_le_bytes([bytes[0], bytes[1]])),
+            4 => u64::from(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+            _ => u64::from_le_bytes([
+                bytes[0], bytes[1], bytes[2], bytes[3], bytes[4], bytes[5], bytes[6], bytes[7],
+            ]),
+        };
         if self.signed {
             let shift = 64 - 8 * self.width as u32;
             Some(((raw << shift) as i64) >> shift)
