@@ -143,7 +143,8 @@ fn readme_setup(dir: &Path) -> Option<()> {
     std::fs::create_dir_all(dir.join("docs/img")).ok()
 }
 
-/// docs/real-data.md's setup: a session with its log, no-contact recording and calibration.
+/// docs/real-data.md's setup: a session with its log, no-contact recording and calibration, and
+/// one trial in each of the lab's and other tools' formats.
 fn real_data_setup(dir: &Path) -> Option<()> {
     let sim = dir.join("sim-session");
     // Every motion of the tiny Experiment 1: the walkthrough ends in a reproduction, which
@@ -164,6 +165,28 @@ fn real_data_setup(dir: &Path) -> Option<()> {
          \x20   a = np.empty((480, 640), dtype=object)\n\
          \x20   for i in range(a.size): a.flat[i] = [i % 997 + k * 0.25 for k in range(n)] if i % 13 == 0 else []\n\
          \x20   pickle.dump(a, open(sys.argv[1] + f'/trial_07_events_{pol}.pickle', 'wb'))",
+        &[s(dir)],
+    )?;
+    // The same trial as the other tools write it: event_utils' HDF5, DSEC's, dv-processing's
+    // NPY, an NPZ of one array per field, and a CSV without a header line.
+    evtac_testkit::run_python(
+        "import sys, os, numpy as np, h5py\n\
+         d = sys.argv[1]; rng = np.random.default_rng(7); n = 5000\n\
+         t = np.sort(rng.integers(1_700_000_000_000_000, 1_700_000_002_000_000, n))\n\
+         x, y, p = rng.integers(0, 640, n), rng.integers(0, 480, n), rng.integers(0, 2, n)\n\
+         with h5py.File(d + '/trial_07.h5', 'w') as f:\n\
+         \x20   f['events/xs'] = x.astype('i2'); f['events/ys'] = y.astype('i2')\n\
+         \x20   f['events/ts'] = t / 1e6; f['events/ps'] = p.astype(bool)\n\
+         \x20   f.attrs['sensor_resolution'] = (480, 640); f.attrs['num_events'] = n\n\
+         with h5py.File(d + '/dsec_events.h5', 'w') as f:\n\
+         \x20   f['events/x'] = x.astype('u2'); f['events/y'] = y.astype('u2')\n\
+         \x20   f['events/t'] = (t - t[0]).astype('u4'); f['events/p'] = p.astype('u1')\n\
+         \x20   f['t_offset'] = np.int64(t[0])\n\
+         a = np.zeros(n, dtype=[('timestamp', '<i8'), ('x', '<i2'), ('y', '<i2'), ('polarity', 'i1')])\n\
+         a['timestamp'], a['x'], a['y'], a['polarity'] = t, x, y, p\n\
+         np.save(d + '/events.npy', a)\n\
+         np.savez(d + '/trial.npz', t=t, x=x, y=y, p=p)\n\
+         np.savetxt(d + '/events.csv', np.stack([t, x, y, p], 1), fmt='%d', delimiter=',')",
         &[s(dir)],
     )?;
     Some(())
