@@ -18,9 +18,10 @@
 //! - the domain is `ROS_DOMAIN_ID`'s, as ROS 2 reads it.
 //!
 //! # The DDS crate
-//! [RustDDS](https://crates.io/crates/rustdds) (Atostek): a maintained, pure-Rust DDS with
-//! regular releases, used in production with ROS 2, and interop-tested by its authors against
-//! Fast DDS, Cyclone DDS, RTI Connext and OpenDDS; it serializes serde types to CDR. Its sister
+//! [RustDDS](https://crates.io/crates/rustdds) (Atostek, 0.15): a maintained pure-Rust DDS
+//! (regular releases, a company behind it that supports ROS 2 users), which exchanges data with
+//! ROS 2, publishes interoperability results (the OMG `dds-rtps` tests) and lists Cyclone DDS
+//! and Fast DDS interop fixes release after release; it serializes serde types to CDR. Its sister
 //! crate `ros2-client` (same authors, built on it) adds ROS 2 nodes, services, actions and
 //! parameters, but its `Node` wants a `Spinner` running on an async executor for its graph
 //! bookkeeping, which would mean an executor and a thread for features evtac does not use; one

@@ -27,16 +27,21 @@ const CYCLONE_LOOPBACK: &str = "<CycloneDDS><Domain id=\"any\"><General><Interfa
      <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/>\
      </Peers></Discovery></Domain></CycloneDDS>";
 
-/// A domain id for this run: varies between runs and tests, so that tests running at the same
-/// time (or another engineer's) do not cross-talk.
-fn random_domain(salt: u16) -> u16 {
-    let nanos = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let mixed = nanos ^ std::process::id().rotate_left(16) ^ u32::from(salt).wrapping_mul(40503);
-    // 1..=230: never ROS's default 0.
-    1 + (mixed % 230) as u16
+/// A domain id for this test in this run: random per run (so that runs at the same time, or
+/// another engineer's, do not cross-talk), and different for each `test` of a run (the tests
+/// run in parallel). 1..=230: never ROS's default 0, and 231 is left to the CLI's test of a
+/// domain without subscribers.
+fn random_domain(test: u32) -> u16 {
+    static RUN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+    let run = *RUN.get_or_init(|| {
+        let nanos = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .unwrap()
+            .subsec_nanos();
+        (nanos ^ std::process::id().rotate_left(16)) % 230
+    });
+    // 61 is prime to 230: distinct tests get distinct domains.
+    1 + ((run + test * 61) % 230) as u16
 }
 
 fn loopback_options(domain: u16, frame_id: &str) -> Ros2Options {
@@ -306,4 +311,64 @@ fn bad_topics_and_domains_are_refused_before_joining_a_domain() {
     options.domain = 250;
     let e = Ros2Publisher::new(options).unwrap_err().to_string();
     assert!(e.contains("domain id 250"), "{e}");
+}
+
+#[test]
+fn a_subscriber_that_comes_and_goes_holds_nothing_up() {
+    let domain = random_domain(3);
+    // Checks that the environment has the subscriber's tools before anything else.
+    if evtac_testkit::python_with("cyclonedds").is_none() {
+        return;
+    }
+    let publisher = Ros2Publisher::new(loopback_options(domain, "neurotac")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let model = model(dir.path());
+    let events = Synthetic::new(5, 300_000.0, 1000, 2_000_000).collect();
+    let expected = support::replayed(&model, &events, 4096);
+    let source = Paced::new(MemorySource::new(events, 4096), 1000);
+    let estimator = Estimator::for_model(&model, SENSOR, 1000).unwrap();
+    // A subscriber joins while estimates flow, and is killed (no goodbye: its writer side
+    // only learns of it when its lease runs out) while they still flow.
+    let visitor = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(200));
+        let mut subscriber = Subscriber::start(domain, 10.0).unwrap();
+        std::thread::sleep(Duration::from_millis(900));
+        subscriber.child.kill().unwrap();
+    });
+    let mut got = Vec::new();
+    let mut matched_at_some_point = false;
+    let started = Instant::now();
+    pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
+        if let Output::Estimate(e) = out {
+            publisher.publish(&e);
+            matched_at_some_point |= publisher.subscribers() > 0;
+            got.push(e);
+        }
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    let took = started.elapsed();
+    visitor.join().unwrap();
+    let stats = publisher.finish();
+    // The paced source vouches for the time up to its last slice's end, which may make one
+    // estimate past the last event that the replay from memory does not make.
+    assert!(
+        (expected.len()..=expected.len() + 1).contains(&got.len()),
+        "{} estimates, {} from memory",
+        got.len(),
+        expected.len()
+    );
+    support::assert_same_estimates(&got[..expected.len()], &expected);
+    assert!(
+        matched_at_some_point,
+        "the visiting subscriber never matched"
+    );
+    assert_eq!(
+        stats.published + stats.dropped(),
+        got.len() as u64,
+        "{stats}"
+    );
+    // A 2 s replay at recorded pace, not held up by the subscriber (generous for a busy
+    // machine; a stall on a dead reader would be the 5 ms write bound per estimate at least).
+    assert!(took < Duration::from_secs(4), "the replay took {took:?}");
 }
