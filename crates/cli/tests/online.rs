@@ -1,6 +1,6 @@
 //! Tests of `evtac online`.
 
-use crate::common::{evtac, run_ok, simulate_tiny};
+use crate::common::{evtac, run_err, run_ok, simulate_tiny};
 use evtac_learn::{ModelBundle, Representation};
 use evtac_repr::ReprConfig;
 use std::io::Write;
@@ -266,4 +266,158 @@ fn a_replay_as_fast_as_possible_reports_processing_time_not_latency() {
         "{stderr}"
     );
     assert!(!stderr.contains("not measured"), "{stderr}");
+}
+
+/// `--ros2`: a Cyclone DDS subscriber (Python binding, ROS 2's IDL types for
+/// `geometry_msgs/msg/Vector3Stamped`, reliable) on loopback receives one message per CSV row,
+/// stamped with its `t_us`, carrying its degrees in radians, in the frame `--frame-id` names;
+/// the summary reports the publishing. The subscriber script is the online crate's.
+#[test]
+fn ros2_publishes_what_the_csv_holds() {
+    use std::io::{BufRead, BufReader};
+    let Some(python) = evtac_testkit::python_with("cyclonedds") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    // 400 ms of events whose density and position change every 20 ms, so that estimates vary.
+    let mut csv = String::from("t,x,y,p\n");
+    for i in 0..60_000i64 {
+        let t = 2_000_000 + i * 400_000 / 60_000;
+        let phase = (t / 20_000) % 7;
+        let x = 220 + (i * 7919 % (60 + 20 * phase));
+        let y = 140 + (i * 104_729 % (200 - 20 * phase));
+        csv.push_str(&format!("{t},{x},{y},{}\n", i32::from(i % 3 == 0)));
+    }
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv).unwrap();
+    let domain =
+        1 + (std::process::id() ^ std::time::UNIX_EPOCH.elapsed().unwrap().subsec_nanos()) % 230;
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../online/tests/support/ros2_subscriber.py");
+    let cyclone_loopback = "<CycloneDDS><Domain id=\"any\"><General><Interfaces>\
+         <NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast>\
+         </General><Discovery><ParticipantIndex>auto</ParticipantIndex>\
+         <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers>\
+         <Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
+    let mut subscriber = std::process::Command::new(python)
+        .arg(script)
+        .args([&domain.to_string(), "rt/robot/contact_angle", "3", "120"])
+        .env("CYCLONEDDS_URI", cyclone_loopback)
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut received = BufReader::new(subscriber.stdout.take().unwrap());
+    let mut line = String::new();
+    received.read_line(&mut line).unwrap();
+    assert_eq!(line.trim(), "ready");
+
+    let out = dir.path().join("estimates.csv");
+    let run = evtac()
+        .args(["online", "--model", model.to_str().unwrap()])
+        .args(["--input", events.to_str().unwrap(), "--sensor", "640x480"])
+        .args(["--realtime", "--output", out.to_str().unwrap()])
+        .args([
+            "--ros2",
+            "/robot/contact_angle",
+            "--frame-id",
+            "left_finger",
+        ])
+        .args([
+            "--ros-domain",
+            &domain.to_string(),
+            "--ros-interface",
+            "127.0.0.1",
+        ])
+        .args(["--ros2-wait-subscribers", "1"])
+        .env_remove("ROS_DOMAIN_ID")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    if !run.status.success() {
+        let _ = subscriber.kill();
+        panic!("evtac online failed: {stderr}");
+    }
+    let rows = rows(&std::fs::read_to_string(&out).unwrap());
+    assert!(rows.len() >= 390, "{} rows: {stderr}", rows.len());
+    assert!(
+        stderr.contains(&format!(
+            "ROS 2 /robot/contact_angle (DDS rt/robot/contact_angle, domain {domain}): {} \
+             published, 0 dropped",
+            rows.len()
+        )),
+        "{stderr}"
+    );
+    let mut samples = Vec::new();
+    for line in received.lines() {
+        let line = line.unwrap();
+        if line == "end" {
+            break;
+        }
+        samples.push(line);
+    }
+    assert!(subscriber.wait().unwrap().success());
+    assert_eq!(samples.len(), rows.len(), "messages received vs CSV rows");
+    for (row, sample) in rows.iter().zip(&samples) {
+        let f: Vec<&str> = sample.split(' ').collect();
+        let t_us: i64 = row[0].parse().unwrap();
+        let (sec, nanosec): (i64, i64) = (f[1].parse().unwrap(), f[2].parse().unwrap());
+        assert_eq!(sec * 1_000_000 + nanosec / 1000, t_us, "{sample}");
+        assert_eq!(nanosec % 1000, 0);
+        assert_eq!(f[3], "left_finger");
+        for (deg, rad) in [(&row[1], f[4]), (&row[2], f[5])] {
+            let expected = f64::from(deg.parse::<f32>().unwrap()).to_radians();
+            assert_eq!(
+                rad.parse::<f64>().unwrap().to_bits(),
+                expected.to_bits(),
+                "t = {t_us}: {deg} degrees published as {rad}"
+            );
+        }
+        assert_eq!(f[6], "0.0");
+    }
+}
+
+#[test]
+fn ros2_flags_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    let (m, e) = (model.to_str().unwrap(), events.to_str().unwrap());
+    let base = ["online", "--model", m, "--input", e, "--sensor", "640x480"];
+    let with = |extra: &[&'static str]| [&base[..], extra].concat();
+    let msg = run_err(&with(&["--ros2", "/contact-angle", "--ros-domain", "9"]));
+    assert!(msg.contains("invalid ROS 2 topic name"), "{msg}");
+    let msg = run_err(&with(&["--ros2", "/contact_angle", "--ros-domain", "240"]));
+    assert!(msg.contains("domain id 240"), "{msg}");
+    // --frame-id without --ros2 is a mistake worth saying.
+    let msg = run_err(&with(&["--frame-id", "x"]));
+    assert!(msg.contains("--ros2"), "{msg}");
+    let out = evtac()
+        .args(with(&["--ros2", "/contact_angle"]))
+        .env("ROS_DOMAIN_ID", "abc")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let msg = String::from_utf8_lossy(&out.stderr);
+    assert!(msg.contains("ROS_DOMAIN_ID=\"abc\""), "{msg}");
+    // Nobody subscribes in this domain: waiting for one fails, naming the topic and domain.
+    let msg = run_err(&with(&[
+        "--ros2",
+        "/contact_angle",
+        "--ros-domain",
+        "231",
+        "--ros-interface",
+        "127.0.0.1",
+        "--ros2-wait-subscribers",
+        "1",
+        "--ros2-wait-timeout-s",
+        "0.5",
+    ]));
+    assert!(
+        msg.contains("0 of 1 ROS 2 subscriber(s) matched on /contact_angle in domain 231"),
+        "{msg}"
+    );
 }

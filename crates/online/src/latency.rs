@@ -122,6 +122,9 @@ pub struct Summary {
     pub span_us: Option<(i64, i64)>,
     /// Wall-clock time from the first chunk to the end of the run.
     pub wall: Duration,
+    /// What publishing on ROS 2 did, when the run published (set by the caller, who owns the
+    /// publisher: see [`crate::ros2::Ros2Publisher::finish`]).
+    pub ros2: Option<crate::ros2::PublishStats>,
 }
 
 impl Summary {
@@ -146,6 +149,7 @@ impl Summary {
             reconnects: 0,
             span_us: None,
             wall: Duration::ZERO,
+            ros2: None,
         }
     }
 }
@@ -202,6 +206,9 @@ impl std::fmt::Display for Summary {
         }
         if self.reconnects > 0 {
             writeln!(f, "reconnections: {}", self.reconnects)?;
+        }
+        if let Some(ros2) = &self.ros2 {
+            writeln!(f, "{ros2}")?;
         }
         write!(f, "wall time: {:.3} s", self.wall.as_secs_f64())
     }

@@ -13,6 +13,8 @@
 //! - [`pipeline::run`]: ingestion and estimation on two threads with a bounded queue between.
 //! - [`Summary`]: estimates, median/P99/max latency and processing time, late estimates,
 //!   dropped events.
+//! - [`ros2`]: each estimate published on a ROS 2 topic (`geometry_msgs/msg/Vector3Stamped`,
+//!   pure Rust over DDS, never holding estimation up).
 //!
 //! The exact definition of latency is in `docs/online.md`; in short, it runs from the moment the
 //! ingestion thread received the chunk that made an estimate's time final to the end of that
@@ -49,6 +51,7 @@ pub mod input;
 mod latency;
 mod notice;
 pub mod pipeline;
+pub mod ros2;
 mod schedule;
 
 pub use backoff::Backoff;

@@ -4,4 +4,5 @@ mod live;
 mod pipeline;
 mod processing;
 mod replay;
+mod ros2;
 mod support;

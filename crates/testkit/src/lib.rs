@@ -71,6 +71,24 @@ pub fn python() -> Option<PathBuf> {
     }
 }
 
+/// The reference Python when it can import `module` (e.g. `cyclonedds`, installed by
+/// `bash .ci/python-env`), or `None` (test skipped) outside CI.
+pub fn python_with(module: &str) -> Option<PathBuf> {
+    let python = python()?;
+    let imports = Command::new(&python)
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if imports {
+        Some(python)
+    } else {
+        missing(&format!(
+            "the Python module {module} in {} (run `bash .ci/python-env`)",
+            python.display()
+        ))
+    }
+}
+
 /// Runs `script` with the reference Python and `args`; returns its stdout. Panics with the
 /// script's stderr when it fails. `None` when Python is unavailable outside CI.
 pub fn run_python(script: &str, args: &[&str]) -> Option<String> {

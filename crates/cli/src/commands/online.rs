@@ -4,14 +4,19 @@
 //! A recording replayed as fast as possible is read far ahead of the estimator, so its latency
 //! would be mostly time spent queueing; its summary reports the processing time per estimate
 //! instead and says that latency needs `--realtime`.
+//!
+//! With `--ros2 TOPIC` every estimate is also published on ROS 2 (`evtac_online::ros2`), without
+//! holding the estimation up; the CSV output goes on alongside.
 
 use anyhow::Context;
 use evtac_events::output::{OutputFile, refuse_input};
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
+use evtac_online::ros2::{self, Ros2Options, Ros2Publisher};
 use evtac_online::{Backoff, Estimator, Summary};
 use std::io::Write;
+use std::net::IpAddr;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -73,6 +78,28 @@ pub struct Args {
     /// Stop after this many seconds of wall-clock time (checked at each estimate).
     #[arg(long)]
     pub max_duration_s: Option<f64>,
+    /// Also publish every estimate on this ROS 2 topic (e.g. `/contact_angle`) as
+    /// `geometry_msgs/msg/Vector3Stamped`: x = pitch, y = roll in radians, stamped with the
+    /// estimate's event time (see docs/online.md). Needs no ROS installation.
+    #[arg(long, value_name = "TOPIC")]
+    pub ros2: Option<String>,
+    /// `header.frame_id` of the ROS 2 messages.
+    #[arg(long, default_value = "neurotac", requires = "ros2")]
+    pub frame_id: String,
+    /// ROS 2 (DDS) domain id, 0 to 232; `ROS_DOMAIN_ID` when absent, else 0.
+    #[arg(long, requires = "ros2")]
+    pub ros_domain: Option<u16>,
+    /// Use only the network interface with this address for ROS 2 discovery and data (e.g.
+    /// `127.0.0.1` to stay on this host); repeat for several. Every interface when absent.
+    #[arg(long, value_name = "ADDR", requires = "ros2")]
+    pub ros_interface: Vec<IpAddr>,
+    /// Before reading the input, wait until this many ROS 2 subscribers are matched (so that
+    /// none misses the first estimates), for at most `--ros2-wait-timeout-s`.
+    #[arg(long, value_name = "COUNT", requires = "ros2")]
+    pub ros2_wait_subscribers: Option<usize>,
+    /// Longest wait for `--ros2-wait-subscribers`; the run fails when they are not there by then.
+    #[arg(long, default_value_t = 30.0, requires = "ros2_wait_subscribers")]
+    pub ros2_wait_timeout_s: f64,
 }
 
 fn seconds(what: &str, s: f64) -> anyhow::Result<Duration> {
@@ -96,6 +123,41 @@ fn stop_on_interrupt() -> anyhow::Result<Arc<AtomicBool>> {
     })
     .context("installing the Ctrl-C handler")?;
     Ok(stop)
+}
+
+/// The ROS 2 publisher of `--ros2 TOPIC`, once its subscribers are there when asked to wait.
+fn ros2_publisher(
+    args: &Args,
+    topic: &str,
+    say: &dyn Fn(&dyn std::fmt::Display),
+) -> anyhow::Result<Ros2Publisher> {
+    let domain = match args.ros_domain {
+        Some(domain) => domain,
+        None => ros2::domain_from_env()?.unwrap_or(0),
+    };
+    let publisher = Ros2Publisher::new(Ros2Options {
+        topic: topic.to_owned(),
+        frame_id: args.frame_id.clone(),
+        domain,
+        interfaces: args.ros_interface.clone(),
+    })?;
+    say(&format_args!(
+        "publishing on ROS 2 topic {topic} (DDS topic {}, domain {domain})",
+        publisher.dds_topic()
+    ));
+    if let Some(count) = args.ros2_wait_subscribers {
+        let timeout = seconds("--ros2-wait-timeout-s", args.ros2_wait_timeout_s)?;
+        say(&format_args!("waiting for {count} ROS 2 subscriber(s)"));
+        if !publisher.wait_for_subscribers(count, timeout) {
+            anyhow::bail!(
+                "{} of {count} ROS 2 subscriber(s) matched on {topic} in domain {domain} within \
+                 {:.1} s (same domain? discovery reaches them? see docs/online.md, ROS 2)",
+                publisher.subscribers(),
+                timeout.as_secs_f64()
+            );
+        }
+    }
+    Ok(publisher)
 }
 
 /// Runs `evtac online`.
@@ -133,6 +195,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(|s| seconds("--max-duration-s", s))
         .transpose()?;
     let say = |what: &dyn std::fmt::Display| eprintln!("evtac online: {what}");
+    // Before the input opens: a live stream does not wait while subscribers are awaited.
+    let publisher = match &args.ros2 {
+        Some(topic) => Some(ros2_publisher(&args, topic, &say)?),
+        None => None,
+    };
     let opened = input::open(&spec, &options, &mut |n| say(&n))
         .with_context(|| format!("opening {spec}"))?;
     let sensor = opened.resolution.with_context(|| {
@@ -177,6 +244,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         |output| {
             match output {
                 Output::Estimate(e) => {
+                    // First: it only hands the estimate to the publishing thread.
+                    if let Some(publisher) = &publisher {
+                        publisher.publish(&e);
+                    }
                     let written = writeln!(
                         out,
                         "{},{},{},{:.3}",
@@ -201,8 +272,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
     );
     let flushed = out.flush();
+    let ros2 = publisher.map(Ros2Publisher::finish);
     let with_pace = |mut summary: Summary| {
         summary.paced = paced;
+        summary.ros2 = ros2;
         summary
     };
     let summary = match result {

@@ -1,0 +1,705 @@
+//! Publishing estimates on ROS 2, without a ROS installation: pure Rust over DDS.
+//!
+//! A robot's controller usually lives in ROS 2, and ROS 2 nodes talk DDS (RTPS over UDP) under
+//! `rclcpp`/`rclpy`. So instead of linking ROS (a C/C++ install, a sourced workspace, a build
+//! system of its own), evtac speaks DDS itself with the conventions ROS 2 puts on top of it, and
+//! any ROS 2 node (`ros2 topic echo`, a controller, `rosbag2`) on the same domain receives the
+//! estimates as if they came from a ROS node:
+//!
+//! - the ROS topic `/contact_angle` is the DDS topic `rt/contact_angle` ([`dds_topic_name`]);
+//! - the message is `geometry_msgs/msg/Vector3Stamped`, whose DDS type name is
+//!   `geometry_msgs::msg::dds_::Vector3Stamped_` ([`TYPE_NAME`]), serialized as ROS 2 does:
+//!   plain CDR, little endian ([`Vector3Stamped`] mirrors the IDL field by field);
+//! - `vector.x` is the pitch and `vector.y` the roll, in radians (REP 103), `vector.z` is 0;
+//!   `header.stamp` is the estimate's event time `t_us` as seconds and nanoseconds (the sensor's
+//!   clock, see `docs/online.md`), `header.frame_id` is configurable (`neurotac`);
+//! - the QoS is the one a default `rclcpp`/`rclpy` subscription asks for: reliable, keep last
+//!   ([`HISTORY_DEPTH`]), volatile;
+//! - the domain is `ROS_DOMAIN_ID`'s, as ROS 2 reads it.
+//!
+//! # The DDS crate
+//! [RustDDS](https://crates.io/crates/rustdds) (Atostek, 0.15): a maintained pure-Rust DDS
+//! (regular releases, a company behind it that supports ROS 2 users), which exchanges data with
+//! ROS 2, publishes interoperability results (the OMG `dds-rtps` tests) and lists Cyclone DDS
+//! and Fast DDS interop fixes release after release; it serializes serde types to CDR. Its sister
+//! crate `ros2-client` (same authors, built on it) adds ROS 2 nodes, services, actions and
+//! parameters, but its `Node` wants a `Spinner` running on an async executor for its graph
+//! bookkeeping, which would mean an executor and a thread for features evtac does not use; one
+//! topic needs only the two naming conventions above, which this module spells out. The price:
+//! `ros2 node list` shows no evtac node (`ros2 topic list/echo/info` work as usual).
+//!
+//! # Nothing blocks estimation
+//! [`Ros2Publisher::publish`] never waits: it stamps the hand-over time and puts the estimate
+//! into a bounded queue ([`QUEUE`] messages) for a publishing thread, which serializes it and
+//! hands it to the DDS writer. RustDDS's reliable writer keeps up to 8192 samples that a
+//! subscriber has not acknowledged; when that window is full (a subscriber that stopped reading
+//! but did not leave), a write waits at most [`WRITE_BLOCKING`] and then gives up. A full queue
+//! or a write that gave up drops that estimate for ROS and counts it ([`PublishStats`]); the
+//! estimation and the CSV output go on untouched. No subscriber at all is not a drop: with
+//! volatile durability nobody is owed the message, and DDS discards it at once.
+//!
+//! Messages published before a subscriber's discovery completes are not delivered to it
+//! (volatile durability, as ROS 2's default). A run that must not miss its first estimates
+//! (a replay recorded with `ros2 bag record`, the interop test) waits for its subscribers first:
+//! [`Ros2Publisher::wait_for_subscribers`] (`evtac online --ros2-wait-subscribers N`).
+
+use crate::estimator::Estimate;
+use crate::latency::LatencyStats;
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError, bounded};
+use rustdds::no_key::DataWriter;
+use rustdds::policy::{Durability, History, Reliability};
+use rustdds::{
+    DataWriterStatus, DomainParticipantBuilder, QosPolicies, QosPolicyBuilder, StatusEvented,
+    TopicKind,
+};
+use serde::{Deserialize, Serialize};
+use std::net::IpAddr;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// The DDS type name of `geometry_msgs/msg/Vector3Stamped`.
+pub const TYPE_NAME: &str = "geometry_msgs::msg::dds_::Vector3Stamped_";
+
+/// History depth of the writer (ROS 2's default `rmw_qos_profile_default` keeps 10).
+pub const HISTORY_DEPTH: i32 = 10;
+
+/// Estimates the queue to the publishing thread holds before further ones are dropped: a
+/// quarter of a second at one estimate per millisecond.
+pub const QUEUE: usize = 256;
+
+/// Longest a write waits for room in the reliable writer's window before the estimate is
+/// dropped (see the module docs).
+pub const WRITE_BLOCKING: Duration = Duration::from_millis(5);
+
+/// How long [`Ros2Publisher::finish`] waits for subscribers to acknowledge what was published,
+/// so that a run's last estimates are not lost by the participant leaving.
+pub const LINGER: Duration = Duration::from_secs(2);
+
+/// Largest domain id: RTPS's port mapping (7400 + 250 * domain + ...) leaves the 16-bit port
+/// range above 232, and ROS 2 documents 0..=232 as well.
+pub const MAX_DOMAIN_ID: u16 = 232;
+
+/// `builtin_interfaces/msg/Time`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Time {
+    /// Seconds (may be negative; the stamp is `sec + nanosec * 1e-9`).
+    pub sec: i32,
+    /// Nanoseconds, `0..1_000_000_000`.
+    pub nanosec: u32,
+}
+
+impl Time {
+    /// The time `t_us` microseconds after the clock's zero: whole seconds rounded down, the
+    /// remainder as nanoseconds (so -1 us is `{sec: -1, nanosec: 999_999_000}`). Times beyond
+    /// `i32` seconds (year 2038 for a Unix clock) saturate.
+    pub fn from_micros(t_us: i64) -> Self {
+        let sec = t_us.div_euclid(1_000_000);
+        // 0..1e6 us, as nanoseconds below 1e9.
+        let nanosec = (t_us.rem_euclid(1_000_000) * 1000) as u32;
+        match i32::try_from(sec) {
+            Ok(sec) => Self { sec, nanosec },
+            Err(_) if sec < 0 => Self {
+                sec: i32::MIN,
+                nanosec: 0,
+            },
+            Err(_) => Self {
+                sec: i32::MAX,
+                nanosec: 999_999_999,
+            },
+        }
+    }
+}
+
+/// `std_msgs/msg/Header`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Header {
+    /// When the data is for.
+    pub stamp: Time,
+    /// The coordinate frame the data is in.
+    pub frame_id: String,
+}
+
+/// `geometry_msgs/msg/Vector3`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Vector3Stamped`, as evtac fills it from an [`Estimate`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Vector3Stamped {
+    /// `stamp` = the estimate's time, `frame_id` as configured.
+    pub header: Header,
+    /// `x` = pitch, `y` = roll, in radians; `z` = 0.
+    pub vector: Vector3,
+}
+
+impl Vector3Stamped {
+    /// The message for `estimate`: `x` and `y` are [`radians`] of its pitch and roll, the stamp
+    /// is [`Time::from_micros`] of its `t_us`.
+    pub fn from_estimate(estimate: &Estimate, frame_id: &str) -> Self {
+        Self {
+            header: Header {
+                stamp: Time::from_micros(estimate.t_us),
+                frame_id: frame_id.to_owned(),
+            },
+            vector: Vector3 {
+                x: radians(estimate.pitch_deg),
+                y: radians(estimate.roll_deg),
+                z: 0.0,
+            },
+        }
+    }
+}
+
+/// An estimate's angle in radians, as published: the `f32` degrees widened to `f64` exactly,
+/// then multiplied by `PI / 180` in `f64` ([`f64::to_radians`], the same operation as Python's
+/// `math.radians(float(numpy.float32(deg)))`).
+pub fn radians(deg: f32) -> f64 {
+    f64::from(deg).to_radians()
+}
+
+/// The DDS topic of the ROS 2 topic `topic`: `/contact_angle` and `contact_angle` (relative to
+/// the root namespace) are `rt/contact_angle`, `/robot/contact_angle` is
+/// `rt/robot/contact_angle`. A name ROS 2 would refuse is an error: empty tokens, a trailing
+/// `/`, characters other than letters, digits and `_`, a token starting with a digit, `~`
+/// substitutions.
+pub fn dds_topic_name(topic: &str) -> Result<String, Error> {
+    let bad = |why: &str| Error::TopicName {
+        topic: topic.to_owned(),
+        why: why.to_owned(),
+    };
+    let name = topic.strip_prefix('/').unwrap_or(topic);
+    if name.is_empty() {
+        return Err(bad("it is empty"));
+    }
+    for token in name.split('/') {
+        if token.is_empty() {
+            return Err(bad("it has an empty token (`//` or a trailing `/`)"));
+        }
+        if !token.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(bad(
+                "only letters, digits, `_` and `/` are allowed (no `~` or `{}` substitutions)",
+            ));
+        }
+        if token.starts_with(|c: char| c.is_ascii_digit()) {
+            return Err(bad("a token starts with a digit"));
+        }
+    }
+    Ok(format!("rt/{name}"))
+}
+
+/// The domain id in `ROS_DOMAIN_ID`, as ROS 2 reads it: `None` when unset or empty.
+pub fn domain_from_env() -> Result<Option<u16>, Error> {
+    match std::env::var("ROS_DOMAIN_ID") {
+        Ok(v) if v.trim().is_empty() => Ok(None),
+        Ok(v) => v
+            .trim()
+            .parse::<u16>()
+            .ok()
+            .filter(|&d| d <= MAX_DOMAIN_ID)
+            .map(Some)
+            .ok_or(Error::DomainFromEnv { value: v }),
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(Error::DomainFromEnv {
+            value: v.to_string_lossy().into_owned(),
+        }),
+    }
+}
+
+/// Errors of this module.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The ROS 2 topic name is invalid.
+    #[error("invalid ROS 2 topic name {topic:?}: {why}")]
+    TopicName {
+        /// The name given.
+        topic: String,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// The domain id is out of range.
+    #[error("invalid ROS 2 domain id {domain}: it must be from 0 to {MAX_DOMAIN_ID}")]
+    Domain {
+        /// The id given.
+        domain: u32,
+    },
+    /// `ROS_DOMAIN_ID` does not hold a domain id.
+    #[error("ROS_DOMAIN_ID={value:?} is not a domain id (0 to {MAX_DOMAIN_ID})")]
+    DomainFromEnv {
+        /// The variable's value.
+        value: String,
+    },
+    /// A DDS entity could not be created.
+    #[error(
+        "cannot create the DDS {what} for publishing on ROS 2 topic {topic} \
+         (DDS topic {dds_topic}) in domain {domain}: {source}"
+    )]
+    Create {
+        /// Which entity (participant, topic, publisher, writer).
+        what: &'static str,
+        /// The ROS 2 topic.
+        topic: String,
+        /// The DDS topic.
+        dds_topic: String,
+        /// The domain id.
+        domain: u16,
+        /// What RustDDS said.
+        #[source]
+        source: rustdds::dds::CreateError,
+    },
+    /// The publishing thread could not be started.
+    #[error("cannot start the ROS 2 publishing thread: {0}")]
+    Thread(#[source] std::io::Error),
+}
+
+/// Where and how to publish.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Ros2Options {
+    /// The ROS 2 topic (`/contact_angle`).
+    pub topic: String,
+    /// `header.frame_id` of every message.
+    pub frame_id: String,
+    /// The DDS domain (ROS 2's `ROS_DOMAIN_ID`).
+    pub domain: u16,
+    /// Use only the network interfaces with these addresses for discovery and data (for
+    /// example `127.0.0.1` to stay on this host); every interface when empty.
+    pub interfaces: Vec<IpAddr>,
+}
+
+impl Ros2Options {
+    /// `topic` in domain 0, frame `neurotac`, every interface.
+    pub fn new(topic: impl Into<String>) -> Self {
+        Self {
+            topic: topic.into(),
+            frame_id: "neurotac".to_owned(),
+            domain: 0,
+            interfaces: Vec::new(),
+        }
+    }
+}
+
+/// What the publisher did over a run, for the summary.
+#[derive(Debug, Clone)]
+pub struct PublishStats {
+    /// The ROS 2 topic.
+    pub topic: String,
+    /// The DDS topic it maps to.
+    pub dds_topic: String,
+    /// The DDS domain.
+    pub domain: u16,
+    /// Estimates handed to the DDS writer.
+    pub published: u64,
+    /// Estimates dropped because the queue to the publishing thread was full.
+    pub dropped_queue_full: u64,
+    /// Estimates dropped because the writer gave up (its reliable window stayed full for
+    /// [`WRITE_BLOCKING`], or it failed).
+    pub dropped_write: u64,
+    /// Subscribers matched when the run ended.
+    pub subscribers: usize,
+    /// Whether every subscriber acknowledged every published estimate before the publisher
+    /// left (waited for up to [`LINGER`]).
+    pub acknowledged: bool,
+    /// From [`Ros2Publisher::publish`] to the DDS writer having taken the message (serialized
+    /// and in its send buffer; RustDDS's own thread puts it on the wire): median, P99, max.
+    pub latency_median: Duration,
+    /// P99 of the publish latency.
+    pub latency_p99: Duration,
+    /// Largest publish latency.
+    pub latency_max: Duration,
+}
+
+impl PublishStats {
+    /// Estimates not published, for any reason.
+    pub fn dropped(&self) -> u64 {
+        self.dropped_queue_full + self.dropped_write
+    }
+}
+
+impl std::fmt::Display for PublishStats {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let us = |d: Duration| d.as_secs_f64() * 1e6;
+        writeln!(
+            f,
+            "ROS 2 {} (DDS {}, domain {}): {} published, {} dropped ({} queue full, {} write \
+             gave up), {} subscriber(s) at the end{}",
+            self.topic,
+            self.dds_topic,
+            self.domain,
+            self.published,
+            self.dropped(),
+            self.dropped_queue_full,
+            self.dropped_write,
+            self.subscribers,
+            if self.acknowledged {
+                ""
+            } else {
+                ", not all acknowledged"
+            },
+        )?;
+        write!(
+            f,
+            "ROS 2 publish latency (estimate handed over to DDS writer done): median {:.1} us, \
+             P99 {:.1} us, max {:.1} us",
+            us(self.latency_median),
+            us(self.latency_p99),
+            us(self.latency_max)
+        )
+    }
+}
+
+/// Counters shared between the caller and the publishing thread.
+#[derive(Debug, Default)]
+struct Shared {
+    dropped_queue_full: AtomicU64,
+    subscribers: AtomicUsize,
+}
+
+type Writer = DataWriter<Vector3Stamped>;
+
+/// What the publishing thread returns.
+struct Done {
+    published: u64,
+    dropped_write: u64,
+    latency: LatencyStats,
+    acknowledged: bool,
+    subscribers: usize,
+}
+
+/// Publishes estimates on a ROS 2 topic from a thread of its own (see the module docs).
+pub struct Ros2Publisher {
+    options: Ros2Options,
+    dds_topic: String,
+    tx: Option<Sender<(Estimate, Instant)>>,
+    shared: Arc<Shared>,
+    thread: Option<JoinHandle<Done>>,
+    // Dropped last (fields drop in order): the writer lives in the thread.
+    _participant: rustdds::DomainParticipant,
+}
+
+impl std::fmt::Debug for Ros2Publisher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Ros2Publisher")
+            .field("options", &self.options)
+            .field("dds_topic", &self.dds_topic)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The QoS of a default `rclcpp`/`rclpy` publisher, with the writer's wait bounded.
+fn qos() -> QosPolicies {
+    QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::from_std(WRITE_BLOCKING),
+        })
+        .history(History::KeepLast {
+            depth: HISTORY_DEPTH,
+        })
+        .durability(Durability::Volatile)
+        .build()
+}
+
+impl Ros2Publisher {
+    /// Joins the DDS domain, creates the topic and its writer, and starts the publishing
+    /// thread.
+    pub fn new(options: Ros2Options) -> Result<Self, Error> {
+        if options.domain > MAX_DOMAIN_ID {
+            return Err(Error::Domain {
+                domain: options.domain.into(),
+            });
+        }
+        let dds_topic = dds_topic_name(&options.topic)?;
+        let create = |what: &'static str| {
+            let (topic, dds_topic, domain) =
+                (options.topic.clone(), dds_topic.clone(), options.domain);
+            move |source| Error::Create {
+                what,
+                topic,
+                dds_topic,
+                domain,
+                source,
+            }
+        };
+        let mut builder = DomainParticipantBuilder::new(options.domain);
+        if !options.interfaces.is_empty() {
+            builder = builder.with_only_networks(options.interfaces.iter().copied());
+        }
+        let participant = builder.build().map_err(create("participant"))?;
+        let qos = qos();
+        let topic = participant
+            .create_topic(
+                dds_topic.clone(),
+                TYPE_NAME.to_owned(),
+                &qos,
+                TopicKind::NoKey,
+            )
+            .map_err(create("topic"))?;
+        let publisher = participant
+            .create_publisher(&qos)
+            .map_err(create("publisher"))?;
+        let writer: Writer = publisher
+            .create_datawriter_no_key_cdr::<Vector3Stamped>(&topic, None)
+            .map_err(create("data writer"))?;
+        let (tx, rx) = bounded(QUEUE);
+        let shared = Arc::new(Shared::default());
+        let thread = std::thread::Builder::new()
+            .name("evtac-ros2".into())
+            .spawn({
+                let shared = Arc::clone(&shared);
+                let frame_id = options.frame_id.clone();
+                move || publish_loop(&writer, &rx, &frame_id, &shared)
+            })
+            .map_err(Error::Thread)?;
+        Ok(Self {
+            options,
+            dds_topic,
+            tx: Some(tx),
+            shared,
+            thread: Some(thread),
+            _participant: participant,
+        })
+    }
+
+    /// The DDS topic the estimates go to.
+    pub fn dds_topic(&self) -> &str {
+        &self.dds_topic
+    }
+
+    /// Subscribers matched to the writer, as of the publishing thread's latest look (it looks
+    /// every few milliseconds while idle, and after every message).
+    pub fn subscribers(&self) -> usize {
+        self.shared.subscribers.load(Ordering::Relaxed)
+    }
+
+    /// Waits until at least `count` subscribers are matched, or `timeout` passed; returns
+    /// whether they are.
+    pub fn wait_for_subscribers(&self, count: usize, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if self.subscribers() >= count {
+                return true;
+            }
+            if Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
+    /// Hands `estimate` to the publishing thread, never waiting: when its queue is full the
+    /// estimate is dropped and counted.
+    pub fn publish(&self, estimate: &Estimate) {
+        let Some(tx) = &self.tx else { return };
+        match tx.try_send((*estimate, Instant::now())) {
+            Ok(()) => {}
+            // Disconnected only if the thread died (a panic, reported by `finish`).
+            Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => {
+                self.shared
+                    .dropped_queue_full
+                    .fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// Publishes what is still queued, waits up to [`LINGER`] for the subscribers to
+    /// acknowledge everything, leaves the domain and returns the run's figures.
+    pub fn finish(mut self) -> PublishStats {
+        self.tx = None;
+        let done = self.thread.take().and_then(|t| t.join().ok());
+        let shared = &self.shared;
+        let dropped_queue_full = shared.dropped_queue_full.load(Ordering::Relaxed);
+        let mut stats = PublishStats {
+            topic: self.options.topic.clone(),
+            dds_topic: self.dds_topic.clone(),
+            domain: self.options.domain,
+            published: 0,
+            dropped_queue_full,
+            dropped_write: 0,
+            subscribers: shared.subscribers.load(Ordering::Relaxed),
+            acknowledged: false,
+            latency_median: Duration::ZERO,
+            latency_p99: Duration::ZERO,
+            latency_max: Duration::ZERO,
+        };
+        if let Some(done) = done {
+            stats.published = done.published;
+            stats.dropped_write = done.dropped_write;
+            stats.subscribers = done.subscribers;
+            stats.acknowledged = done.acknowledged;
+            stats.latency_median = done.latency.quantile(0.5);
+            stats.latency_p99 = done.latency.quantile(0.99);
+            stats.latency_max = done.latency.max();
+        }
+        stats
+    }
+}
+
+impl Drop for Ros2Publisher {
+    fn drop(&mut self) {
+        // Not finished: still let the thread end before the participant goes.
+        self.tx = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+/// How often the idle publishing thread refreshes the subscriber count.
+const IDLE_POLL: Duration = Duration::from_millis(5);
+
+/// The publishing thread: messages from the queue to the writer until the queue closes.
+fn publish_loop(
+    writer: &Writer,
+    rx: &Receiver<(Estimate, Instant)>,
+    frame_id: &str,
+    shared: &Shared,
+) -> Done {
+    // RustDDS reports matches as status events; the latest says how many are matched now.
+    let mut subscribers = 0usize;
+    let mut count = |w: &Writer| {
+        while let Some(status) = w.try_recv_status() {
+            if let DataWriterStatus::PublicationMatched { current, .. } = status {
+                subscribers = usize::try_from(current.count()).unwrap_or(0);
+            }
+        }
+        subscribers
+    };
+    // The threshold of "late" is irrelevant here; only the quantiles are reported.
+    let mut latency = LatencyStats::new(WRITE_BLOCKING);
+    let (mut published, mut dropped_write) = (0u64, 0u64);
+    loop {
+        match rx.recv_timeout(IDLE_POLL) {
+            Ok((estimate, handed)) => {
+                let message = Vector3Stamped::from_estimate(&estimate, frame_id);
+                match writer.write(message, None) {
+                    Ok(()) => {
+                        latency.record(handed.elapsed());
+                        published += 1;
+                    }
+                    Err(_) => dropped_write += 1,
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
+        }
+        shared.subscribers.store(count(writer), Ordering::Relaxed);
+    }
+    let acknowledged = writer.wait_for_acknowledgments(LINGER).unwrap_or(false);
+    Done {
+        published,
+        dropped_write,
+        latency,
+        acknowledged,
+        subscribers: count(writer),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topic_names_map_as_ros2_does() {
+        assert_eq!(
+            dds_topic_name("/contact_angle").unwrap(),
+            "rt/contact_angle"
+        );
+        assert_eq!(dds_topic_name("contact_angle").unwrap(), "rt/contact_angle");
+        assert_eq!(
+            dds_topic_name("/robot1/contact_angle").unwrap(),
+            "rt/robot1/contact_angle"
+        );
+        for bad in ["", "/", "/a//b", "/a/", "/a b", "/~/x", "/1abc", "/a-b"] {
+            let e = dds_topic_name(bad).unwrap_err().to_string();
+            assert!(e.contains("invalid ROS 2 topic name"), "{bad:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn stamps_split_microseconds_into_seconds_and_nanoseconds() {
+        assert_eq!(Time::from_micros(0), Time { sec: 0, nanosec: 0 });
+        assert_eq!(
+            Time::from_micros(1_234_567),
+            Time {
+                sec: 1,
+                nanosec: 234_567_000
+            }
+        );
+        assert_eq!(
+            Time::from_micros(-1),
+            Time {
+                sec: -1,
+                nanosec: 999_999_000
+            }
+        );
+        // A DV camera's Unix-time microseconds.
+        assert_eq!(
+            Time::from_micros(1_700_000_000_000_001),
+            Time {
+                sec: 1_700_000_000,
+                nanosec: 1000
+            }
+        );
+        assert_eq!(Time::from_micros(i64::MAX).sec, i32::MAX);
+        assert_eq!(Time::from_micros(i64::MIN).sec, i32::MIN);
+    }
+
+    #[test]
+    fn messages_carry_radians_and_serialize_as_ros2_cdr() {
+        let e = Estimate {
+            t_us: 2_000_500,
+            pitch_deg: 90.0,
+            roll_deg: -0.1,
+            latency: Duration::ZERO,
+            processing: Duration::ZERO,
+        };
+        let m = Vector3Stamped::from_estimate(&e, "neurotac");
+        assert_eq!(m.vector.x, std::f64::consts::FRAC_PI_2);
+        assert_eq!(
+            m.vector.y,
+            f64::from(-0.1f32) * (std::f64::consts::PI / 180.0)
+        );
+        assert_eq!(m.vector.z, 0.0);
+        assert_eq!(
+            m.header.stamp,
+            Time {
+                sec: 2,
+                nanosec: 500_000
+            }
+        );
+        // CDR as rclcpp writes it: int32, uint32, string (u32 length with the NUL, bytes,
+        // NUL), padding to 8, three float64.
+        use rustdds::no_key::SerializerAdapter;
+        let bytes = rustdds::CDRSerializerAdapter::<Vector3Stamped>::to_bytes(&m).unwrap();
+        assert_eq!(
+            <rustdds::CDRSerializerAdapter<Vector3Stamped>>::output_encoding(),
+            rustdds::RepresentationIdentifier::CDR_LE
+        );
+        let mut expected = Vec::new();
+        expected.extend(2i32.to_le_bytes());
+        expected.extend(500_000u32.to_le_bytes());
+        expected.extend(9u32.to_le_bytes());
+        expected.extend(b"neurotac\0");
+        expected.extend([0u8; 3]);
+        for v in [m.vector.x, m.vector.y, 0.0] {
+            expected.extend(v.to_le_bytes());
+        }
+        assert_eq!(&bytes[..], &expected[..]);
+    }
+
+    #[test]
+    fn out_of_range_domains_are_refused_with_their_number() {
+        let mut options = Ros2Options::new("/contact_angle");
+        options.domain = 233;
+        let e = Ros2Publisher::new(options).unwrap_err().to_string();
+        assert!(e.contains("233"), "{e}");
+    }
+}

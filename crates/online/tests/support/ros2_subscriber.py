@@ -1,0 +1,76 @@
+"""A subscriber of ROS 2's geometry_msgs/msg/Vector3Stamped written with Cyclone DDS's Python
+binding, as an rclpy node on Cyclone (ROS 2's default middleware in several distributions) sees
+the topic: the IDL types ROS 2 generates (module `msg::dds_`, names ending in `_`), a reliable,
+volatile reader.
+
+argv: domain id, DDS topic (`rt/contact_angle`), seconds without a sample after which to stop
+once samples came, seconds after which to stop in any case. Discovery follows CYCLONEDDS_URI
+(the test confines it to loopback).
+
+Prints `ready` once the reader exists, then, when it stops, one line per sample received,
+`recv_ns sec nanosec frame_id x y z` (recv_ns: wall clock, time.time_ns(), when the sample was
+taken; floats as repr, which round-trips exactly), then `end`.
+"""
+import sys, time
+from dataclasses import dataclass
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.sub import DataReader
+from cyclonedds.core import Qos, Policy, WaitSet, ReadCondition, ViewState, InstanceState, SampleState
+from cyclonedds.util import duration
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.types import int32, uint32, float64
+
+@dataclass
+class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: int32
+    nanosec: uint32
+
+@dataclass
+class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Time_
+    frame_id: str
+
+@dataclass
+class Vector3_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    x: float64
+    y: float64
+    z: float64
+
+@dataclass
+class Vector3Stamped_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3Stamped_"):
+    header: Header_
+    vector: Vector3_
+
+domain, topic, idle_s, deadline_s = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
+dp = DomainParticipant(domain)
+tp = Topic(dp, topic, Vector3Stamped_)
+# What a default rclpy subscription asks for (reliable, volatile), with a history deep enough
+# that a slow Python loop loses nothing.
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.Volatile,
+          Policy.History.KeepLast(100000))
+reader = DataReader(dp, tp, qos=qos)
+cond = ReadCondition(reader, SampleState.Any | ViewState.Any | InstanceState.Any)
+ws = WaitSet(dp)
+ws.attach(cond)
+print("ready", flush=True)
+start = time.monotonic()
+last = None
+out = []
+while True:
+    now = time.monotonic()
+    if now - start > deadline_s or (last is not None and now - last > idle_s):
+        break
+    ws.wait(duration(milliseconds=50))
+    samples = reader.take(N=1000)
+    t = time.time_ns()
+    for s in samples:
+        # The writer leaving comes as an invalid sample (instance state, no data).
+        if not isinstance(s, Vector3Stamped_):
+            continue
+        out.append(f"{t} {s.header.stamp.sec} {s.header.stamp.nanosec} {s.header.frame_id} "
+                   f"{s.vector.x!r} {s.vector.y!r} {s.vector.z!r}")
+    if samples:
+        last = time.monotonic()
+print("\n".join(out))
+print("end", flush=True)
