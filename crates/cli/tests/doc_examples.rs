@@ -143,8 +143,8 @@ fn readme_setup(dir: &Path) -> Option<()> {
     std::fs::create_dir_all(dir.join("docs/img")).ok()
 }
 
-/// docs/real-data.md's setup: a session with its log, no-contact recording and calibration, and
-/// one trial in each of the lab's and other tools' formats.
+/// docs/real-data.md's setup: a session with its log, no-contact recording and calibration, one
+/// trial in each of the lab's and other tools' formats, and ROS bags.
 fn real_data_setup(dir: &Path) -> Option<()> {
     let sim = dir.join("sim-session");
     // Every motion of the tiny Experiment 1: the walkthrough ends in a reproduction, which
@@ -189,6 +189,10 @@ fn real_data_setup(dir: &Path) -> Option<()> {
          np.savetxt(d + '/events.csv', np.stack([t, x, y, p], 1), fmt='%d', delimiter=',')",
         &[s(dir)],
     )?;
+    // ROS bags, written by the `rosbags` package as the bag readers' tests write them.
+    let bags = Path::new(env!("CARGO_MANIFEST_DIR")).join("../events/tests/formats/ros_bags.py");
+    let script = std::fs::read_to_string(bags).ok()?;
+    evtac_testkit::run_python(&script, &[s(dir)])?;
     Some(())
 }
 
