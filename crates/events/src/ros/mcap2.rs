@@ -1,9 +1,11 @@
 //! The MCAP container (rosbag2's default storage since ROS 2 Iron), read with Foxglove's `mcap`
 //! crate: the format's reference Rust reader, kept in step with the specification, with zstd
-//! and lz4 chunks. Its streaming reader checks each record's length against the file's
-//! (records are never longer than the file), decompresses a chunk as its records are read
-//! rather than reserving the declared size, and reports a file cut short after its last whole
-//! message (the end magic is missing), which is an error here as for any truncated file.
+//! and lz4 chunks. Its sans-io linear reader is driven here with a record length limit (see
+//! [`record_limit`]), which bounds every record, inside a chunk too, before any buffer is sized
+//! by it: the crate's `RawMessageStream` (0.26) sets no limit for the records of a chunk and
+//! reserved a damaged length (5 PB, found by fuzzing), which aborted the process. A file cut
+//! short after its last whole message (the end magic missing) is an error, as for any
+//! truncated file.
 //!
 //! The file is read in order, not through its summary: the summary is optional (a recording
 //! that crashed has none), and every message is needed anyway. A channel's schema name is the
@@ -12,7 +14,8 @@
 
 use std::collections::HashMap;
 
-use mcap::read::RawMessageStream;
+use mcap::records::Record;
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::{Collector, Place, RosError};
 
@@ -27,36 +30,91 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
     let broken = |e: mcap::McapError| RosError::Mcap {
         what: e.to_string(),
     };
-    let mut stream = RawMessageStream::new(bytes).map_err(broken)?;
-    // Channel id -> topic index in the collector.
-    let mut channels: HashMap<u16, usize> = HashMap::new();
-    while let Some(message) = stream.next() {
-        let message = message.map_err(broken)?;
-        let id = message.header.channel_id;
-        let topic = match channels.get(&id) {
-            Some(&topic) => topic,
-            None => {
-                let channel = stream.get_channel(id).ok_or_else(|| RosError::Mcap {
-                    what: format!(
-                        "message {} refers to channel {id}, which the file has not defined",
-                        message.header.sequence
-                    ),
-                })?;
-                let message_type = channel
-                    .schema
-                    .as_ref()
-                    .map_or("(no schema)", |s| s.name.as_str());
-                let topic = c.topic(&channel.topic, message_type, &channel.message_encoding);
-                channels.insert(id, topic);
-                topic
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default().with_record_length_limit(record_limit(bytes.len())),
+    );
+    let mut rest = bytes;
+    // Schema id -> name; channel id -> topic index in the collector (or the channel, until its
+    // first message).
+    let mut schemas: HashMap<u16, String> = HashMap::new();
+    let mut channels: HashMap<u16, mcap::records::Channel> = HashMap::new();
+    let mut topics: HashMap<u16, usize> = HashMap::new();
+    let mut past_data_end = false;
+    let mut ended = false;
+    while let Some(event) = reader.next_event() {
+        match event.map_err(broken)? {
+            LinearReadEvent::ReadRequest(need) => {
+                let n = need.min(rest.len());
+                reader.insert(n).copy_from_slice(&rest[..n]);
+                reader.notify_read(n);
+                rest = &rest[n..];
             }
-        };
-        c.message(
-            topic,
-            message.header.log_time,
-            &message.data,
-            Place::Unknown,
-        )?;
+            LinearReadEvent::Record { opcode, data } => {
+                // The summary repeats schemas and channels: read on to the end magic only.
+                if past_data_end {
+                    ended |= opcode == mcap::records::op::FOOTER;
+                    continue;
+                }
+                match mcap::parse_record(opcode, data).map_err(broken)? {
+                    Record::Schema { header, .. } => {
+                        schemas.insert(header.id, header.name);
+                    }
+                    Record::Channel(channel) => {
+                        channels.insert(channel.id, channel);
+                    }
+                    Record::Message { header, data } => {
+                        let id = header.channel_id;
+                        let topic = match topics.get(&id) {
+                            Some(&topic) => topic,
+                            None => {
+                                let channel = channels.get(&id).ok_or_else(|| RosError::Mcap {
+                                    what: format!(
+                                        "message {} refers to channel {id}, which the file has \
+                                         not defined",
+                                        header.sequence
+                                    ),
+                                })?;
+                                let message_type = match channel.schema_id {
+                                    0 => "(no schema)",
+                                    sid => schemas.get(&sid).map(String::as_str).ok_or_else(
+                                        || RosError::Mcap {
+                                            what: format!(
+                                                "channel {id} ({}) refers to schema {sid}, which \
+                                                 the file has not defined",
+                                                channel.topic
+                                            ),
+                                        },
+                                    )?,
+                                };
+                                let topic = c.topic(
+                                    &channel.topic,
+                                    message_type,
+                                    &channel.message_encoding,
+                                );
+                                topics.insert(id, topic);
+                                topic
+                            }
+                        };
+                        c.message(topic, header.log_time, &data, Place::Unknown)?;
+                    }
+                    Record::DataEnd(_) => past_data_end = true,
+                    Record::Footer(_) => ended = true,
+                    _ => {}
+                }
+            }
+        }
+    }
+    if !ended {
+        return Err(RosError::Mcap {
+            what: "the file ends before its footer and end magic (cut short?)".into(),
+        });
     }
     Ok(())
+}
+
+/// The longest record accepted, in a chunk or not: sixteen times the file, at least 64 MiB, at
+/// most 2 GiB (rosbag2 writes chunks of about a megabyte; a record is never longer than its
+/// decompressed chunk, and a chunk this far beyond its file is a damaged size field).
+fn record_limit(file_len: usize) -> usize {
+    file_len.saturating_mul(16).clamp(64 << 20, 2 << 30)
 }

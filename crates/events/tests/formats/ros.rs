@@ -388,3 +388,26 @@ fn the_fuzz_entry_points_decode_whole_bags() {
     assert_eq!(evtac_events::ros::fuzz_decode_rosbag(&mcap), 0);
     assert_eq!(evtac_events::ros::fuzz_decode_mcap(&bag), 0);
 }
+
+/// Found by the `mcap` fuzz target: a record inside a chunk declaring 5 PB made the `mcap`
+/// crate's message stream reserve it (the process aborted on the failed allocation); a schema
+/// name declaring 2 GiB is reserved by the crate before it is checked. Both are errors naming
+/// the file, and the first allocates no more than the file backs.
+#[test]
+fn damaged_mcap_lengths_are_errors_not_aborts() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/formats/regressions");
+    let huge = dir.join("mcap-record-of-5-petabytes.mcap");
+    let (result, largest) =
+        crate::alloc::largest_allocation_during(|| evtac_events::read_recording(&huge));
+    let err = result.unwrap_err().to_string();
+    assert!(
+        err.contains("mcap-record-of-5-petabytes.mcap") && err.contains("exceeds limit"),
+        "{err}"
+    );
+    assert!(largest < 64 << 20, "allocated {largest} bytes");
+    let string = dir.join("mcap-string-of-2-gibibytes.mcap");
+    let err = evtac_events::read_recording(&string)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("mcap-string-of-2-gibibytes.mcap"), "{err}");
+}
