@@ -18,7 +18,7 @@
 //!
 //! The HDF5 library itself is the HDF Group's (`libhdf5`, through the `hdf5-metno` bindings):
 //! the format's B-trees, chunking and filters are too large to rewrite. Data is read in slices of
-//! [`CHUNK`] events, so memory holds a chunk whatever size a dataset claims; attributes are read
+//! 65,536 events, so memory holds a slice whatever size a dataset claims; attributes are read
 //! only when they hold a handful of values.
 
 use std::ops::Range;

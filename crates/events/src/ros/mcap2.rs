@@ -1,7 +1,7 @@
 //! The MCAP container (rosbag2's default storage since ROS 2 Iron), read with Foxglove's `mcap`
 //! crate: the format's reference Rust reader, kept in step with the specification, with zstd
 //! and lz4 chunks. Its sans-io linear reader is driven here with a record length limit (see
-//! [`record_limit`]), which bounds every record, inside a chunk too, before any buffer is sized
+//! `record_limit`), which bounds every record, inside a chunk too, before any buffer is sized
 //! by it: the crate's `RawMessageStream` (0.26) sets no limit for the records of a chunk and
 //! reserved a damaged length (5 PB, found by fuzzing), which aborted the process. A file cut
 //! short after its last whole message (the end magic missing) is an error, as for any
