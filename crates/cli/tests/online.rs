@@ -392,7 +392,7 @@ fn ros2_flags_are_checked() {
     assert!(msg.contains("invalid ROS 2 topic name"), "{msg}");
     let msg = run_err(&with(&["--ros2", "/contact_angle", "--ros-domain", "240"]));
     assert!(msg.contains("domain id 240"), "{msg}");
-    // --frame-id without --ros2 is a mistake worth saying.
+    // --frame-id without --ros2 or --mcap is a mistake worth saying.
     let msg = run_err(&with(&["--frame-id", "x"]));
     assert!(msg.contains("--ros2"), "{msg}");
     let out = evtac()
@@ -420,4 +420,79 @@ fn ros2_flags_are_checked() {
         msg.contains("0 of 1 ROS 2 subscriber(s) matched on /contact_angle in domain 231"),
         "{msg}"
     );
+}
+
+/// `--mcap`: the log holds what the CSV holds, read back by the `mcap` Python package (schema,
+/// encoding, log time) and by `rosbags` (`AnyReader` on the file, `deserialize_cdr`).
+#[test]
+fn mcap_logs_what_the_csv_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    let (out, log) = (dir.path().join("est.csv"), dir.path().join("run.mcap"));
+    let [m, e, o, l] = [&model, &events, &out, &log].map(|p| p.to_str().unwrap());
+    let base = ["online", "--model", m, "--input", e, "--sensor", "640x480"];
+    let run = run_ok(
+        &[
+            &base[..],
+            &["--output", o, "--mcap", l, "--frame-id", "left"],
+        ]
+        .concat(),
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let rows = rows(&std::fs::read_to_string(&out).unwrap());
+    assert!(rows.len() >= 40, "{} rows", rows.len());
+    assert!(
+        stderr.contains(&format!("logged {} estimate(s) to {l}", rows.len())),
+        "{stderr}"
+    );
+    // The log is never written over the input.
+    let msg = run_err(&[&base[..], &["--mcap", e]].concat());
+    assert!(msg.contains("refusing to write over it"), "{msg}");
+    assert!(std::fs::read_to_string(&events).unwrap() == csv_events());
+
+    if evtac_testkit::python_with("mcap").is_none()
+        || evtac_testkit::python_with("rosbags").is_none()
+    {
+        return;
+    }
+    let script = r#"
+import sys
+from pathlib import Path
+from mcap.reader import make_reader
+from rosbags.highlevel import AnyReader
+with open(sys.argv[1], 'rb') as f:
+    times = [(s.name, s.encoding, c.topic, c.message_encoding, m.log_time)
+             for s, c, m in make_reader(f).iter_messages()]
+with AnyReader([Path(sys.argv[1])]) as reader:
+    msgs = [(c.msgtype, reader.typestore.deserialize_cdr(raw, c.msgtype))
+            for c, _, raw in reader.messages()]
+assert len(times) == len(msgs), (len(times), len(msgs))
+for (name, enc, topic, menc, t), (typ, msg) in zip(times, msgs):
+    print(name, enc, topic, menc, t, typ, msg.header.stamp.sec, msg.header.stamp.nanosec,
+          msg.header.frame_id, repr(msg.vector.x), repr(msg.vector.y), repr(msg.vector.z))
+"#;
+    let got = evtac_testkit::run_python(script, &[l]).unwrap();
+    let lines: Vec<Vec<&str>> = got.lines().map(|l| l.split(' ').collect()).collect();
+    assert_eq!(lines.len(), rows.len(), "messages vs CSV rows");
+    for (row, f) in rows.iter().zip(&lines) {
+        let t_us: i64 = row[0].parse().unwrap();
+        let ns = (t_us * 1000).to_string();
+        let ty = "geometry_msgs/msg/Vector3Stamped";
+        assert_eq!(f[..6], [ty, "ros2msg", "/contact_angle", "cdr", &ns, ty]);
+        let (sec, nanosec): (i64, i64) = (f[6].parse().unwrap(), f[7].parse().unwrap());
+        assert_eq!(sec * 1_000_000 + nanosec / 1000, t_us, "{f:?}");
+        assert_eq!(f[8], "left");
+        for (deg, rad) in [(&row[1], f[9]), (&row[2], f[10])] {
+            let expected = f64::from(deg.parse::<f32>().unwrap()).to_radians();
+            assert_eq!(
+                rad.parse::<f64>().unwrap().to_bits(),
+                expected.to_bits(),
+                "t = {t_us}: {deg} degrees logged as {rad}"
+            );
+        }
+        assert_eq!(f[11], "0.0");
+    }
 }

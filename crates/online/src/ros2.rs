@@ -49,8 +49,8 @@ use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError, bounde
 use rustdds::no_key::DataWriter;
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{
-    DataWriterStatus, DomainParticipantBuilder, QosPolicies, QosPolicyBuilder, StatusEvented,
-    TopicKind,
+    DataWriterStatus, DomainParticipantBuilder, QosPolicies, QosPolicyBuilder,
+    RepresentationIdentifier, StatusEvented, TopicKind,
 };
 use serde::{Deserialize, Serialize};
 use std::net::IpAddr;
@@ -158,6 +158,45 @@ impl Vector3Stamped {
         }
     }
 }
+
+impl Vector3Stamped {
+    /// Appends the message as a ROS 2 serialized message: the 4-byte encapsulation header of
+    /// plain little-endian CDR (`00 01 00 00`) and the CDR body RustDDS's serializer makes (the
+    /// bytes its data writer puts on the wire after the same header). This is what `rosbag2`
+    /// stores and `rclpy.serialization.deserialize_message` reads.
+    pub fn to_cdr(&self, out: &mut Vec<u8>) -> Result<(), rustdds::serialization::Error> {
+        out.extend_from_slice(&RepresentationIdentifier::CDR_LE.to_bytes());
+        out.extend_from_slice(&[0, 0]);
+        rustdds::serialization::to_writer_with_rep_id(out, self, RepresentationIdentifier::CDR_LE)
+    }
+}
+
+/// The ROS 2 type name of the message ([`Vector3Stamped`]), as `rosbag2` and MCAP name it.
+pub const MSG_TYPE: &str = "geometry_msgs/msg/Vector3Stamped";
+
+/// The `.msg` definition of [`MSG_TYPE`] with its dependencies, as `rosbag2` stores it in an
+/// MCAP schema (encoding `ros2msg`): the type's own definition, then each type it uses after a
+/// line of 80 `=` and a `MSG: package/Type` line. Field for field the Rust types of this module.
+pub const MSG_DEFINITION: &str = "\
+std_msgs/Header header
+geometry_msgs/Vector3 vector
+
+================================================================================
+MSG: std_msgs/Header
+builtin_interfaces/Time stamp
+string frame_id
+
+================================================================================
+MSG: builtin_interfaces/Time
+int32 sec
+uint32 nanosec
+
+================================================================================
+MSG: geometry_msgs/Vector3
+float64 x
+float64 y
+float64 z
+";
 
 /// An estimate's angle in radians, as published: the `f32` degrees widened to `f64` exactly,
 /// then multiplied by `PI / 180` in `f64` ([`f64::to_radians`], the same operation as Python's

@@ -1,6 +1,7 @@
 //! Integration tests of `evtac-online`: one binary, one module per concern.
 
 mod live;
+mod mcap_log;
 mod pipeline;
 mod processing;
 mod replay;

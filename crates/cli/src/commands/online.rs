@@ -6,12 +6,15 @@
 //! instead and says that latency needs `--realtime`.
 //!
 //! With `--ros2 TOPIC` every estimate is also published on ROS 2 (`evtac_online::ros2`), without
-//! holding the estimation up; the CSV output goes on alongside.
+//! holding the estimation up; the CSV output goes on alongside. With `--mcap FILE` the same
+//! messages are logged to an MCAP file (`evtac_online::mcap_log`) that Foxglove and `rosbags`
+//! open.
 
 use anyhow::Context;
 use evtac_events::output::{OutputFile, refuse_input};
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::mcap_log::{self, McapLog};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::ros2::{self, Ros2Options, Ros2Publisher};
 use evtac_online::{Backoff, Estimator, Summary};
@@ -83,9 +86,9 @@ pub struct Args {
     /// estimate's event time (see docs/online.md). Needs no ROS installation.
     #[arg(long, value_name = "TOPIC")]
     pub ros2: Option<String>,
-    /// `header.frame_id` of the ROS 2 messages.
-    #[arg(long, default_value = "neurotac", requires = "ros2")]
-    pub frame_id: String,
+    /// `header.frame_id` of the ROS 2 messages and of the MCAP log's (default `neurotac`).
+    #[arg(long)]
+    pub frame_id: Option<String>,
     /// ROS 2 (DDS) domain id, 0 to 232; `ROS_DOMAIN_ID` when absent, else 0.
     #[arg(long, requires = "ros2")]
     pub ros_domain: Option<u16>,
@@ -100,6 +103,18 @@ pub struct Args {
     /// Longest wait for `--ros2-wait-subscribers`; the run fails when they are not there by then.
     #[arg(long, default_value_t = 30.0, requires = "ros2_wait_subscribers")]
     pub ros2_wait_timeout_s: f64,
+    /// Also log every estimate to this MCAP file, as the `--ros2` messages
+    /// (`geometry_msgs/msg/Vector3Stamped`, CDR) on the `--ros2` topic or `/contact_angle`,
+    /// logged at the estimate's event time; Foxglove and rosbags open it (see docs/online.md).
+    #[arg(long, value_name = "FILE")]
+    pub mcap: Option<PathBuf>,
+}
+
+impl Args {
+    /// `--frame-id`, or `neurotac`.
+    fn frame_id(&self) -> &str {
+        self.frame_id.as_deref().unwrap_or("neurotac")
+    }
 }
 
 fn seconds(what: &str, s: f64) -> anyhow::Result<Duration> {
@@ -137,7 +152,7 @@ fn ros2_publisher(
     };
     let publisher = Ros2Publisher::new(Ros2Options {
         topic: topic.to_owned(),
-        frame_id: args.frame_id.clone(),
+        frame_id: args.frame_id().to_owned(),
         domain,
         interfaces: args.ros_interface.clone(),
     })?;
@@ -194,6 +209,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .max_duration_s
         .map(|s| seconds("--max-duration-s", s))
         .transpose()?;
+    if args.frame_id.is_some() && args.ros2.is_none() && args.mcap.is_none() {
+        anyhow::bail!(
+            "--frame-id names the frame of the --ros2 messages and the --mcap log: give either"
+        );
+    }
     let say = |what: &dyn std::fmt::Display| eprintln!("evtac online: {what}");
     // Before the input opens: a live stream does not wait while subscribers are awaited.
     let publisher = match &args.ros2 {
@@ -223,6 +243,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         None => None,
     };
+    // Like the CSV file, the log appears when the run ends without error.
+    let mut log = match &args.mcap {
+        Some(path) => {
+            let inputs = match &spec {
+                SourceSpec::File(input) => vec![input.clone()],
+                _ => Vec::new(),
+            };
+            let topic = args.ros2.as_deref().unwrap_or(mcap_log::DEFAULT_TOPIC);
+            Some(McapLog::create(path, &inputs, topic, args.frame_id())?)
+        }
+        None => None,
+    };
+    let mut log_error = None;
     let mut stdout = None;
     let out: &mut dyn Write = match &mut file {
         Some(f) => f,
@@ -247,6 +280,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     // First: it only hands the estimate to the publishing thread.
                     if let Some(publisher) = &publisher {
                         publisher.publish(&e);
+                    }
+                    if let Some(log) = &mut log
+                        && let Err(e) = log.write(&e)
+                    {
+                        log_error = Some(e);
+                        return ControlFlow::Break(());
                     }
                     let written = writeln!(
                         out,
@@ -295,6 +334,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return Err(e).context("writing the estimates");
     }
     flushed.context("writing the estimates")?;
+    if let Some(e) = log_error {
+        return Err(e.into());
+    }
+    if let Some(log) = log {
+        let written = log.written();
+        log.finish()?;
+        if let Some(path) = &args.mcap {
+            say(&format_args!(
+                "logged {written} estimate(s) to {}",
+                path.display()
+            ));
+        }
+    }
     if let (Some(file), Some(path)) = (file, &args.output) {
         OutputFile::commit_buffered(file).with_context(|| format!("writing {}", path.display()))?;
     }

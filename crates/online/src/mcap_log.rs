@@ -1,0 +1,195 @@
+//! Logging estimates to an MCAP file, the log format of ROS 2 (`rosbag2`'s default storage) and
+//! Foxglove.
+//!
+//! A run's estimates are worth keeping beside the other signals of an experiment: the CSV output
+//! holds them, but robotics tools want a log they can open, plot against time and replay. An
+//! MCAP log ([`McapLog`], `evtac online --mcap FILE`) holds exactly what [`crate::ros2`]
+//! publishes, so Foxglove plots it, `rosbags` (Python) reads it and `ros2 bag play` replays it
+//! onto the topic as if evtac were running:
+//!
+//! - one channel, on the ROS 2 topic `/contact_angle` (or the one given), message encoding
+//!   `cdr`;
+//! - its schema is named `geometry_msgs/msg/Vector3Stamped` ([`MSG_TYPE`]), schema encoding
+//!   `ros2msg`, the `.msg` text with its dependencies `std_msgs/Header`,
+//!   `builtin_interfaces/Time` and `geometry_msgs/Vector3` ([`MSG_DEFINITION`]), as `rosbag2`
+//!   writes it; the file's profile is `ros2`;
+//! - each message is [`Vector3Stamped::from_estimate`] (`x` = pitch, `y` = roll in radians,
+//!   `z` = 0, `header.stamp` = the estimate's `t_us`) serialized by the same CDR serializer the
+//!   DDS publisher uses ([`Vector3Stamped::to_cdr`]: the encapsulation header `00 01 00 00`, then
+//!   little-endian CDR);
+//! - its log time and publish time are the estimate's `t_us` in nanoseconds: the event time, as
+//!   the stamp (an MCAP time is unsigned, so an estimate before the clock's zero is an error);
+//! - chunks are zstd-compressed on the calling thread (no compression threads), with the
+//!   summary, chunk and message indexes readers seek with.
+//!
+//! The file is written as every evtac output: under a temporary name beside its final one,
+//! renamed by [`McapLog::finish`] once complete ([`OutputFile`]), so a failed or killed run
+//! leaves no truncated log under the final name; and never over one of the run's inputs
+//! ([`refuse_input`]).
+
+use crate::estimator::Estimate;
+use crate::ros2::{MSG_DEFINITION, MSG_TYPE, Vector3Stamped};
+use evtac_events::output::{OutputFile, OutputIsInput, refuse_input};
+use mcap::records::MessageHeader;
+use mcap::{Compression, WriteOptions, Writer};
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// The channel's message encoding.
+pub const MESSAGE_ENCODING: &str = "cdr";
+
+/// The schema's encoding.
+pub const SCHEMA_ENCODING: &str = "ros2msg";
+
+/// The MCAP profile of ROS 2 logs (`rosbags` refuses a file without it).
+pub const PROFILE: &str = "ros2";
+
+/// The topic when none is given (the ROS 2 publisher's default).
+pub const DEFAULT_TOPIC: &str = "/contact_angle";
+
+/// Errors of this module.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The log would overwrite an input.
+    #[error(transparent)]
+    OutputIsInput(#[from] OutputIsInput),
+    /// The file could not be created, written or renamed.
+    #[error("writing the MCAP log {}: {source}", path.display())]
+    Io {
+        /// The log's final path.
+        path: PathBuf,
+        /// What failed.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The MCAP writer failed.
+    #[error("writing the MCAP log {}: {source}", path.display())]
+    Mcap {
+        /// The log's final path.
+        path: PathBuf,
+        /// What the `mcap` crate said.
+        #[source]
+        source: mcap::McapError,
+    },
+    /// The message could not be serialized.
+    #[error("serializing an estimate for the MCAP log: {0}")]
+    Serialize(#[source] rustdds::serialization::Error),
+    /// An estimate before the clock's zero has no MCAP time.
+    #[error(
+        "the estimate at t = {t_us} us is before the clock's zero: MCAP log times are unsigned"
+    )]
+    NegativeTime {
+        /// The estimate's time.
+        t_us: i64,
+    },
+}
+
+/// An MCAP log of estimates being written (see the module docs).
+pub struct McapLog {
+    writer: Writer<BufWriter<OutputFile>>,
+    path: PathBuf,
+    channel: u16,
+    frame_id: String,
+    sequence: u32,
+    buf: Vec<u8>,
+}
+
+impl std::fmt::Debug for McapLog {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("McapLog")
+            .field("path", &self.path)
+            .field("frame_id", &self.frame_id)
+            .field("written", &self.sequence)
+            .finish_non_exhaustive()
+    }
+}
+
+impl McapLog {
+    /// Starts the log `path` with one channel on `topic` whose messages have `header.frame_id`
+    /// `frame_id`; refuses a `path` that is one of `inputs`. Nothing appears under `path` before
+    /// [`finish`](Self::finish).
+    pub fn create<P: AsRef<Path>>(
+        path: &Path,
+        inputs: &[P],
+        topic: &str,
+        frame_id: &str,
+    ) -> Result<Self, Error> {
+        refuse_input(path, inputs)?;
+        let io = |source| Error::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let mcap = |source| Error::Mcap {
+            path: path.to_owned(),
+            source,
+        };
+        let file = OutputFile::buffered(path).map_err(io)?;
+        let mut writer = WriteOptions::new()
+            .profile(PROFILE)
+            .library(format!("evtac {}", env!("CARGO_PKG_VERSION")))
+            .compression(Some(Compression::Zstd))
+            .compression_threads(0)
+            .create(file)
+            .map_err(mcap)?;
+        let schema = writer
+            .add_schema(MSG_TYPE, SCHEMA_ENCODING, MSG_DEFINITION.as_bytes())
+            .map_err(mcap)?;
+        let channel = writer
+            .add_channel(schema, topic, MESSAGE_ENCODING, &BTreeMap::new())
+            .map_err(mcap)?;
+        Ok(Self {
+            writer,
+            path: path.to_owned(),
+            channel,
+            frame_id: frame_id.to_owned(),
+            sequence: 0,
+            buf: Vec::with_capacity(128),
+        })
+    }
+
+    /// Appends `estimate` as a message (see the module docs).
+    pub fn write(&mut self, estimate: &Estimate) -> Result<(), Error> {
+        let time_ns = u64::try_from(estimate.t_us)
+            .ok()
+            .and_then(|us| us.checked_mul(1000))
+            .ok_or(Error::NegativeTime {
+                t_us: estimate.t_us,
+            })?;
+        self.buf.clear();
+        Vector3Stamped::from_estimate(estimate, &self.frame_id)
+            .to_cdr(&mut self.buf)
+            .map_err(Error::Serialize)?;
+        self.sequence = self.sequence.wrapping_add(1);
+        let header = MessageHeader {
+            channel_id: self.channel,
+            sequence: self.sequence,
+            log_time: time_ns,
+            publish_time: time_ns,
+        };
+        self.writer
+            .write_to_known_channel(&header, &self.buf)
+            .map_err(|source| Error::Mcap {
+                path: self.path.clone(),
+                source,
+            })
+    }
+
+    /// Messages written so far (modulo 2^32).
+    pub fn written(&self) -> u32 {
+        self.sequence
+    }
+
+    /// Writes the summary and footer and renames the file to its final name.
+    pub fn finish(mut self) -> Result<(), Error> {
+        self.writer.finish().map_err(|source| Error::Mcap {
+            path: self.path.clone(),
+            source,
+        })?;
+        OutputFile::commit_buffered(self.writer.into_inner()).map_err(|source| Error::Io {
+            path: self.path,
+            source,
+        })
+    }
+}
