@@ -452,6 +452,8 @@ fn mcap_logs_what_the_csv_holds() {
     let msg = run_err(&[&base[..], &["--mcap", e]].concat());
     assert!(msg.contains("refusing to write over it"), "{msg}");
     assert!(std::fs::read_to_string(&events).unwrap() == csv_events());
+    let msg = run_err(&[&base[..], &["--output", l, "--mcap", l]].concat());
+    assert!(msg.contains("--mcap and --output are both"), "{msg}");
 
     if evtac_testkit::python_with("mcap").is_none()
         || evtac_testkit::python_with("rosbags").is_none()

@@ -214,6 +214,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "--frame-id names the frame of the --ros2 messages and the --mcap log: give either"
         );
     }
+    if let (Some(mcap), Some(output)) = (&args.mcap, &args.output)
+        && mcap == output
+    {
+        anyhow::bail!(
+            "--mcap and --output are both {}: give the log and the CSV different names",
+            mcap.display()
+        );
+    }
     let say = |what: &dyn std::fmt::Display| eprintln!("evtac online: {what}");
     // Before the input opens: a live stream does not wait while subscribers are awaited.
     let publisher = match &args.ros2 {
