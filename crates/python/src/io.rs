@@ -39,7 +39,7 @@ pub struct Recording {
     #[pyo3(get)]
     triggers: Py<PyAny>,
     /// `(width, height)` of the sensor (of the crop when one was taken), or `None` when the
-    /// file does not state it (CSV, NPY) and none was given.
+    /// file does not state it (CSV, NPY, NPZ, DSEC's HDF5) and none was given.
     #[pyo3(get)]
     resolution: Option<(u16, u16)>,
     /// The file's format: `AEDAT4`, `AEDAT3.1`, `AEDAT2`, `EVT2`, `EVT21`, `EVT3`, `CSV` or

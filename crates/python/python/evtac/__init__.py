@@ -145,14 +145,15 @@ def read(
     resolution: Optional[Size] = None,
     stream: Optional[Union[str, int]] = None,
 ) -> Recording:
-    """Reads a whole event file: AEDAT 4.0, 3.1 or 2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY (the
-    formats ``evtac convert`` reads).
+    """Reads a whole event file in any format ``evtac convert`` reads: AEDAT 4.0, 3.1 or 2.0,
+    EVT 2.0/2.1/3.0 raw, CSV, NPY, NPZ, HDF5, the NeuroTac lab's pickles, ROS bags.
 
     ``roi=(w, h)`` keeps the centered ``w x h`` region (coordinates shifted into it; the
     recording's resolution is then the region's). ``resolution=(w, h)`` declares the sensor size
-    of files that do not store it (CSV, NPY) and checks every event against it. ``stream``
-    picks the event stream of an AEDAT4 file with several (two cameras): its id, name, camera
-    name or ``CAMERA/NAME`` as ``evtac info`` lists them; that camera's IMU comes with it.
+    of files that do not store it (CSV, NPY, NPZ, DSEC's HDF5) and checks every event against
+    it. ``stream`` picks the event stream of an AEDAT4 file with several (two cameras): its id,
+    name, camera name or ``CAMERA/NAME`` as ``evtac info`` lists them; that camera's IMU comes
+    with it. For a ROS bag it names the event topic (``/dvs/events``).
 
     Returns a :class:`Recording` with ``events``, ``imu``, ``triggers`` (structured arrays),
     ``resolution``, ``format`` and ``source``.
