@@ -62,8 +62,12 @@ use std::time::{Duration, Instant};
 /// The DDS type name of `geometry_msgs/msg/Vector3Stamped`.
 pub const TYPE_NAME: &str = "geometry_msgs::msg::dds_::Vector3Stamped_";
 
-/// History depth of the writer (ROS 2's default `rmw_qos_profile_default` keeps 10).
-pub const HISTORY_DEPTH: i32 = 10;
+/// History depth of the writer: a second of estimates at one per millisecond. A reliable writer
+/// resends only what its history still holds, so ROS 2's default depth of 10
+/// (`rmw_qos_profile_default`) gave a subscriber that fell 10 ms behind on a loaded machine
+/// gaps (4 of 401 estimates in a CI run); a subscriber's own depth (10 by default) is its own.
+/// Keep-last with any depth matches a default subscription.
+pub const HISTORY_DEPTH: i32 = 1000;
 
 /// Estimates the queue to the publishing thread holds before further ones are dropped: a
 /// quarter of a second at one estimate per millisecond.
