@@ -2,9 +2,9 @@
 //! ([`EventReader`]) or read it whole ([`read_recording`]), and write events to any writable
 //! format ([`EventWriter`]).
 //!
-//! The format is recognised by the file's first bytes (AEDAT4 and NPY magic, `#!AER-DAT2.0` /
-//! `#!AER-DAT3.1` header, EVT `%` header, ROS 1 bag and MCAP magic; a folder is a rosbag2 bag)
-//! and otherwise by its extension (`.csv`). Every reader validates what it decodes: events
+//! The format is recognised by the file's first bytes (AEDAT4, NPY, HDF5 and MCAP magic,
+//! `#!AER-DAT2.0` / `#!AER-DAT3.1` header, EVT `%` header, `#ROSBAG V2.0`, a NeuroTac pickle's
+//! opening; a folder is a rosbag2 bag) and otherwise by its extension (`.csv`; `.npz` for a zip). Every reader validates what it decodes: events
 //! inside the declared resolution and timestamps that never go backwards.
 //!
 //! [`EventReader::select_range`] (and [`read_recording_range`]) read a time range `[from, to)`:
@@ -221,9 +221,10 @@ impl Format {
             }
             _ => Err(Error::UnknownFormat {
                 path: path.to_path_buf(),
-                reason: "no AEDAT4, NPY, EVT, ROS bag or MCAP signature, and the extension is not \
-                         .csv"
-                    .into(),
+                reason:
+                    "no AEDAT4, NPY, HDF5, EVT, ROS bag or MCAP signature, and the extension is \
+                         not .csv (nor .npz for a zip)"
+                        .into(),
             }),
         }
     }
@@ -275,8 +276,7 @@ enum Inner {
 }
 
 /// A recording read whole (NeuroTac pickles, NPZ archives and ROS bags, which must be parsed
-/// whole),
-/// handed out in chunks like the streaming readers'.
+/// whole), handed out in chunks like the streaming readers'.
 struct MemoryEvents {
     events: Vec<Event>,
     /// IMU samples, in time order.
