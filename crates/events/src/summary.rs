@@ -90,14 +90,13 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// Reads the rest of `reader` chunk by chunk (bounded memory) and summarises it;
-    /// `on_position` sees the reader's byte position after each chunk (for a progress bar).
-    pub fn read(reader: &mut EventReader, mut on_position: impl FnMut(u64)) -> Result<Self, Error> {
-        let mut s = Summary {
-            format: reader.format().name().to_string(),
-            source: reader.source().map(str::to_string),
-            width: reader.resolution().map(|r| r.width),
-            height: reader.resolution().map(|r| r.height),
+    /// The summary of a `format` file with nothing read yet: no counts, times, streams or notes.
+    fn empty(format: Format) -> Self {
+        Summary {
+            format: format.name().to_string(),
+            source: None,
+            width: None,
+            height: None,
             events: 0,
             on_events: 0,
             first_t_us: None,
@@ -108,9 +107,22 @@ impl Summary {
             last_imu_t_us: None,
             triggers: 0,
             streams: Vec::new(),
-            topics: reader.topics().to_vec(),
+            topics: Vec::new(),
             selection: None,
+            note: None,
+        }
+    }
+
+    /// Reads the rest of `reader` chunk by chunk (bounded memory) and summarises it;
+    /// `on_position` sees the reader's byte position after each chunk (for a progress bar).
+    pub fn read(reader: &mut EventReader, mut on_position: impl FnMut(u64)) -> Result<Self, Error> {
+        let mut s = Summary {
+            source: reader.source().map(str::to_string),
+            width: reader.resolution().map(|r| r.width),
+            height: reader.resolution().map(|r| r.height),
+            topics: reader.topics().to_vec(),
             note: reader.note().map(str::to_string),
+            ..Summary::empty(reader.format())
         };
         while let Some(chunk) = reader.next_chunk()? {
             if let (Some(first), Some(last)) = (chunk.events.first(), chunk.events.last()) {
@@ -167,23 +179,9 @@ impl Summary {
                     && *selection == StreamSelection::default() =>
             {
                 Ok(Self {
-                    format: format.name().to_string(),
-                    source: None,
-                    width: None,
-                    height: None,
-                    events: 0,
-                    on_events: 0,
-                    first_t_us: None,
-                    last_t_us: None,
-                    imu_samples: 0,
-                    imu_rate_hz: None,
-                    first_imu_t_us: None,
-                    last_imu_t_us: None,
-                    triggers: 0,
-                    streams: Vec::new(),
                     topics: crate::ros::topics(path)?,
                     selection: Some(error.reason),
-                    note: None,
+                    ..Self::empty(format)
                 })
             }
             Err(e) => Err(e),

@@ -46,12 +46,11 @@ pub fn synthetic_events(n: usize, width: u16, height: u16) -> Vec<Event> {
         .collect()
 }
 
-/// Reads the `.expected.npy` of the EVT3 fixture with the crate's own NPY reader.
 /// The events of a headerless `t,x,y,p` text file that a test's Python script wrote as the
 /// expected answer.
 pub fn read_expected_csv(path: &std::path::Path) -> Vec<Event> {
     std::fs::read_to_string(path)
-        .unwrap()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .lines()
         .map(|l| {
             let v: Vec<i64> = l.split(',').map(|f| f.parse().unwrap()).collect();
@@ -65,6 +64,7 @@ pub fn read_expected_csv(path: &std::path::Path) -> Vec<Event> {
         .collect()
 }
 
+/// Reads the `.expected.npy` of the EVT3 fixture with the crate's own NPY reader.
 pub fn read_npy_events(path: &std::path::Path) -> Vec<Event> {
     let mut reader = evtac_events::npy::NpyReader::from_path(path).expect("open npy");
     let mut out = Vec::new();

@@ -13,7 +13,7 @@ use evtac_events::aedat::StreamSelection;
 use evtac_events::{Error, Event, Format, ImuSample, Resolution, Summary};
 use evtac_testkit::{real_fixture, run_python};
 
-use crate::common::read_npy_events;
+use crate::common::{read_expected_csv, read_npy_events};
 
 const WRITE: &str = include_str!("ros_bags.py");
 const EVT3_RAW: &str = "prophesee_gen4_1280x720.evt3.raw";
@@ -39,23 +39,6 @@ fn csv_rows(path: &Path) -> Vec<Vec<f64>> {
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .lines()
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
-
-/// `NAME.events.csv`: t (us), x, y, p.
-fn expected_events(path: &Path) -> Vec<Event> {
-    std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .lines()
-        .map(|l| {
-            let v: Vec<i64> = l.split(',').map(|f| f.parse().unwrap()).collect();
-            Event {
-                t: v[0],
-                x: v[1] as u16,
-                y: v[2] as u16,
-                polarity: v[3] == 1,
-            }
-        })
         .collect()
 }
 
@@ -105,7 +88,7 @@ fn assert_imu(what: &str, got: &[ImuSample], want: &Path) {
 fn ros1_bags_read_event_for_event_with_every_chunk_compression() {
     let Some(dir) = written() else { return };
     let d = dir.path();
-    let want = expected_events(&d.join("dvs1.events.csv"));
+    let want = read_expected_csv(&d.join("dvs1.events.csv"));
     for file in ["dvs.bag", "dvs_bz2.bag", "dvs_lz4.bag"] {
         let path = d.join(file);
         assert_eq!(Format::detect(&path).unwrap(), Format::RosBag, "{file}");
@@ -146,7 +129,7 @@ fn ros1_bags_read_event_for_event_with_every_chunk_compression() {
 fn ros2_mcap_folders_and_files_read_event_for_event() {
     let Some(dir) = written() else { return };
     let d = dir.path();
-    let want = expected_events(&d.join("dvs2.events.csv"));
+    let want = read_expected_csv(&d.join("dvs2.events.csv"));
     for file in ["dvs2", "dvs2/dvs2.mcap", "dvs2_zstd"] {
         let path = d.join(file);
         assert_eq!(Format::detect(&path).unwrap(), Format::Mcap, "{file}");
@@ -213,7 +196,7 @@ fn mono_packets_add_dt_to_the_time_base() {
     let d = dir.path();
     let rec = evtac_events::read_recording(d.join("mono.mcap")).unwrap();
     assert_eq!(rec.resolution, Some(Resolution::new(640, 480)));
-    let want = expected_events(&d.join("mono.events.csv"));
+    let want = read_expected_csv(&d.join("mono.events.csv"));
     assert_events("mono", &rec.events, &want);
     assert!(rec.imu.is_empty());
 }
@@ -275,7 +258,7 @@ fn with_two_cameras_a_topic_is_chosen_by_name() {
     assert_events(
         "stereo /cam1",
         &rec.events,
-        &expected_events(&d.join("stereo1.events.csv")),
+        &read_expected_csv(&d.join("stereo1.events.csv")),
     );
     assert_imu("stereo /cam1", &rec.imu, &d.join("stereo1.imu.csv"));
     // `info` lists the topics and says why it counts nothing.
