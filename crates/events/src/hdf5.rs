@@ -338,13 +338,12 @@ impl Hdf5Reader {
                 ),
             });
         }
-        let stated = match small_attribute(root, "sensor_resolution")? {
-            None => match small_attribute(&group, "sensor_resolution")? {
-                None => None,
-                Some(v) => Some(two_sizes(&v)?),
-            },
-            Some(v) => Some(two_sizes(&v)?),
+        // On the file (event_utils, the NeuroTac code), else on the `events` group.
+        let sizes = match small_attribute(root, "sensor_resolution")? {
+            Some(v) => Some(v),
+            None => small_attribute(&group, "sensor_resolution")?,
         };
+        let stated = sizes.as_deref().map(two_sizes).transpose()?;
         let t_offset = if columns[0].kind != Kind::Seconds && file.link_exists("t_offset") {
             file.dataset("t_offset")
                 .and_then(|d| d.read_scalar::<i64>())
