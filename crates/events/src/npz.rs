@@ -13,7 +13,7 @@
 //! its buffer with the bytes actually inflated, so a member's declared size never decides an
 //! allocation.
 
-use std::io::{Read, Seek};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 use crate::Event;
@@ -95,8 +95,9 @@ pub fn read(path: impl AsRef<Path>) -> Result<NpzEvents, NpzError> {
 }
 
 /// Reads an NPZ archive from any seekable source.
-pub fn read_from(source: impl Read + Seek) -> Result<NpzEvents, NpzError> {
-    let mut archive = zip::ZipArchive::new(source).map_err(|e| NpzError::Zip(e.to_string()))?;
+pub fn read_from(mut source: impl Read + Seek) -> Result<NpzEvents, NpzError> {
+    let end = end_record(&mut source).map_err(|e| NpzError::Zip(e.to_string()))?;
+    let mut archive = zip::ZipArchive::new(source).map_err(|e| NpzError::Zip(end.explain(e)))?;
     let members: Vec<String> = archive.file_names().map(str::to_string).collect();
     let stem = |m: &str| m.strip_suffix(".npy").unwrap_or(m).to_string();
     // One array per field, when the members' names say so.
@@ -193,6 +194,55 @@ fn read_columns<R: Read + Seek>(
         events,
         members: names.iter().map(|s| s.to_string()).collect(),
     })
+}
+
+/// Where a zip's end record is: the zip crate's errors do not say where the archive is broken,
+/// and an error must (a cut file loses its end record, a damaged one points at the wrong place).
+enum EndRecord {
+    /// Not in the last `searched` bytes of the file.
+    Missing { searched: u64 },
+    /// At byte `at`, putting the central directory at byte `directory`.
+    At { at: u64, directory: u64 },
+}
+
+/// The longest tail a zip's end record can be in: the record (22 bytes) and its comment (at
+/// most 65,535).
+const END_RECORD_SEARCH: u64 = 22 + 65_535;
+
+/// Finds the last end record signature in the tail of `source`, and rewinds it.
+fn end_record(source: &mut (impl Read + Seek)) -> std::io::Result<EndRecord> {
+    let len = source.seek(SeekFrom::End(0))?;
+    let searched = len.min(END_RECORD_SEARCH);
+    source.seek(SeekFrom::Start(len - searched))?;
+    let mut tail = Vec::new();
+    source.take(searched).read_to_end(&mut tail)?;
+    source.rewind()?;
+    let found = tail
+        .windows(22)
+        .rposition(|w| w.starts_with(b"PK\x05\x06"))
+        .map(|i| EndRecord::At {
+            at: len - searched + i as u64,
+            directory: u64::from(u32::from_le_bytes(
+                tail[i + 16..i + 20].try_into().expect("4 bytes"),
+            )),
+        });
+    Ok(found.unwrap_or(EndRecord::Missing { searched }))
+}
+
+impl EndRecord {
+    /// The zip crate's error `e` on opening the archive, with where the archive is broken.
+    fn explain(&self, e: zip::result::ZipError) -> String {
+        match *self {
+            EndRecord::Missing { searched } => format!(
+                "no zip end record in the file's last {searched} bytes (a zip ends with one): \
+                 the archive is cut short, or is not a zip ({e})"
+            ),
+            EndRecord::At { at, directory } => format!(
+                "the end record at byte {at} puts the central directory at byte {directory}, \
+                 which does not read: {e}"
+            ),
+        }
+    }
 }
 
 /// Decodes `bytes` as an NPZ archive, for the fuzz target: any input gives events or an

@@ -6,8 +6,10 @@
 //! `0x06` chunk info (the index, read past).
 //!
 //! The file is scanned from start to end, chunks decompressed one at a time, so a bag that was
-//! never indexed (a recording cut short) reads as well as a finished one, up to where it is
-//! broken. A message whose connection is only defined later (in the index section) is kept
+//! never indexed (the recorder stopped before closing it: `index_pos` 0) reads as well as a
+//! finished one, up to where it is broken. A closed bag's index, written last, is checked
+//! against what its bag header declares ([`Index`]): a closed bag cut short is an error, never
+//! read as a shorter bag. A message whose connection is only defined later (in the index section) is kept
 //! until the connection is known.
 //!
 //! Why not the `rosbag` crate (0.6): it memory-maps the file (undefined behaviour if the file
@@ -156,7 +158,106 @@ fn le_u32(v: &[u8]) -> Option<u32> {
 const OP_MESSAGE: u8 = 0x02;
 const OP_BAG_HEADER: u8 = 0x03;
 const OP_CHUNK: u8 = 0x05;
+const OP_CHUNK_INFO: u8 = 0x06;
 const OP_CONNECTION: u8 = 0x07;
+
+/// The index a closed bag ends with, as its bag header declares it and as the scan finds it.
+/// A bag cut short after it was closed (or whose header is damaged) must be an error, not a
+/// shorter bag: the index, written last, is what shows the cut. A bag that was never closed
+/// (`index_pos` 0: the recorder stopped before writing the index) has none to check, and is
+/// read up to where it is broken.
+struct Index {
+    /// Where the bag header puts the index (0: never written), and the record counts it
+    /// declares.
+    pos: u64,
+    connections: u32,
+    chunks: u32,
+    /// The offset of the first top-level connection or chunk info record found, and the
+    /// counts found.
+    found_at: Option<u64>,
+    found_connections: u32,
+    found_chunks: u32,
+}
+
+impl Index {
+    /// The declaration in the bag header `header` (the record at `offset`) of a file of
+    /// `file_len` bytes.
+    fn declared(header: &[(&[u8], &[u8])], offset: u64, file_len: u64) -> Result<Self, RosError> {
+        let at = |what: String| RosError::Container { offset, what };
+        let pos = field(header, "index_pos")
+            .and_then(|v| Some(u64::from_le_bytes(v.try_into().ok()?)))
+            .ok_or_else(|| at("the bag header has no 8-byte index_pos field".into()))?;
+        let count = |name: &str| {
+            field(header, name)
+                .and_then(le_u32)
+                .ok_or_else(|| at(format!("the bag header has no 4-byte {name} field")))
+        };
+        let (connections, chunks) = (count("conn_count")?, count("chunk_count")?);
+        if pos >= file_len {
+            return Err(at(format!(
+                "the bag header's index_pos puts the index at byte {pos}, at or past the end of \
+                 the file ({file_len} bytes): the bag is cut short"
+            )));
+        }
+        Ok(Index {
+            pos,
+            connections,
+            chunks,
+            found_at: None,
+            found_connections: 0,
+            found_chunks: 0,
+        })
+    }
+
+    /// Notes a top-level record of kind `op` at `offset`.
+    fn saw(&mut self, op: u8, offset: u64) {
+        if op == OP_CONNECTION || op == OP_CHUNK_INFO {
+            self.found_at.get_or_insert(offset);
+            match op {
+                OP_CONNECTION => self.found_connections += 1,
+                _ => self.found_chunks += 1,
+            }
+        }
+    }
+
+    /// Whether the index found is the one declared (always, for a bag never closed).
+    fn check(&self, header_offset: u64) -> Result<(), RosError> {
+        if self.pos == 0 {
+            return Ok(());
+        }
+        let what = match self.found_at {
+            None => format!(
+                "the bag header's index_pos puts the index at byte {}, but the file holds no \
+                 index records: the bag is cut short or damaged",
+                self.pos
+            ),
+            Some(at) if at != self.pos => format!(
+                "the bag header's index_pos puts the index at byte {}, but it starts at byte \
+                 {at}: the bag header is damaged",
+                self.pos
+            ),
+            Some(_)
+                if (self.found_connections, self.found_chunks)
+                    != (self.connections, self.chunks) =>
+            {
+                format!(
+                    "the index (from byte {}) holds {} connection and {} chunk info records, \
+                     but the bag header declares {} and {}: the bag is cut short or damaged",
+                    self.pos,
+                    self.found_connections,
+                    self.found_chunks,
+                    self.connections,
+                    self.chunks
+                )
+            }
+            Some(_) => return Ok(()),
+        };
+        Err(RosError::Container {
+            offset: header_offset,
+            what,
+        })
+    }
+}
 
 /// A message whose connection was not defined yet when it was read.
 struct Pending {
@@ -175,8 +276,8 @@ struct Scan<'c> {
 }
 
 impl Scan<'_> {
-    /// Handles one record of the file (`in_chunk`: read from a chunk's data).
-    fn record(&mut self, records: &Records<'_>, r: &Record<'_>) -> Result<(), RosError> {
+    /// Handles one record of the file or of a chunk (`records.inside`), and returns its op.
+    fn record(&mut self, records: &Records<'_>, r: &Record<'_>) -> Result<u8, RosError> {
         let at = |what: String| RosError::Container {
             offset: r.offset,
             what: if records.inside {
@@ -202,7 +303,7 @@ impl Scan<'_> {
                 .ok_or_else(|| at("the record has no 4-byte conn field".into()))
         };
         match op {
-            OP_CHUNK if !records.inside => self.chunk(r, &header),
+            OP_CHUNK if !records.inside => self.chunk(r, &header)?,
             OP_CONNECTION => {
                 let conn = conn()?;
                 let data = fields(r.data).map_err(|e| at(format!("connection {conn}: {e}")))?;
@@ -221,7 +322,6 @@ impl Scan<'_> {
                 let index = self.c.topic(&topic, &message_type, "ros1");
                 // The index section repeats the chunks' connection records.
                 self.connections.entry(conn).or_insert(index);
-                Ok(())
             }
             OP_MESSAGE => {
                 let conn = conn()?;
@@ -237,21 +337,20 @@ impl Scan<'_> {
                     Place::Record(r.offset)
                 };
                 match self.connections.get(&conn) {
-                    Some(&topic) => self.c.message(topic, time_ns, r.data, place),
-                    None => {
-                        self.pending.push(Pending {
-                            conn,
-                            time_ns,
-                            data: r.data.to_vec(),
-                            place,
-                        });
-                        Ok(())
-                    }
+                    Some(&topic) => self.c.message(topic, time_ns, r.data, place)?,
+                    None => self.pending.push(Pending {
+                        conn,
+                        time_ns,
+                        data: r.data.to_vec(),
+                        place,
+                    }),
                 }
             }
-            // The bag header, index data and chunk info: nothing the scan needs.
-            _ => Ok(()),
+            // The bag header, index data and chunk info: nothing the scan needs (the index is
+            // checked against the bag header by `Index`).
+            _ => {}
         }
+        Ok(op)
     }
 
     /// Decompresses a chunk and handles the records inside.
@@ -360,9 +459,10 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
         connections: HashMap::new(),
         pending: Vec::new(),
     };
-    let mut first = true;
+    let header_offset = magic.len() as u64;
+    let mut index: Option<Index> = None;
     while let Some(record) = records.next()? {
-        if first {
+        let Some(index) = index.as_mut() else {
             let header = fields(record.header).map_err(|what| RosError::Container {
                 offset: record.offset,
                 what,
@@ -373,10 +473,18 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
                     what: "the first record is not the bag header (op 0x03)".into(),
                 });
             }
-            first = false;
-        }
-        scan.record(&records, &record)?;
+            index = Some(Index::declared(&header, record.offset, bytes.len() as u64)?);
+            continue;
+        };
+        let op = scan.record(&records, &record)?;
+        index.saw(op, record.offset);
     }
+    index
+        .ok_or_else(|| RosError::Container {
+            offset: header_offset,
+            what: "the file ends after its first line: it has no bag header record".into(),
+        })?
+        .check(header_offset)?;
     for p in std::mem::take(&mut scan.pending) {
         let topic = *scan.connections.get(&p.conn).ok_or_else(|| {
             let offset = match p.place {

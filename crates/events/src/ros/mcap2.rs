@@ -27,8 +27,10 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
             what: "not an MCAP file: it does not start with the magic `\\x89MCAP0\\r\\n`".into(),
         });
     }
-    let broken = |e: mcap::McapError| RosError::Mcap {
-        what: e.to_string(),
+    // What the reader had read when a problem is found: `bytes.len() - rest.len()`.
+    let broken = |rest: &[u8]| {
+        let read_to = (bytes.len() - rest.len()) as u64;
+        move |what: String| RosError::Mcap { read_to, what }
     };
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default().with_record_length_limit(record_limit(bytes.len())),
@@ -42,7 +44,7 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
     let mut past_data_end = false;
     let mut ended = false;
     while let Some(event) = reader.next_event() {
-        match event.map_err(broken)? {
+        match event.map_err(|e| broken(rest)(e.to_string()))? {
             LinearReadEvent::ReadRequest(need) => {
                 let n = need.min(rest.len());
                 reader.insert(n).copy_from_slice(&rest[..n]);
@@ -55,7 +57,7 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
                     ended |= opcode == mcap::records::op::FOOTER;
                     continue;
                 }
-                match mcap::parse_record(opcode, data).map_err(broken)? {
+                match mcap::parse_record(opcode, data).map_err(|e| broken(rest)(e.to_string()))? {
                     Record::Schema { header, .. } => {
                         schemas.insert(header.id, header.name);
                     }
@@ -67,24 +69,24 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
                         let topic = match topics.get(&id) {
                             Some(&topic) => topic,
                             None => {
-                                let channel = channels.get(&id).ok_or_else(|| RosError::Mcap {
-                                    what: format!(
+                                let channel = channels.get(&id).ok_or_else(|| {
+                                    broken(rest)(format!(
                                         "message {} refers to channel {id}, which the file has \
                                          not defined",
                                         header.sequence
-                                    ),
+                                    ))
                                 })?;
                                 let message_type = match channel.schema_id {
                                     0 => "(no schema)",
-                                    sid => schemas.get(&sid).map(String::as_str).ok_or_else(
-                                        || RosError::Mcap {
-                                            what: format!(
+                                    sid => {
+                                        schemas.get(&sid).map(String::as_str).ok_or_else(|| {
+                                            broken(rest)(format!(
                                                 "channel {id} ({}) refers to schema {sid}, which \
                                                  the file has not defined",
                                                 channel.topic
-                                            ),
-                                        },
-                                    )?,
+                                            ))
+                                        })?
+                                    }
                                 };
                                 let topic = c.topic(
                                     &channel.topic,
@@ -105,9 +107,9 @@ pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
         }
     }
     if !ended {
-        return Err(RosError::Mcap {
-            what: "the file ends before its footer and end magic (cut short?)".into(),
-        });
+        return Err(broken(rest)(
+            "the file ends before its footer and end magic (cut short?)".into(),
+        ));
     }
     Ok(())
 }

@@ -98,9 +98,13 @@ pub enum RosError {
         /// What is wrong.
         what: String,
     },
-    /// The MCAP container is broken or cut off (the `mcap` crate's finding).
-    #[error("broken MCAP container: {what}")]
+    /// The MCAP container is broken or cut off (the `mcap` crate's finding). Its reader reads
+    /// records in order and does not say where a record starts: the place given is how far the
+    /// file had been read when the problem was found.
+    #[error("broken MCAP container, read up to byte {read_to}: {what}")]
     Mcap {
+        /// The bytes of the file read when the problem was found.
+        read_to: u64,
         /// What the reader found.
         what: String,
     },

@@ -5,6 +5,7 @@
 mod aedat_legacy;
 mod alloc;
 mod bad_input;
+mod bad_input_archives;
 mod bad_input_legacy;
 mod common;
 mod csv;

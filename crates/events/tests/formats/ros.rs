@@ -319,7 +319,7 @@ fn a_truncated_bag_is_an_error_naming_the_file() {
     let (err, text) = error(&d.join("cut.bag"), &StreamSelection::default());
     assert!(matches!(err, Error::Ros { .. }), "{err:?}");
     assert!(
-        text.contains("cut.bag") && text.contains("truncated") && text.contains("byte offset"),
+        text.contains("cut.bag") && text.contains("cut short") && text.contains("byte offset"),
         "{text}"
     );
     let (err, text) = error(&d.join("cut.mcap"), &StreamSelection::default());
