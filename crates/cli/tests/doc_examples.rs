@@ -144,7 +144,7 @@ fn readme_setup(dir: &Path) -> Option<()> {
 }
 
 /// docs/real-data.md's setup: a session with its log, no-contact recording and calibration, one
-/// trial in each of the lab's and other tools' formats, and ROS bags.
+/// trial in each of the lab's and other tools' formats, ROS bags, and the session as a ROS bag.
 fn real_data_setup(dir: &Path) -> Option<()> {
     let sim = dir.join("sim-session");
     // Every motion of the tiny Experiment 1: the walkthrough ends in a reproduction, which
@@ -193,6 +193,10 @@ fn real_data_setup(dir: &Path) -> Option<()> {
     let bags = Path::new(env!("CARGO_MANIFEST_DIR")).join("../events/tests/formats/ros_bags.py");
     let script = std::fs::read_to_string(bags).ok()?;
     evtac_testkit::run_python(&script, &[s(dir)])?;
+    // The session as the rpg_dvs_ros driver would have recorded it: "From ROS" imports it.
+    let to_bag = include_str!("aedat_to_bag.py");
+    let (session, bag) = (dir.join("session.aedat4"), dir.join("session.bag"));
+    evtac_testkit::run_python(to_bag, &[s(&session), s(&bag)])?;
     Some(())
 }
 
