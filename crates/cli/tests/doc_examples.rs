@@ -2,8 +2,8 @@
 //! [`DOCS`], run as written,
 //! so that an example that drifts from the tool fails the build.
 //!
-//! Each fenced `sh` block runs in a folder of its own, after its document's setup has put there
-//! the files the prose assumes (a recording, a session and its log, a trained model): real
+//! Each fenced `sh` block runs in a folder of its own, holding a copy of what its document's setup
+//! made once: the files the prose assumes (a recording, a session and its log, a trained model): real
 //! fixtures from `../shared`, and simulated data. The commands run through `bash` in block
 //! order with the `evtac` under test first on the `PATH`; lines that are not `evtac` commands
 //! (`sbatch`, `cargo ...`) are not run. Two changes are made, both printed: `--scale small` and
@@ -144,7 +144,8 @@ fn readme_setup(dir: &Path) -> Option<()> {
 }
 
 /// docs/real-data.md's setup: a session with its log, no-contact recording and calibration, one
-/// trial in each of the lab's and other tools' formats, ROS bags, and the session as a ROS bag.
+/// trial in each of the lab's and other tools' formats, ROS bags, the session as a ROS bag, and
+/// a folder of four trials as the lab's pickles with their log.
 fn real_data_setup(dir: &Path) -> Option<()> {
     let sim = dir.join("sim-session");
     // Every motion of the tiny Experiment 1: the walkthrough ends in a reproduction, which
@@ -197,6 +198,12 @@ fn real_data_setup(dir: &Path) -> Option<()> {
     let to_bag = include_str!("aedat_to_bag.py");
     let (session, bag) = (dir.join("session.aedat4"), dir.join("session.bag"));
     evtac_testkit::run_python(to_bag, &[s(&session), s(&bag)])?;
+    // Four trials as the lab's collection script saves them, with their log, in `lab/`:
+    // "From the NeuroTac lab's collection scripts" imports them.
+    let trials = dir.join("sim-trials");
+    crate::common::simulate_tiny("exp1", 22, &trials, 4);
+    let to_lab = include_str!("aedat_to_neurotac.py");
+    evtac_testkit::run_python(to_lab, &[s(&trials), s(&dir.join("lab"))])?;
     Some(())
 }
 
@@ -261,6 +268,20 @@ fn run_bash(dir: &Path, text: &str) -> std::process::Output {
         .expect("bash runs")
 }
 
+/// Copies the files and folders under `from` into `to` (which exists).
+fn copy_tree(from: &Path, to: &Path) {
+    for entry in std::fs::read_dir(from).expect("the set-up folder") {
+        let entry = entry.expect("an entry");
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            std::fs::create_dir(&target).expect("a folder");
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
+
 fn say(text: &str) {
     // Past libtest's capture: what was skipped or changed shows in a plain run.
     let _ = std::io::Write::write_all(&mut std::io::stderr(), text.as_bytes());
@@ -274,16 +295,23 @@ fn every_documented_evtac_command_runs_as_written() {
     let mut every_doc_documented = 0;
     for (doc, setup) in DOCS {
         let markdown = std::fs::read_to_string(root.join(doc)).expect("the document");
+        // The document's files, made once and copied into each block's folder.
+        let mut prepared: Option<tempfile::TempDir> = None;
         for block in blocks(&markdown) {
             let commands: Vec<&Example> = block.iter().filter(|c| runs_evtac(&c.text)).collect();
             if commands.is_empty() {
                 continue;
             }
             every_doc_documented += 1;
-            let dir = tempfile::tempdir().expect("tmp");
-            if setup(dir.path()).is_none() {
-                return; // a fixture or Python is missing outside CI: said by the testkit
+            if prepared.is_none() {
+                let template = tempfile::tempdir().expect("tmp");
+                if setup(template.path()).is_none() {
+                    return; // a fixture or Python is missing outside CI: said by the testkit
+                }
+                prepared = Some(template);
             }
+            let dir = tempfile::tempdir().expect("tmp");
+            copy_tree(prepared.as_ref().expect("set up").path(), dir.path());
             for c in commands {
                 let at = format!("{doc}:{}", c.line);
                 if let Some((_, why)) = SKIP.iter().find(|(text, _)| c.text.contains(text)) {

@@ -9,6 +9,7 @@
 //!   <trial files>       one recording per trial, named in trials.csv's `file` column
 //!   calibration.json    the IMU-to-sensor rotation (evtac-labels)
 //!   no_contact.aedat4   a recording without contact, for the static representation's mask
+//!   label_source.json   labels from the commanded motion instead of the IMU (evtac-labels)
 //!   labels/<trial>.csv  (pitch, roll) over time, computed from the IMU (evtac-labels)
 //!   truth/<trial>.csv   the simulator's true angles (simulated datasets only)
 //!   simulator.json      how the simulator made it (simulated datasets only)
@@ -33,6 +34,9 @@ pub const MANIFEST_FILE: &str = "trials.csv";
 pub const CALIBRATION_FILE: &str = "calibration.json";
 /// The recording without contact that the no-contact mask is built from.
 pub const NO_CONTACT_FILE: &str = "no_contact.aedat4";
+/// Where the dataset's labels come from (the IMU, or the robot's commanded motion), when not
+/// the IMU.
+pub const LABEL_SOURCE_FILE: &str = "label_source.json";
 /// The folder of label files, `<trial>.csv` each.
 pub const LABELS_DIR: &str = "labels";
 /// The folder of the simulator's true angles, `<trial>.csv` each.

@@ -12,7 +12,7 @@ use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_import::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use evtac_labels::geometry::Calibration;
-use evtac_labels::{LabelConfig, LabelSeries};
+use evtac_labels::{LabelConfig, LabelSeries, LabelSource};
 use evtac_repr::{CROP, Mask, ReprConfig};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -27,7 +27,8 @@ pub enum Error {
     /// A file could not be read or written.
     #[error(transparent)]
     Io(#[from] IoError),
-    /// `calibration.json` is missing or not a calibration.
+    /// `calibration.json` is missing or not a calibration, or `label_source.json` does not
+    /// read.
     #[error(transparent)]
     Calibration(evtac_labels::Error),
     /// `no_contact.aedat4` is missing and the mask was not opted out of.
@@ -116,6 +117,8 @@ pub struct Dataset {
     pub calibration: Calibration,
     /// Where the calibration and the mask come from.
     pub inputs: Inputs,
+    /// Where its labels come from (`label_source.json`: the IMU unless it says otherwise).
+    pub label_source: LabelSource,
 }
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
@@ -171,6 +174,7 @@ impl Dataset {
         let manifest = Manifest::read(dir)?;
         let calibration = evtac_labels::dataset_calibration(dir, inputs.calibration)
             .map_err(Error::Calibration)?;
+        let label_source = LabelSource::of(dir).map_err(Error::Calibration)?;
         let no_contact = dir.join(NO_CONTACT_FILE);
         if inputs.mask == MaskSource::NoContact && !no_contact.is_file() {
             return Err(Error::MissingNoContact { path: no_contact });
@@ -180,6 +184,7 @@ impl Dataset {
             manifest,
             calibration,
             inputs,
+            label_source,
         })
     }
 
@@ -255,13 +260,18 @@ impl Dataset {
     }
 
     /// What labels depend on besides the trial: the calibration this dataset was opened with
-    /// (the file's, or the identity when opted out) and the label settings.
+    /// (the file's, or the identity when opted out) and the label settings; and for labels from
+    /// the commanded motion, that source (named only then, so that the IMU labels of every
+    /// dataset written before the choice existed keep their key and their cache).
     fn labels_key(&self) -> String {
-        serde_json::json!({
+        let mut key = serde_json::json!({
             "calibration": self.calibration,
             "config": LabelConfig::default(),
-        })
-        .to_string()
+        });
+        if self.label_source != LabelSource::Imu {
+            key["source"] = serde_json::json!(self.label_source);
+        }
+        key.to_string()
     }
 
     /// The labels of `meta`: `labels/<trial>.csv` when `labels/<trial>.key.json` says it was

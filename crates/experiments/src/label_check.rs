@@ -9,7 +9,7 @@
 use crate::dataset::{self, Dataset};
 pub use crate::results::LabelCheck;
 use evtac_labels::validation::check_stop;
-use evtac_labels::{LabelConfig, LabelSeries, Summary, TruthError};
+use evtac_labels::{LabelConfig, LabelSeries, LabelSource, Summary, TruthError};
 
 /// Checks the labels of every trial of `ds` (computing those that are missing).
 pub fn of_dataset(ds: &Dataset) -> Result<LabelCheck, dataset::Error> {
@@ -21,6 +21,8 @@ pub fn of_dataset(ds: &Dataset) -> Result<LabelCheck, dataset::Error> {
             continue;
         }
         let labels = ds.labels(meta)?;
+        // Labels from the command hold the commanded stop angle by construction.
+        let stop = stop.filter(|_| ds.label_source == LabelSource::Imu);
         if let Some(((start, end), deg)) = stop {
             // A stop too short for its margins has nothing to average: not a label error.
             if let Ok(check) = check_stop(&labels, start, end, margin_us, deg) {
@@ -41,5 +43,6 @@ pub fn of_dataset(ds: &Dataset) -> Result<LabelCheck, dataset::Error> {
     Ok(LabelCheck {
         stop_error_deg: Summary::of(&stops),
         truth_rms_deg: Summary::of(&rms),
+        label_source: ds.label_source,
     })
 }

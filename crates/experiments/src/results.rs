@@ -419,6 +419,11 @@ pub struct LabelCheck {
     /// Per-trial RMS error of the labels against the ground truth over pitch and roll, degrees
     /// (trials with a truth file).
     pub truth_rms_deg: Option<evtac_labels::Summary>,
+    /// Where the labels came from: the IMU, or the commanded motion (then no stop check: it
+    /// would compare the command with itself). Absent from results written before the choice
+    /// existed, which were all the IMU's.
+    #[serde(default)]
+    pub label_source: evtac_labels::LabelSource,
 }
 
 /// Everything a reproduction measured.

@@ -11,9 +11,10 @@
 //!   ([`evtac_events::Summary`]), on a sensor no smaller than the crop;
 //! - each recording's event and IMU time spans cover its motion window and the still lead-in
 //!   the labels need before it ([`LabelConfig::still_lead_in_us`]), with IMU samples at the rate
-//!   the labels' bias needs ([`LabelConfig::min_imu_rate_hz`]);
-//! - `calibration.json` (a rotation) and `no_contact.aedat4` (readable, with events) present,
-//!   unless opted out ([`Inputs`]);
+//!   the labels' bias needs ([`LabelConfig::min_imu_rate_hz`]) unless the dataset is labelled
+//!   from the commanded motion (`label_source.json`, [`LabelSource`]);
+//! - `calibration.json` (a rotation; not for labels from the commanded motion) and
+//!   `no_contact.aedat4` (readable, with events) present, unless opted out ([`Inputs`]);
 //! - Experiment 3's groups: `seen` or `unseen`, on every row or none, one group per speed or per
 //!   depth.
 
@@ -21,7 +22,7 @@ use crate::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, MaskSource, NO_MASK_FLAG}
 use evtac_events::Summary;
 use evtac_events::layout::{MANIFEST_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, TrialMeta};
-use evtac_labels::{CalibrationSource, LabelConfig};
+use evtac_labels::{CalibrationSource, LabelConfig, LabelSource};
 use evtac_repr::CROP;
 use evtac_sim::Protocol;
 use rayon::prelude::*;
@@ -173,7 +174,20 @@ fn check_dataset(
         problems.extend(range_problems(&manifest_path, *line, meta));
     }
     problems.extend(group_problems(&manifest_path, &rows.trials));
-    problems.extend(calibration_problems(dir, inputs));
+    let source = LabelSource::of(dir).unwrap_or_else(|e| {
+        problems.push(Problem::new(
+            &LabelSource::path(dir),
+            None,
+            None,
+            e.to_string(),
+            r#"write {"labels": "commanded"} to label from the robot's log, or delete the file to label from the IMU"#,
+        ));
+        LabelSource::Imu
+    });
+    // Labels from the commanded motion use no IMU, so no calibration to rotate it.
+    if source == LabelSource::Imu {
+        problems.extend(calibration_problems(dir, inputs));
+    }
 
     let with_no_contact =
         inputs.mask == MaskSource::NoContact && dir.join(NO_CONTACT_FILE).is_file();
@@ -185,7 +199,7 @@ fn check_dataset(
         .trials
         .par_iter()
         .map(|(line, meta)| {
-            let found = recording_problems(dir, *line, meta, &labels);
+            let found = recording_problems(dir, *line, meta, &labels, source);
             progress(CheckProgress::Read);
             found
         })
@@ -503,12 +517,14 @@ fn sensor_problems(path: &Path, line: Option<usize>, s: &Summary) -> Vec<Problem
     }
 }
 
-/// The problems of one trial's files: present, readable, long enough, IMU fast enough.
+/// The problems of one trial's files: present, readable, long enough, IMU fast enough (when the
+/// labels come from the IMU).
 fn recording_problems(
     dir: &Path,
     line: usize,
     t: &TrialMeta,
     labels: &LabelConfig,
+    source: LabelSource,
 ) -> Vec<Problem> {
     let mut out = Vec::new();
     if let Some(truth) = &t.truth
@@ -548,26 +564,30 @@ fn recording_problems(
     out.extend(sensor_problems(&path, Some(line), &s));
     let lead = labels.still_lead_in_us();
     let (from, to) = (t.motion_start_us.saturating_sub(lead), t.motion_end_us);
-    for (stream, first, last, count) in [
-        ("events", s.first_t_us, s.last_t_us, s.events),
-        (
+    let mut streams = vec![("events", s.first_t_us, s.last_t_us, s.events)];
+    if source == LabelSource::Imu {
+        streams.push((
             "IMU samples",
             s.first_imu_t_us,
             s.last_imu_t_us,
             s.imu_samples,
-        ),
-    ] {
+        ));
+    }
+    for (stream, first, last, count) in streams {
         let (Some(first), Some(last)) = (first, last) else {
-            let why = if stream == "events" {
-                "the representations are built from them"
+            let (why, fix) = if stream == "events" {
+                (
+                    "the representations are built from them",
+                    "record with the camera's events enabled",
+                )
             } else {
-                "the labels come from the IMU"
+                (
+                    "the labels come from the IMU",
+                    "record with the camera's IMU enabled, or import with --labels commanded to \
+                     label from the robot's log",
+                )
             };
-            out.push(here(
-                "file",
-                format!("no {stream} ({count}): {why}"),
-                "record with the camera's events and IMU enabled",
-            ));
+            out.push(here("file", format!("no {stream} ({count}): {why}"), fix));
             continue;
         };
         if first > from || last < to {
@@ -594,7 +614,7 @@ fn recording_problems(
         }
     }
     let min_rate = labels.min_imu_rate_hz();
-    if let Some(rate) = s.imu_rate_hz
+    if let Some(rate) = s.imu_rate_hz.filter(|_| source == LabelSource::Imu)
         && rate < min_rate
     {
         out.push(here(

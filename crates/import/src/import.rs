@@ -24,7 +24,7 @@ use evtac_events::IoError;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::{EventWriter, RangeIndex};
-use evtac_labels::CalibrationSource;
+use evtac_labels::{CalibrationSource, LabelSource};
 use std::path::{Path, PathBuf};
 
 /// Kept before each motion's onset by default, ms: the static representation's default decay
@@ -56,6 +56,10 @@ pub struct ImportConfig {
     pub no_contact: Option<NoContact>,
     /// The calibration file (`calibration.json` content), if any.
     pub calibration: Option<PathBuf>,
+    /// Where the dataset's labels will come from: the IMU (every recording must hold one), or
+    /// the commanded motion (recordings without IMU accepted; written to
+    /// `label_source.json`).
+    pub labels: LabelSource,
 }
 
 /// Errors of an import; nothing is left in the output folder after any of them.
@@ -74,6 +78,9 @@ pub enum ImportError {
     /// The calibration file is not a calibration.
     #[error("--calibration: {0}")]
     Calibration(evtac_labels::Error),
+    /// The label source could not be written.
+    #[error("--labels: {0}")]
+    LabelSource(evtac_labels::Error),
     /// The manifest could not be written.
     #[error(transparent)]
     Manifest(#[from] evtac_events::manifest::ManifestError),
@@ -420,6 +427,9 @@ fn write_all(
     }
     if let Some(NoContact::File(path)) = &config.no_contact {
         copy_range(path, None, &no_contact)?;
+    }
+    if config.labels != LabelSource::Imu {
+        config.labels.write(dir).map_err(ImportError::LabelSource)?;
     }
     if let Some(path) = &config.calibration {
         let dest = dir.join(CALIBRATION_FILE);

@@ -25,6 +25,7 @@
 //!     post_us: 200_000,
 //!     no_contact: Some(NoContact::File("no_contact.aedat4".into())),
 //!     calibration: Some("calibration.json".into()),
+//!     labels: evtac_labels::LabelSource::Imu,
 //! };
 //! let out = Path::new("data/exp1");
 //! let summary = import_session(Path::new("session.aedat4"), &log, out, &config, &|| {})?;

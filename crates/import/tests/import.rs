@@ -92,6 +92,7 @@ fn config(ds: &Path, no_contact_end: i64) -> ImportConfig {
         post_us: 300_000,
         no_contact: Some(NoContact::Range(0, no_contact_end)),
         calibration: Some(ds.join("calibration.json")),
+        labels: evtac_labels::LabelSource::Imu,
     }
 }
 

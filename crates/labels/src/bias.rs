@@ -30,7 +30,7 @@ pub enum BiasError {
 }
 
 /// The bias estimate and what it rests on.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Bias {
     /// The mean axial rate over the segment, deg/s: subtract it from every sample.
     pub rate_deg_s: f64,

@@ -9,9 +9,12 @@ use evtac_events::ImuSample;
 use evtac_events::manifest::{Manifest, TrialMeta};
 use serde::{Deserialize, Serialize};
 
+use crate::bias::Bias;
+use crate::commanded::label_commanded;
 use crate::error::{Error, TrialError};
 use crate::geometry::Calibration;
 use crate::series::LabelSeries;
+use crate::source::LabelSource;
 use crate::trial::{LabelConfig, TrialLabels, TrialMotion, label_imu};
 use crate::validation::{StopCheck, Summary, TruthError};
 
@@ -37,11 +40,16 @@ pub enum CalibrationSource {
 }
 
 /// The calibration of the dataset in `dataset_dir` from `source`: [`read_calibration`] or the
-/// identity.
+/// identity. A dataset labelled from the commanded motion needs none (the calibration rotates
+/// the IMU's rates into the sensor's frame, and its labels use no IMU): the identity, whatever
+/// `source` says.
 pub fn dataset_calibration(
     dataset_dir: impl AsRef<Path>,
     source: CalibrationSource,
 ) -> Result<Calibration, Error> {
+    if LabelSource::of(&dataset_dir)? == LabelSource::Commanded {
+        return Ok(Calibration::default());
+    }
     match source {
         CalibrationSource::File => read_calibration(dataset_dir),
         CalibrationSource::Identity => Ok(Calibration::default()),
@@ -88,7 +96,9 @@ pub fn read_calibration_file(path: &Path) -> Result<Calibration, Error> {
     Ok(calibration)
 }
 
-/// Reads the recording of `meta` and labels it (see [`label_imu`]).
+/// Labels the trial `meta` as its dataset's [`LabelSource`] says: reads its recording's IMU and
+/// labels it (see [`label_imu`]), or takes the commanded motion ([`label_commanded`]; no
+/// recording read, no bias, scale 1, no stop check).
 pub fn label_trial(
     dataset_dir: impl AsRef<Path>,
     meta: &TrialMeta,
@@ -97,6 +107,15 @@ pub fn label_trial(
 ) -> Result<TrialLabels, Error> {
     let wrap = |kind: TrialError| Error::trial(&meta.trial, kind);
     let motion = TrialMotion::from_meta(meta).map_err(wrap)?;
+    if LabelSource::of(&dataset_dir)? == LabelSource::Commanded {
+        return Ok(TrialLabels {
+            labels: label_commanded(&motion),
+            bias: Bias::default(),
+            scale_factor: 1.0,
+            final_error_deg: 0.0,
+            stop: None,
+        });
+    }
     let path = dataset_dir.as_ref().join(&meta.file);
     let imu = read_imu(&path).map_err(|e| {
         wrap(TrialError::Read {

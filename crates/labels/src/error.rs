@@ -100,6 +100,14 @@ pub enum Error {
         /// The file that is missing.
         path: PathBuf,
     },
+    /// `label_source.json` could not be read or parsed.
+    #[error("cannot read the label source {path}: {message}")]
+    LabelSource {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// `calibration.json` could not be read or parsed.
     #[error("cannot read the calibration {path}: {message}")]
     Calibration {

@@ -6,7 +6,9 @@
 //! motion, zero-phase low-pass filtered and integrated into the tilt `theta(t)`, which with the
 //! tilt direction `phi` gives the contact angles (pitch, roll). [`trial`] walks through the
 //! steps; each has its own module. [`label_trial`] and [`label_dataset`] work on dataset
-//! folders (`trials.csv`, `calibration.json`, recordings) and write `labels/<trial>.csv`.
+//! folders (`trials.csv`, `calibration.json`, recordings) and write `labels/<trial>.csv`. A
+//! dataset of recordings without an IMU is labelled from the robot's commanded motion instead
+//! ([`commanded`]), when its [`LabelSource`] says so.
 //!
 //! ```
 //! use evtac_events::ImuSample;
@@ -39,6 +41,7 @@
 //! ```
 
 pub mod bias;
+pub mod commanded;
 pub mod dataset;
 pub mod error;
 pub mod filter;
@@ -47,6 +50,7 @@ pub mod integration;
 pub mod rate;
 pub mod scale;
 pub mod series;
+pub mod source;
 pub mod trial;
 pub mod validation;
 
@@ -57,5 +61,6 @@ pub use dataset::{
 pub use error::{Error, TrialError};
 pub use scale::ScaleMethod;
 pub use series::LabelSeries;
+pub use source::LabelSource;
 pub use trial::{LabelConfig, Stop, TrialLabels, TrialMotion, label_imu};
 pub use validation::{StopCheck, Summary, TruthError};

@@ -6,7 +6,7 @@
 
 use anyhow::Context;
 use evtac_events::Trigger;
-use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
+use evtac_events::layout::{CALIBRATION_FILE, LABEL_SOURCE_FILE, NO_CONTACT_FILE};
 use evtac_import::import::{
     DEFAULT_POST_MS, DEFAULT_PRE_MS, ImportConfig, NoContact, Part, import_parts,
 };
@@ -15,6 +15,7 @@ use evtac_import::motions::{self, FoundMotion};
 use evtac_import::robot_log::RobotLog;
 use evtac_import::sync::{Sync, synchronise};
 use evtac_import::trial_folder::{split_by_file, trial_files};
+use evtac_labels::LabelSource;
 use evtac_labels::geometry::Calibration;
 use std::path::{Path, PathBuf};
 
@@ -117,6 +118,30 @@ pub struct Args {
     /// The IMU-to-sensor rotation (a calibration.json), copied into the dataset.
     #[arg(long, value_name = "FILE")]
     pub calibration: Option<PathBuf>,
+    /// Where the dataset's labels come from: imu (the paper's: the gyroscope, integrated; every
+    /// recording must hold an IMU) or commanded (the robot's commanded motion from the log's
+    /// times, for recordings without an IMU: the lab's pickles, HDF5, NPY, NPZ, CSV; written to
+    /// label_source.json, so every command labels the dataset this way).
+    #[arg(long, value_enum, default_value_t = LabelsArg::Imu, value_name = "SOURCE")]
+    pub labels: LabelsArg,
+}
+
+/// `--labels`: [`LabelSource`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum LabelsArg {
+    /// From the IMU's gyroscope (the paper's labels).
+    Imu,
+    /// From the robot's commanded motion (recordings without an IMU).
+    Commanded,
+}
+
+impl From<LabelsArg> for LabelSource {
+    fn from(a: LabelsArg) -> Self {
+        match a {
+            LabelsArg::Imu => LabelSource::Imu,
+            LabelsArg::Commanded => LabelSource::Commanded,
+        }
+    }
 }
 
 /// Where a log-free import lists what it found, in the dataset folder.
@@ -216,7 +241,7 @@ fn parts_unprefixed(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found
         for session in &args.sessions {
             let in_folder = session.is_dir();
             let files = if in_folder {
-                trial_files(session)?
+                trial_files(session, true)?
             } else {
                 vec![session.clone()]
             };
@@ -271,7 +296,7 @@ fn parts_unprefixed(args: &Args, sync: Sync) -> anyhow::Result<(Vec<Part>, Found
                     .map_or_else(String::new, |v| v.get_name().to_string())
             );
             let log = RobotLog::read_per_trial(log, args.clock_offset_us)?;
-            parts.extend(split_by_file(&log, &trial_files(session)?)?);
+            parts.extend(split_by_file(&log, &trial_files(session, false)?)?);
             continue;
         }
         let synced = synchronise(session, RobotLog::read(log, 0)?, sync)?;
@@ -420,6 +445,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             (None, None) => None,
         },
         calibration: args.calibration.clone(),
+        labels: args.labels.into(),
     };
     let trials = parts.iter().map(|p| p.log.rows.len()).sum::<usize>();
     let sources = args
@@ -446,7 +472,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         crate::outputs::write_text(&review, &motions::review_csv(&found))?;
         println!("the motions as found, for review: {}", review.display());
     }
-    if config.calibration.is_none() {
+    if config.labels == LabelSource::Commanded {
+        println!(
+            "labels: from the commanded motion (the log's times), not from an IMU: written to {}",
+            summary.out.join(LABEL_SOURCE_FILE).display()
+        );
+    } else if config.calibration.is_none() {
         println!(
             "no calibration given: add {}, or pass --{IDENTITY_CALIBRATION_FLAG} to the commands \
              that read the dataset",

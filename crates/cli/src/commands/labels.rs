@@ -11,7 +11,7 @@ use anyhow::Context as _;
 use evtac_events::manifest::Manifest;
 use evtac_labels::dataset::IDENTITY_CALIBRATION_FLAG;
 use evtac_labels::dataset::{DatasetLabels, label_and_write};
-use evtac_labels::{CalibrationSource, LabelConfig, ScaleMethod, dataset_calibration};
+use evtac_labels::{CalibrationSource, LabelConfig, LabelSource, ScaleMethod, dataset_calibration};
 use rayon::prelude::*;
 
 /// Arguments of `evtac labels`.
@@ -91,18 +91,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print_text(dir, &summary);
+        print_text(dir, &summary, LabelSource::of(dir)?);
     }
     Ok(())
 }
 
-fn print_text(dir: &std::path::Path, s: &DatasetLabels) {
+fn print_text(dir: &std::path::Path, s: &DatasetLabels, source: LabelSource) {
     println!(
         "labelled {} trials into {}",
         s.trials.len(),
         dir.join(evtac_events::layout::LABELS_DIR).display()
     );
+    if source == LabelSource::Commanded {
+        // No gyroscope was read: no scale, no bias, and a stop check would compare the command
+        // with itself.
+        println!(
+            "labels: the commanded motion from trials.csv (label_source.json), not the IMU: no \
+             stop check, no gyroscope scale"
+        );
+    }
     match &s.stop_error_deg {
+        _ if source == LabelSource::Commanded => {}
         Some(stop) => println!(
             "stop check, integrated tilt minus commanded stop angle (deg): {stop}  \
              [paper: -0.01 +- 0.04]"
@@ -125,7 +134,11 @@ fn print_text(dir: &std::path::Path, s: &DatasetLabels) {
             None => println!(", n = {}", rms.n),
         }
     }
-    if let Some(scale) = &s.scale_factor {
+    if let Some(scale) = s
+        .scale_factor
+        .as_ref()
+        .filter(|_| source == LabelSource::Imu)
+    {
         println!(
             "gyroscope scale factors: {:.4} .. {:.4} (mean {:.4})",
             scale.min, scale.max, scale.mean

@@ -2,6 +2,7 @@
 //! angles (the paper's own check) and the simulator's ground truth, beside the paper's number.
 
 use evtac_experiments::results::LabelCheck;
+use evtac_labels::LabelSource;
 
 /// The paper's label validation at the stops: mean and standard deviation, degrees.
 pub const PAPER_STOP_ERROR_DEG: (f64, f64) = (-0.01, 0.04);
@@ -17,7 +18,16 @@ pub fn section(check: Option<&LabelCheck>) -> String {
         return md;
     };
     let (mean, sd) = PAPER_STOP_ERROR_DEG;
+    if check.label_source == LabelSource::Commanded {
+        md.push_str(
+            "The labels are the robot's commanded motion (`label_source.json`: the recordings \
+             hold no IMU), not the paper's IMU labels: they leave out how the robot tracked its \
+             command, and the paper's stop check, which would compare the command with itself, \
+             is not made.",
+        );
+    }
     match &check.stop_error_deg {
+        _ if check.label_source == LabelSource::Commanded => {}
         Some(s) => md.push_str(&format!(
             "Mean labelled tilt over each stop of Experiment 2 minus the robot's commanded stop \
              angle: {:+.3} ± {:.3} deg over {} stops (range {:+.3} .. {:+.3}); the paper: \
@@ -49,6 +59,7 @@ mod tests {
         let check = LabelCheck {
             stop_error_deg: Summary::of(&[-0.05, 0.01, 0.02]),
             truth_rms_deg: Summary::of(&[0.01, 0.03]),
+            label_source: LabelSource::Imu,
         };
         let md = section(Some(&check));
         assert!(md.contains("-0.007 ± 0.038 deg over 3 stops"), "{md}");
@@ -58,5 +69,18 @@ mod tests {
             "{md}"
         );
         assert!(section(None).contains("Not checked"));
+    }
+
+    #[test]
+    fn labels_from_the_command_are_named_and_not_checked_against_it() {
+        let check = LabelCheck {
+            stop_error_deg: None,
+            truth_rms_deg: None,
+            label_source: LabelSource::Commanded,
+        };
+        let md = section(Some(&check));
+        assert!(md.contains("the robot's commanded motion"), "{md}");
+        assert!(md.contains("is not made"), "{md}");
+        assert!(!md.contains("No trial of Experiment 2"), "{md}");
     }
 }
