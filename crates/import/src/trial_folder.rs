@@ -115,19 +115,33 @@ pub fn trial_files(dir: &Path, imu_only: bool) -> Result<Vec<PathBuf>, ImportErr
 
 /// `log`'s rows (read with [`RobotLog::read_per_trial`]) split by the file of `files` each
 /// row's trial names (its stem), in `files`' order; files no row names are left out. A row
-/// without its file, or two overlapping rows of one file, is an error naming the log's line.
+/// without its file, a row whose trial names two files (`t0.aedat4` and `t0.h5`), or two
+/// overlapping rows of one file, is an error naming the log's line.
 pub fn split_by_file(log: &RobotLog, files: &[PathBuf]) -> Result<Vec<Part>, ImportError> {
-    let by_stem: HashMap<String, usize> = files
-        .iter()
-        .enumerate()
-        .filter_map(|(i, f)| Some((trial_name(f)?, i)))
-        .collect();
+    let mut by_stem: HashMap<String, Vec<usize>> = HashMap::new();
+    for (i, f) in files.iter().enumerate() {
+        if let Some(name) = trial_name(f) {
+            by_stem.entry(name).or_default().push(i);
+        }
+    }
     let mut rows = vec![Vec::new(); files.len()];
     let mut missing = Vec::new();
     for (line, t) in &log.rows {
-        match by_stem.get(&t.trial) {
-            Some(&i) => rows[i].push((*line, t.clone())),
-            None => missing.push(format!(
+        match by_stem.get(&t.trial).map(Vec::as_slice) {
+            Some(&[i]) => rows[i].push((*line, t.clone())),
+            Some(several @ [_, _, ..]) => missing.push(format!(
+                "{}:{line}: column `trial`: `{}` names {} recordings ({}): keep one per trial in \
+                 the folder",
+                log.path.display(),
+                t.trial,
+                several.len(),
+                several
+                    .iter()
+                    .map(|&i| files[i].display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+            _ => missing.push(format!(
                 "{}:{line}: column `trial`: no recording `{}.aedat4` (or another format evtac \
                  reads; `_events_on` for the lab's pickles) in the folder of trials {}",
                 log.path.display(),
@@ -189,5 +203,24 @@ mod tests {
         let all = trial_files(dir.path(), false).unwrap();
         assert!(all.contains(&dir.path().join("t2_events_on.pickle")));
         assert_eq!(names(trial_files(dir.path(), true).unwrap()), ["t0", "t1"]);
+
+        // A trial of two recordings is refused, naming both.
+        std::fs::write(dir.path().join("t0.h5"), b"").unwrap();
+        let log_path = dir.path().join("log.csv");
+        std::fs::write(
+            &log_path,
+            "trial,direction_deg,speed_deg_s,depth_mm,total_deg,motion_start_us,motion_end_us\n\
+             t0,0,6,1.5,20,1000000,4000000\n",
+        )
+        .unwrap();
+        let log = RobotLog::read_per_trial(&log_path, 0).unwrap();
+        let files = trial_files(dir.path(), false).unwrap();
+        let Err(ImportError::Problems(p)) = split_by_file(&log, &files) else {
+            panic!("two recordings of t0 accepted");
+        };
+        assert!(
+            p[0].contains("log.csv:2") && p[0].contains("t0.h5"),
+            "{p:?}"
+        );
     }
 }
