@@ -11,6 +11,7 @@ mod outputs;
 mod progress;
 mod sensor;
 mod streams;
+mod trial_references;
 mod workers;
 
 /// mimalloc rather than glibc's malloc: chosen when training ran on burn, which allocated and

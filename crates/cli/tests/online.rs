@@ -498,3 +498,73 @@ for (name, enc, topic, menc, t), (typ, msg) in zip(times, msgs):
         assert_eq!(f[11], "0.0");
     }
 }
+
+/// `--mcap` on a replayed dataset trial: the trial's labels and truth at each estimate's time on
+/// `/contact_angle/label` and `/contact_angle/truth`, read back by the `mcap` Python package,
+/// equal (in radians) to the dataset's label and truth files at those times.
+#[test]
+fn mcap_logs_a_dataset_trial_s_labels_and_truth_beside_the_estimates() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("sim");
+    crate::common::simulate_tiny("exp1", 7, &ds, 1);
+    run_ok(&["labels", ds.to_str().unwrap()]);
+    let model = dir.path().join("model");
+    bundle(&model);
+    let (out, log) = (dir.path().join("est.csv"), dir.path().join("run.mcap"));
+    let trial = ds.join("t0000.aedat4");
+    let [m, i, o, l] = [&model, &trial, &out, &log].map(|p| p.to_str().unwrap());
+    let run = run_ok(&[
+        "online", "--model", m, "--input", i, "--output", o, "--mcap", l,
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    for name in ["label", "truth"] {
+        assert!(
+            stderr.contains(&format!(
+                "logging the trial's {name} on /contact_angle/{name}"
+            )),
+            "{stderr}"
+        );
+    }
+    let rows = rows(&std::fs::read_to_string(&out).unwrap());
+    assert!(rows.len() > 100, "{} rows", rows.len());
+    if evtac_testkit::python_with("mcap").is_none() {
+        return;
+    }
+    let script = r#"
+import sys, struct
+from mcap.reader import make_reader
+with open(sys.argv[1], 'rb') as f:
+    for s, c, m in make_reader(f).iter_messages():
+        # CDR: 4-byte encapsulation, stamp (8), frame_id (4 + len, padded to 8), then x, y, z.
+        d = m.data[4:]
+        n = struct.unpack_from('<I', d, 8)[0]
+        at = (12 + n + 7) // 8 * 8
+        x, y, z = struct.unpack_from('<3d', d, at)
+        print(c.topic, m.log_time // 1000, repr(x), repr(y))
+"#;
+    let got = evtac_testkit::run_python(script, &[l]).unwrap();
+    let labels = evtac_labels::LabelSeries::read_csv(ds.join("labels/t0000.csv")).unwrap();
+    let truth = evtac_labels::LabelSeries::read_csv(ds.join("truth/t0000.csv")).unwrap();
+    let mut counts = std::collections::HashMap::new();
+    for line in got.lines() {
+        let f: Vec<&str> = line.split(' ').collect();
+        *counts.entry(f[0].to_string()).or_insert(0usize) += 1;
+        let t: i64 = f[1].parse().unwrap();
+        let series = match f[0] {
+            "/contact_angle/label" => &labels,
+            "/contact_angle/truth" => &truth,
+            _ => continue,
+        };
+        let (pitch, roll) = series.at(t);
+        let (x, y): (f64, f64) = (f[2].parse().unwrap(), f[3].parse().unwrap());
+        assert_eq!(x.to_bits(), pitch.to_radians().to_bits(), "{line}");
+        assert_eq!(y.to_bits(), roll.to_radians().to_bits(), "{line}");
+    }
+    for topic in [
+        "/contact_angle",
+        "/contact_angle/label",
+        "/contact_angle/truth",
+    ] {
+        assert_eq!(counts.get(topic), Some(&rows.len()), "{topic}: {counts:?}");
+    }
+}

@@ -19,6 +19,9 @@
 //!   little-endian CDR);
 //! - its log time and publish time are the estimate's `t_us` in nanoseconds: the event time, as
 //!   the stamp (an MCAP time is unsigned, so an estimate before the clock's zero is an error);
+//! - with [`McapLog::add_reference`], more channels of the same type beside it
+//!   (`/contact_angle/label`, `/contact_angle/truth`: a replayed dataset trial's labels and the
+//!   simulator's truth at each estimate's time), so Foxglove plots the estimate against them;
 //! - chunks are zstd-compressed on the calling thread (no compression threads), with the
 //!   summary, chunk and message indexes readers seek with.
 //!
@@ -28,7 +31,7 @@
 //! ([`refuse_input`]).
 
 use crate::estimator::Estimate;
-use crate::ros2::{MSG_DEFINITION, MSG_TYPE, Vector3Stamped};
+use crate::ros2::{MSG_DEFINITION, MSG_TYPE, Vector3, Vector3Stamped};
 use evtac_events::output::{OutputFile, OutputIsInput, refuse_input};
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions, Writer};
@@ -86,11 +89,19 @@ pub enum Error {
     },
 }
 
+/// What else is known of the angles at a time, logged beside each estimate: `(pitch_deg,
+/// roll_deg)` at `t_us` (a replayed dataset trial's labels, or the simulator's truth).
+pub type Reference = Box<dyn Fn(i64) -> (f64, f64) + Send>;
+
 /// An MCAP log of estimates being written (see the module docs).
 pub struct McapLog {
     writer: Writer<BufWriter<OutputFile>>,
     path: PathBuf,
+    schema: u16,
+    topic: String,
     channel: u16,
+    /// The reference channels, each with its angles.
+    references: Vec<(u16, Reference)>,
     frame_id: String,
     sequence: u32,
     buf: Vec<u8>,
@@ -142,14 +153,34 @@ impl McapLog {
         Ok(Self {
             writer,
             path: path.to_owned(),
+            schema,
+            topic: topic.to_owned(),
             channel,
+            references: Vec::new(),
             frame_id: frame_id.to_owned(),
             sequence: 0,
             buf: Vec::with_capacity(128),
         })
     }
 
-    /// Appends `estimate` as a message (see the module docs).
+    /// Adds a channel `<topic>/<name>` (e.g. `/contact_angle/label`) of the same message type,
+    /// on which every estimate written from now on is accompanied by `reference`'s angles at its
+    /// time, so that a plot shows the estimate against what it estimates.
+    pub fn add_reference(&mut self, name: &str, reference: Reference) -> Result<(), Error> {
+        let topic = format!("{}/{name}", self.topic.trim_end_matches('/'));
+        let channel = self
+            .writer
+            .add_channel(self.schema, &topic, MESSAGE_ENCODING, &BTreeMap::new())
+            .map_err(|source| Error::Mcap {
+                path: self.path.clone(),
+                source,
+            })?;
+        self.references.push((channel, reference));
+        Ok(())
+    }
+
+    /// Appends `estimate` as a message (see the module docs), and each reference's angles at
+    /// its time.
     pub fn write(&mut self, estimate: &Estimate) -> Result<(), Error> {
         let time_ns = u64::try_from(estimate.t_us)
             .ok()
@@ -157,13 +188,36 @@ impl McapLog {
             .ok_or(Error::NegativeTime {
                 t_us: estimate.t_us,
             })?;
-        self.buf.clear();
-        Vector3Stamped::from_estimate(estimate, &self.frame_id)
-            .to_cdr(&mut self.buf)
-            .map_err(Error::Serialize)?;
         self.sequence = self.sequence.wrapping_add(1);
+        let message = Vector3Stamped::from_estimate(estimate, &self.frame_id);
+        self.append(self.channel, &message, time_ns)?;
+        for k in 0..self.references.len() {
+            // The reference's own precision (f64), not the estimate's f32.
+            let (pitch_deg, roll_deg) = (self.references[k].1)(estimate.t_us);
+            let reference = Vector3Stamped {
+                vector: Vector3 {
+                    x: pitch_deg.to_radians(),
+                    y: roll_deg.to_radians(),
+                    z: 0.0,
+                },
+                ..message.clone()
+            };
+            self.append(self.references[k].0, &reference, time_ns)?;
+        }
+        Ok(())
+    }
+
+    /// Appends `message` to `channel` at `time_ns`.
+    fn append(
+        &mut self,
+        channel: u16,
+        message: &Vector3Stamped,
+        time_ns: u64,
+    ) -> Result<(), Error> {
+        self.buf.clear();
+        message.to_cdr(&mut self.buf).map_err(Error::Serialize)?;
         let header = MessageHeader {
-            channel_id: self.channel,
+            channel_id: channel,
             sequence: self.sequence,
             log_time: time_ns,
             publish_time: time_ns,

@@ -106,6 +106,8 @@ pub struct Args {
     /// Also log every estimate to this MCAP file, as the `--ros2` messages
     /// (`geometry_msgs/msg/Vector3Stamped`, CDR) on the `--ros2` topic or `/contact_angle`,
     /// logged at the estimate's event time; Foxglove and rosbags open it (see docs/online.md).
+    /// Replaying a dataset's trial, the log also holds the trial's labels and truth at each
+    /// estimate's time, on `<topic>/label` and `<topic>/truth`.
     #[arg(long, value_name = "FILE")]
     pub mcap: Option<PathBuf>,
 }
@@ -259,7 +261,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 _ => Vec::new(),
             };
             let topic = args.ros2.as_deref().unwrap_or(mcap_log::DEFAULT_TOPIC);
-            Some(McapLog::create(path, &inputs, topic, args.frame_id())?)
+            let mut log = McapLog::create(path, &inputs, topic, args.frame_id())?;
+            // A replayed dataset trial: its labels and truth beside the estimates.
+            for input in &inputs {
+                for (name, reference) in crate::trial_references::references(input) {
+                    log.add_reference(name, reference)?;
+                    say(&format_args!(
+                        "logging the trial's {name} on {}/{name}",
+                        topic.trim_end_matches('/')
+                    ));
+                }
+            }
+            Some(log)
         }
         None => None,
     };
