@@ -25,6 +25,7 @@ use crate::npy::{NpyReader, NpyWriter};
 use crate::npz::{NpzError, NpzReader};
 use crate::output::OutputFile;
 use crate::range::{RangeIndex, ScanReason, within};
+use crate::ros::BagEvents;
 use crate::{Error, Event, ImuSample, Resolution, Trigger};
 
 /// The event file formats evtac knows.
@@ -274,11 +275,12 @@ enum Inner {
     Npy(Box<NpyReader<File>>),
     Hdf5(Box<Hdf5Reader>),
     Npz(Box<NpzReader<File>>),
+    Bag(Box<BagEvents>),
     Memory(Box<MemoryEvents>),
 }
 
-/// A recording read whole (NeuroTac pickles and ROS bags, which must be parsed whole), handed
-/// out in chunks like the streaming readers'.
+/// A recording read whole (NeuroTac pickles, which must be parsed whole), handed out in chunks
+/// like the streaming readers'.
 struct MemoryEvents {
     events: Vec<Event>,
     /// IMU samples, in time order.
@@ -513,10 +515,7 @@ pub fn open_with(
             let bag = crate::ros::read(path, format, selection)?;
             note = Some(bag.note);
             topics = bag.topics;
-            let mut r = MemoryEvents::new(bag.events, bag.resolution, len);
-            r.imu = bag.imu;
-            r.triggers = bag.triggers;
-            (Inner::Memory(Box::new(r)), None)
+            (Inner::Bag(Box::new(bag.events)), None)
         }
     };
     let aedat_check = EventCheck::new(resolution);
@@ -562,6 +561,7 @@ impl EventReader {
             Inner::Npy(r) => r.resolution(),
             Inner::Hdf5(r) => r.resolution(),
             Inner::Npz(r) => r.resolution(),
+            Inner::Bag(r) => r.resolution(),
             Inner::Memory(r) => r.check.resolution(),
         }
     }
@@ -610,8 +610,10 @@ impl EventReader {
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
             Inner::Npz(r) => r.set_resolution(resolution),
-            // A pickle's own size was checked above; a bag whose messages state none takes
-            // this one.
+            // A bag whose messages state a size was checked above; one that states none
+            // takes this one.
+            Inner::Bag(r) => r.set_resolution(resolution),
+            // A pickle's own size was checked above.
             Inner::Memory(r) => r.check.set_resolution(Some(resolution)),
         }
         Ok(())
@@ -635,6 +637,7 @@ impl EventReader {
                 (self.len as f64 * r.position() as f64 / r.len().max(1) as f64) as u64
             }
             Inner::Npz(r) => (self.len as f64 * r.progress()) as u64,
+            Inner::Bag(r) => (self.len as f64 * r.progress()) as u64,
             Inner::Memory(r) => {
                 if r.next > 0 {
                     r.len
@@ -881,6 +884,10 @@ fn next_unfiltered<'a>(
                     error: Box::new(error),
                 },
             }),
+        Inner::Bag(r) => r.next_chunk().map_err(|error| Error::Ros {
+            path: path.to_path_buf(),
+            error: Box::new(error),
+        }),
         Inner::Memory(r) => r.next_chunk().map_err(|error| Error::Event {
             path: path.to_path_buf(),
             error,

@@ -7,109 +7,152 @@
 //! short after its last whole message (the end magic missing) is an error, as for any
 //! truncated file.
 //!
-//! The file is read in order, not through its summary: the summary is optional (a recording
-//! that crashed has none), and every message is needed anyway. A channel's schema name is the
-//! message type (`dvs_msgs/msg/EventArray`) and its message encoding says how to decode
-//! (`cdr` from rosbag2, `ros1` from a converted ROS 1 bag).
+//! The file is streamed through the reader (its buffer holds a record or a chunk at a time), not
+//! read whole first: the messages are copied out of it anyway. It is read in order, not through
+//! its summary: the summary is optional (a recording that crashed has none), and every message
+//! is needed anyway. A channel's schema name is the message type (`dvs_msgs/msg/EventArray`)
+//! and its message encoding says how to decode (`cdr` from rosbag2, `ros1` from a converted
+//! ROS 1 bag).
 
 use std::collections::HashMap;
+use std::io::Read;
 
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::{Collector, Place, RosError};
+use crate::npy::read_full;
 
-/// Scans the MCAP file `bytes` into `c`.
-pub(crate) fn scan(bytes: &[u8], c: &mut Collector) -> Result<(), RosError> {
-    if !bytes.starts_with(super::MCAP_MAGIC) {
+/// Scans the MCAP file in `source`, `len` bytes long, into `c`.
+pub(crate) fn scan(mut source: impl Read, len: u64, c: &mut Collector) -> Result<(), RosError> {
+    let failed = |e: std::io::Error| RosError::Mcap {
+        what: format!("reading the file failed: {e}"),
+    };
+    let mut head = [0u8; 8];
+    let got = read_full(&mut source, &mut head).map_err(failed)?;
+    if !head[..got].starts_with(super::MCAP_MAGIC) {
         return Err(RosError::Container {
             offset: 0,
             what: "not an MCAP file: it does not start with the magic `\\x89MCAP0\\r\\n`".into(),
         });
     }
-    let broken = |e: mcap::McapError| RosError::Mcap {
-        what: e.to_string(),
-    };
+    let limit = record_limit(usize::try_from(len).unwrap_or(usize::MAX));
     let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default().with_record_length_limit(record_limit(bytes.len())),
+        LinearReaderOptions::default()
+            .with_record_length_limit(limit),
     );
-    let mut rest = bytes;
-    // Schema id -> name; channel id -> topic index in the collector (or the channel, until its
-    // first message).
-    let mut schemas: HashMap<u16, String> = HashMap::new();
-    let mut channels: HashMap<u16, mcap::records::Channel> = HashMap::new();
-    let mut topics: HashMap<u16, usize> = HashMap::new();
-    let mut past_data_end = false;
-    let mut ended = false;
+    // The magic, read above, goes to the reader first; then the rest of the file as it asks.
+    let mut pending: &[u8] = &head;
+    let mut left = len.saturating_sub(head.len() as u64);
+    let mut scan = Scan {
+        c,
+        schemas: HashMap::new(),
+        channels: HashMap::new(),
+        topics: HashMap::new(),
+        past_data_end: false,
+        ended: false,
+    };
     while let Some(event) = reader.next_event() {
         match event.map_err(broken)? {
             LinearReadEvent::ReadRequest(need) => {
-                let n = need.min(rest.len());
-                reader.insert(n).copy_from_slice(&rest[..n]);
-                reader.notify_read(n);
-                rest = &rest[n..];
+                // Never more than the file still holds: the reader's buffer grows by what is
+                // asked here, and a damaged length may ask for gigabytes.
+                let available = (pending.len() as u64).saturating_add(left);
+                let n = need.min(usize::try_from(available).unwrap_or(usize::MAX));
+                let buf = reader.insert(n);
+                let from_head = pending.len().min(n);
+                buf[..from_head].copy_from_slice(&pending[..from_head]);
+                pending = &pending[from_head..];
+                let read = read_full(&mut source, &mut buf[from_head..]).map_err(failed)?;
+                left = left.saturating_sub(read as u64);
+                reader.notify_read(from_head + read);
             }
-            LinearReadEvent::Record { opcode, data } => {
-                // The summary repeats schemas and channels: read on to the end magic only.
-                if past_data_end {
-                    ended |= opcode == mcap::records::op::FOOTER;
-                    continue;
-                }
-                match mcap::parse_record(opcode, data).map_err(broken)? {
-                    Record::Schema { header, .. } => {
-                        schemas.insert(header.id, header.name);
-                    }
-                    Record::Channel(channel) => {
-                        channels.insert(channel.id, channel);
-                    }
-                    Record::Message { header, data } => {
-                        let id = header.channel_id;
-                        let topic = match topics.get(&id) {
-                            Some(&topic) => topic,
-                            None => {
-                                let channel = channels.get(&id).ok_or_else(|| RosError::Mcap {
-                                    what: format!(
-                                        "message {} refers to channel {id}, which the file has \
-                                         not defined",
-                                        header.sequence
-                                    ),
-                                })?;
-                                let message_type = match channel.schema_id {
-                                    0 => "(no schema)",
-                                    sid => schemas.get(&sid).map(String::as_str).ok_or_else(
-                                        || RosError::Mcap {
-                                            what: format!(
-                                                "channel {id} ({}) refers to schema {sid}, which \
-                                                 the file has not defined",
-                                                channel.topic
-                                            ),
-                                        },
-                                    )?,
-                                };
-                                let topic = c.topic(
-                                    &channel.topic,
-                                    message_type,
-                                    &channel.message_encoding,
-                                );
-                                topics.insert(id, topic);
-                                topic
-                            }
-                        };
-                        c.message(topic, header.log_time, &data, Place::Unknown)?;
-                    }
-                    Record::DataEnd(_) => past_data_end = true,
-                    Record::Footer(_) => ended = true,
-                    _ => {}
-                }
-            }
+            LinearReadEvent::Record { opcode, data } => scan.record(opcode, data)?,
         }
     }
-    if !ended {
+    if !scan.ended {
         return Err(RosError::Mcap {
             what: "the file ends before its footer and end magic (cut short?)".into(),
         });
     }
     Ok(())
+}
+
+fn broken(e: mcap::McapError) -> RosError {
+    RosError::Mcap {
+        what: e.to_string(),
+    }
+}
+
+/// The scan's state: the schemas and channels defined so far, the topic of each channel with
+/// messages, and where in the file the scan is.
+struct Scan<'c> {
+    c: &'c mut Collector,
+    /// Schema id -> name.
+    schemas: HashMap<u16, String>,
+    /// Channel id -> channel, and -> topic index in the collector from its first message.
+    channels: HashMap<u16, mcap::records::Channel>,
+    topics: HashMap<u16, usize>,
+    past_data_end: bool,
+    ended: bool,
+}
+
+impl Scan<'_> {
+    /// Handles one record of the file, or of a chunk.
+    fn record(&mut self, opcode: u8, data: &[u8]) -> Result<(), RosError> {
+        // The summary repeats schemas and channels: read on to the end magic only.
+        if self.past_data_end {
+            self.ended |= opcode == mcap::records::op::FOOTER;
+            return Ok(());
+        }
+        match mcap::parse_record(opcode, data).map_err(broken)? {
+            Record::Schema { header, .. } => {
+                self.schemas.insert(header.id, header.name);
+            }
+            Record::Channel(channel) => {
+                self.channels.insert(channel.id, channel);
+            }
+            Record::Message { header, data } => {
+                let topic = self.topic(header.channel_id, header.sequence)?;
+                self.c
+                    .message(topic, header.log_time, &data, Place::Unknown)?;
+            }
+            Record::DataEnd(_) => self.past_data_end = true,
+            Record::Footer(_) => self.ended = true,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The collector's topic of channel `id` (added at its first message, `sequence`).
+    fn topic(&mut self, id: u16, sequence: u32) -> Result<usize, RosError> {
+        if let Some(&topic) = self.topics.get(&id) {
+            return Ok(topic);
+        }
+        let channel = self.channels.get(&id).ok_or_else(|| RosError::Mcap {
+            what: format!(
+                "message {sequence} refers to channel {id}, which the file has not defined"
+            ),
+        })?;
+        let message_type = match channel.schema_id {
+            0 => "(no schema)",
+            sid => self
+                .schemas
+                .get(&sid)
+                .map(String::as_str)
+                .ok_or_else(|| RosError::Mcap {
+                    what: format!(
+                        "channel {id} ({}) refers to schema {sid}, which the file has not defined",
+                        channel.topic
+                    ),
+                })?,
+        };
+        let topic = self
+            .c
+            .topic(&channel.topic, message_type, &channel.message_encoding);
+        self.topics.insert(id, topic);
+        Ok(topic)
+    }
 }
 
 /// The longest record accepted, in a chunk or not: sixteen times the file, at least 64 MiB, at
