@@ -1,11 +1,13 @@
 //! The MCAP container (rosbag2's default storage since ROS 2 Iron), read with Foxglove's `mcap`
-//! crate: the format's reference Rust reader, kept in step with the specification, with zstd
-//! and lz4 chunks. Its sans-io linear reader is driven here with a record length limit (see
-//! `record_limit`), which bounds every record, inside a chunk too, before any buffer is sized
-//! by it: the crate's `RawMessageStream` (0.26) sets no limit for the records of a chunk and
-//! reserved a damaged length (5 PB, found by fuzzing), which aborted the process. A file cut
-//! short after its last whole message (the end magic missing) is an error, as for any
-//! truncated file.
+//! crate: the format's reference Rust reader, kept in step with the specification. Its sans-io
+//! linear reader is driven here with a record length limit (see `record_limit`), which bounds
+//! every record before any buffer is sized by it: the crate's `RawMessageStream` (0.26) sets no
+//! limit for the records of a chunk and reserved a damaged length (5 PB, found by fuzzing),
+//! which aborted the process. The reader hands chunks over whole, and the `chunk` module
+//! decompresses them (zstd, lz4) and walks their records itself: the crate's own walk trusted a
+//! record's length inside an uncompressed chunk (an overflow panic, found by fuzzing), and it
+//! reserves a string's declared length before checking it. A file cut short after its last whole
+//! message (the end magic missing) is an error, as for any truncated file.
 //!
 //! The file is streamed through the reader (its buffer holds a record or a chunk at a time), not
 //! read whole first: the messages are copied out of it anyway. It is read in order, not through
@@ -23,6 +25,8 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use super::{Collector, Place, RosError};
 use crate::npy::read_full;
 
+mod chunk;
+
 /// Scans the MCAP file in `source`, `len` bytes long, into `c`.
 pub(crate) fn scan(mut source: impl Read, len: u64, c: &mut Collector) -> Result<(), RosError> {
     let failed = |e: std::io::Error| RosError::Mcap {
@@ -39,18 +43,21 @@ pub(crate) fn scan(mut source: impl Read, len: u64, c: &mut Collector) -> Result
     let limit = record_limit(usize::try_from(len).unwrap_or(usize::MAX));
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
-            .with_record_length_limit(limit),
+            .with_record_length_limit(limit)
+            .with_emit_chunks(true),
     );
     // The magic, read above, goes to the reader first; then the rest of the file as it asks.
     let mut pending: &[u8] = &head;
     let mut left = len.saturating_sub(head.len() as u64);
     let mut scan = Scan {
         c,
+        limit,
         schemas: HashMap::new(),
         channels: HashMap::new(),
         topics: HashMap::new(),
         past_data_end: false,
         ended: false,
+        inflated: Vec::new(),
     };
     while let Some(event) = reader.next_event() {
         match event.map_err(broken)? {
@@ -88,6 +95,8 @@ fn broken(e: mcap::McapError) -> RosError {
 /// messages, and where in the file the scan is.
 struct Scan<'c> {
     c: &'c mut Collector,
+    /// The longest record (and decompressed chunk) accepted.
+    limit: usize,
     /// Schema id -> name.
     schemas: HashMap<u16, String>,
     /// Channel id -> channel, and -> topic index in the collector from its first message.
@@ -95,6 +104,8 @@ struct Scan<'c> {
     topics: HashMap<u16, usize>,
     past_data_end: bool,
     ended: bool,
+    /// A compressed chunk's records, decompressed (reused from chunk to chunk).
+    inflated: Vec<u8>,
 }
 
 impl Scan<'_> {
@@ -105,6 +116,18 @@ impl Scan<'_> {
             self.ended |= opcode == mcap::records::op::FOOTER;
             return Ok(());
         }
+        // Only the records the scan uses are parsed: the others (indexes, attachments,
+        // metadata) hold nothing evtac reads, and the crate allocates for their strings before
+        // checking them (a 1.4 GB index string, found by fuzzing). Those parsed have their
+        // strings checked first.
+        use mcap::records::op;
+        if !matches!(
+            opcode,
+            op::SCHEMA | op::CHANNEL | op::MESSAGE | op::CHUNK | op::DATA_END | op::FOOTER
+        ) {
+            return Ok(());
+        }
+        chunk::strings_fit(opcode, data)?;
         match mcap::parse_record(opcode, data).map_err(broken)? {
             Record::Schema { header, .. } => {
                 self.schemas.insert(header.id, header.name);
@@ -116,6 +139,18 @@ impl Scan<'_> {
                 let topic = self.topic(header.channel_id, header.sequence)?;
                 self.c
                     .message(topic, header.log_time, &data, Place::Unknown)?;
+            }
+            Record::Chunk { header, data } => {
+                let mut inflated = std::mem::take(&mut self.inflated);
+                let limit = self
+                    .limit
+                    .min(usize::try_from(self.c.limit()).unwrap_or(usize::MAX));
+                let records = chunk::records(&header, &data, limit, &mut inflated);
+                let walked = records.and_then(|records| {
+                    chunk::each_record(records, |opcode, data| self.record(opcode, data))
+                });
+                self.inflated = inflated;
+                walked?;
             }
             Record::DataEnd(_) => self.past_data_end = true,
             Record::Footer(_) => self.ended = true,
