@@ -25,7 +25,7 @@
 
 mod header;
 
-pub(crate) use header::{coordinates, polarity};
+pub(crate) use header::{Scalar, coordinates, polarity};
 
 use std::fs::File;
 use std::io::{BufWriter, ErrorKind, Read, Seek, SeekFrom, Write};
@@ -149,7 +149,7 @@ impl From<std::io::Error> for NpyError {
 }
 
 /// Reads into `buf` until it is full or the source ends; returns the bytes read.
-fn read_full(source: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+pub(crate) fn read_full(source: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut filled = 0;
     while filled < buf.len() {
         match source.read(&mut buf[filled..]) {
@@ -254,43 +254,6 @@ pub(crate) fn read_header(source: &mut impl Read) -> Result<(header::Header, u64
         ))
     })?;
     Ok((header::parse(text)?, start + header_len))
-}
-
-/// Reads a whole one-dimensional array of integers or bools (one column of an NPZ archive) as
-/// `i64`s: numpy's `np.savez(f, t=t, x=x, y=y, p=p)` writes one such array per field.
-pub(crate) fn read_column(mut source: impl Read) -> Result<Vec<i64>, NpyError> {
-    let (header, data_start) = read_header(&mut source)?;
-    let scalar = header.scalar()?;
-    let declared = header.count;
-    // Grown by the bytes present, so a length the data does not back costs nothing.
-    let mut bytes = Vec::new();
-    let want = declared.saturating_mul(scalar.width as u64);
-    let got = (&mut source).take(want).read_to_end(&mut bytes)? as u64;
-    if got < want {
-        return Err(NpyError::Truncated {
-            declared,
-            complete: got / scalar.width as u64,
-            offset: data_start + got,
-        });
-    }
-    let mut probe = [0u8; 1];
-    if read_full(&mut source, &mut probe)? > 0 {
-        return Err(NpyError::TrailingData {
-            declared,
-            offset: data_start + got,
-        });
-    }
-    bytes
-        .chunks_exact(scalar.width)
-        .enumerate()
-        .map(|(i, v)| {
-            scalar.load(v).ok_or_else(|| NpyError::BadRecord {
-                index: i as u64,
-                offset: data_start + (i * scalar.width) as u64,
-                reason: "the value is larger than 2^63 - 1".into(),
-            })
-        })
-        .collect()
 }
 
 impl<R: Read> NpyReader<R> {

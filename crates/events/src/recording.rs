@@ -22,8 +22,10 @@ use crate::csv::{CsvReader, CsvWriter};
 use crate::evt::{EvtReader, EvtVersion};
 use crate::hdf5::Hdf5Reader;
 use crate::npy::{NpyReader, NpyWriter};
+use crate::npz::{NpzError, NpzReader};
 use crate::output::OutputFile;
 use crate::range::{RangeIndex, ScanReason, within};
+use crate::ros::BagEvents;
 use crate::{Error, Event, ImuSample, Resolution, Trigger};
 
 /// The event file formats evtac knows.
@@ -272,11 +274,13 @@ enum Inner {
     Csv(Box<CsvReader<BufReader<File>>>),
     Npy(Box<NpyReader<File>>),
     Hdf5(Box<Hdf5Reader>),
+    Npz(Box<NpzReader<File>>),
+    Bag(Box<BagEvents>),
     Memory(Box<MemoryEvents>),
 }
 
-/// A recording read whole (NeuroTac pickles, NPZ archives and ROS bags, which must be parsed
-/// whole), handed out in chunks like the streaming readers'.
+/// A recording read whole (NeuroTac pickles, which must be parsed whole), handed out in chunks
+/// like the streaming readers'.
 struct MemoryEvents {
     events: Vec<Event>,
     /// IMU samples, in time order.
@@ -500,22 +504,18 @@ pub fn open_with(
             (Inner::Hdf5(Box::new(r)), None)
         }
         Format::Npz => {
-            let file = crate::npz::read(path).map_err(|error| Error::Npz {
+            let r = NpzReader::from_path(path).map_err(|error| Error::Npz {
                 path: path.to_path_buf(),
                 error: Box::new(error),
             })?;
-            note = Some(file.note());
-            let r = MemoryEvents::new(file.events, None, len);
-            (Inner::Memory(Box::new(r)), None)
+            note = Some(r.note());
+            (Inner::Npz(Box::new(r)), None)
         }
         Format::RosBag | Format::Mcap => {
             let bag = crate::ros::read(path, format, selection)?;
             note = Some(bag.note);
             topics = bag.topics;
-            let mut r = MemoryEvents::new(bag.events, bag.resolution, len);
-            r.imu = bag.imu;
-            r.triggers = bag.triggers;
-            (Inner::Memory(Box::new(r)), None)
+            (Inner::Bag(Box::new(bag.events)), None)
         }
     };
     let aedat_check = EventCheck::new(resolution);
@@ -560,6 +560,8 @@ impl EventReader {
             Inner::Csv(r) => r.resolution(),
             Inner::Npy(r) => r.resolution(),
             Inner::Hdf5(r) => r.resolution(),
+            Inner::Npz(r) => r.resolution(),
+            Inner::Bag(r) => r.resolution(),
             Inner::Memory(r) => r.check.resolution(),
         }
     }
@@ -607,8 +609,11 @@ impl EventReader {
             Inner::Evt(r) => r.set_resolution(resolution),
             Inner::Csv(r) => r.set_resolution(resolution),
             Inner::Npy(r) => r.set_resolution(resolution),
-            // A pickle's own size was checked above; an NPZ, or a bag whose messages state
-            // none, takes this one.
+            Inner::Npz(r) => r.set_resolution(resolution),
+            // A bag whose messages state a size was checked above; one that states none
+            // takes this one.
+            Inner::Bag(r) => r.set_resolution(resolution),
+            // A pickle's own size was checked above.
             Inner::Memory(r) => r.check.set_resolution(Some(resolution)),
         }
         Ok(())
@@ -631,6 +636,8 @@ impl EventReader {
             Inner::Hdf5(r) => {
                 (self.len as f64 * r.position() as f64 / r.len().max(1) as f64) as u64
             }
+            Inner::Npz(r) => (self.len as f64 * r.progress()) as u64,
+            Inner::Bag(r) => (self.len as f64 * r.progress()) as u64,
             Inner::Memory(r) => {
                 if r.next > 0 {
                     r.len
@@ -858,6 +865,29 @@ fn next_unfiltered<'a>(
                 path: path.to_path_buf(),
                 error: Box::new(error),
             }),
+        Inner::Npz(r) => r
+            .next_chunk()
+            .map(|c| {
+                c.map(|events| Chunk {
+                    events,
+                    ..Chunk::default()
+                })
+            })
+            .map_err(|error| match error {
+                // A check failure reads as it does for every other format.
+                NpzError::Event(error) => Error::Event {
+                    path: path.to_path_buf(),
+                    error,
+                },
+                error => Error::Npz {
+                    path: path.to_path_buf(),
+                    error: Box::new(error),
+                },
+            }),
+        Inner::Bag(r) => r.next_chunk().map_err(|error| Error::Ros {
+            path: path.to_path_buf(),
+            error: Box::new(error),
+        }),
         Inner::Memory(r) => r.next_chunk().map_err(|error| Error::Event {
             path: path.to_path_buf(),
             error,

@@ -53,6 +53,7 @@
 mod bag1;
 mod mcap2;
 mod msg;
+mod stream;
 
 use std::collections::HashMap;
 use std::fmt;
@@ -62,9 +63,10 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::aedat::{SelectionError, StreamChoice, StreamSelection};
-use crate::check::EventCheck;
 use crate::evt::Evt3Decoder;
 use crate::{Error, Event, Format, ImuSample, Resolution, Trigger};
+pub(crate) use stream::BagEvents;
+use stream::Decoder;
 
 pub use msg::STANDARD_GRAVITY;
 
@@ -222,12 +224,22 @@ impl fmt::Display for Place {
     }
 }
 
-/// One message kept by a scan: its bytes in the topic's buffer.
+/// One message kept by a scan, and where its bytes are.
 #[derive(Debug, Clone)]
 struct Kept {
     time_ns: u64,
-    range: Range<usize>,
+    bytes: Bytes,
     place: Place,
+}
+
+/// Where a kept message's bytes are in the collector.
+#[derive(Debug, Clone)]
+enum Bytes {
+    /// In a file of the bag read whole (a ROS 1 message outside compressed chunks).
+    File(usize, Range<usize>),
+    /// Copied into a block (a message from a compressed chunk, or from the MCAP reader, whose
+    /// buffer is reused).
+    Block(usize, Range<usize>),
 }
 
 /// A topic found by a scan, with the messages kept from it.
@@ -237,7 +249,6 @@ struct Topic {
     kind: Kind,
     /// The message encoding (`ros1`, `cdr`, ...).
     encoding: String,
-    buf: Vec<u8>,
     messages: Vec<Kept>,
 }
 
@@ -253,10 +264,10 @@ impl Topic {
         }
     }
 
-    /// The kept messages in receive-time order (ties in file order).
-    fn in_order(&self) -> Vec<&Kept> {
-        let mut order: Vec<&Kept> = self.messages.iter().collect();
-        order.sort_by_key(|m| m.time_ns);
+    /// The indexes of the kept messages in receive-time order (ties in file order).
+    fn in_order(&self) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..self.messages.len()).collect();
+        order.sort_by_key(|&i| self.messages[i].time_ns);
         order
     }
 
@@ -271,6 +282,11 @@ impl Topic {
 }
 
 /// Gathers topics and messages while a container is scanned.
+///
+/// Message bytes are not gathered into one growing buffer per topic: its reallocations copied
+/// every byte again and again, and with the page faults of the fresh memory they were most of
+/// the time a bag took to read. A message inside a file read whole is kept as a range of that
+/// file; the others are copied into blocks that are filled and never moved.
 #[derive(Debug)]
 pub(crate) struct Collector {
     topics: Vec<Topic>,
@@ -280,7 +296,16 @@ pub(crate) struct Collector {
     /// Cap on the bytes kept (fuzzing), and the bytes kept so far.
     limit: u64,
     kept: u64,
+    /// The files read whole so far, and the addresses of the one being scanned (a message
+    /// whose bytes lie there is kept as a range of it).
+    files: Vec<Vec<u8>>,
+    scanning: Range<usize>,
+    /// Copied message bytes.
+    blocks: Vec<Vec<u8>>,
 }
+
+/// Bytes per block of copied messages (a longer message gets a block of its own size).
+const BLOCK: usize = 1 << 20;
 
 impl Collector {
     fn new(keep: bool, limit: u64) -> Self {
@@ -290,7 +315,55 @@ impl Collector {
             keep,
             limit,
             kept: 0,
+            files: Vec::new(),
+            scanning: 0..0,
+            blocks: Vec::new(),
         }
+    }
+
+    /// Scans `file` (read whole) with `scan`, keeping messages that lie in it as ranges of it.
+    fn scan_file(
+        &mut self,
+        file: Vec<u8>,
+        scan: impl FnOnce(&[u8], &mut Self) -> Result<(), RosError>,
+    ) -> Result<(), RosError> {
+        let start = file.as_ptr() as usize;
+        self.scanning = start..start + file.len();
+        let scanned = scan(&file, self);
+        self.scanning = 0..0;
+        self.files.push(file);
+        scanned
+    }
+
+    /// The bytes of a kept message.
+    fn bytes(&self, kept: &Kept) -> &[u8] {
+        match &kept.bytes {
+            Bytes::File(i, range) => &self.files[*i][range.clone()],
+            Bytes::Block(i, range) => &self.blocks[*i][range.clone()],
+        }
+    }
+
+    /// Keeps `data`: as a range of the file being scanned when it lies there, else copied.
+    fn keep_bytes(&mut self, data: &[u8]) -> Bytes {
+        // Addresses compared as numbers only: the range found indexes the file's own bytes.
+        let at = data.as_ptr() as usize;
+        if self.scanning.start <= at && at + data.len() <= self.scanning.end {
+            let start = at - self.scanning.start;
+            return Bytes::File(self.files.len(), start..start + data.len());
+        }
+        let fits = self
+            .blocks
+            .last()
+            .is_some_and(|b| b.capacity() - b.len() >= data.len());
+        if !fits {
+            // Sized by bytes already in memory, never by a length field.
+            self.blocks.push(Vec::with_capacity(BLOCK.max(data.len())));
+        }
+        let i = self.blocks.len() - 1;
+        let block = &mut self.blocks[i];
+        let start = block.len();
+        block.extend_from_slice(data);
+        Bytes::Block(i, start..block.len())
     }
 
     /// The index of the topic `name` of `message_type` (added on first sight).
@@ -307,7 +380,6 @@ impl Collector {
             },
             kind: Kind::of(message_type),
             encoding: encoding.to_string(),
-            buf: Vec::new(),
             messages: Vec::new(),
         });
         self.by_name.insert(key, self.topics.len() - 1);
@@ -322,18 +394,16 @@ impl Collector {
         data: &[u8],
         place: Place,
     ) -> Result<(), RosError> {
-        let t = &mut self.topics[topic];
-        t.info.messages += 1;
-        if self.keep && t.kind != Kind::Other {
+        self.topics[topic].info.messages += 1;
+        if self.keep && self.topics[topic].kind != Kind::Other {
             self.kept += data.len() as u64;
             if self.kept > self.limit {
                 return Err(RosError::TooLarge { limit: self.limit });
             }
-            let start = t.buf.len();
-            t.buf.extend_from_slice(data);
-            t.messages.push(Kept {
+            let bytes = self.keep_bytes(data);
+            self.topics[topic].messages.push(Kept {
                 time_ns,
-                range: start..t.buf.len(),
+                bytes,
                 place,
             });
         }
@@ -413,17 +483,27 @@ pub(crate) fn bag_len(path: &Path) -> Result<u64, Error> {
     Ok(len)
 }
 
-/// Scans every file of the bag at `path` into one collector.
+/// Scans every file of the bag at `path` into one collector: a ROS 1 bag read whole (its
+/// messages are kept as ranges of it), MCAP files streamed through their reader.
 fn scan(path: &Path, format: Format, keep: bool) -> Result<Collector, Error> {
     let mut c = Collector::new(keep, u64::MAX);
     for file in bag_files(path)? {
-        let bytes = std::fs::read(&file).map_err(|error| Error::Io {
+        let io = |error| Error::Io {
             path: file.clone(),
             error,
-        })?;
+        };
         let scanned = match format {
-            Format::RosBag => bag1::scan(&bytes, &mut c),
-            _ => mcap2::scan(&bytes, &mut c),
+            Format::RosBag => {
+                let bytes = std::fs::read(&file).map_err(io)?;
+                c.scan_file(bytes, bag1::scan)
+            }
+            _ => {
+                let f = std::fs::File::open(&file).map_err(io)?;
+                let len = f.metadata().map_err(io)?.len();
+                // Buffered: the reader asks for a record header, then its body, and so on.
+                let source = std::io::BufReader::with_capacity(1 << 16, f);
+                mcap2::scan(source, len, &mut c)
+            }
         };
         scanned.map_err(|error| Error::Ros {
             path: file,
@@ -586,11 +666,8 @@ fn pick(
 /// A bag read for one event topic (and its IMU topic).
 #[derive(Debug)]
 pub(crate) struct BagRecording {
-    pub events: Vec<Event>,
-    pub imu: Vec<ImuSample>,
-    pub triggers: Vec<Trigger>,
-    /// The size the event messages state (`None`: they all say 0x0).
-    pub resolution: Option<Resolution>,
+    /// The event topic, decoded as its chunks are asked for, with the IMU samples.
+    pub events: BagEvents,
     pub topics: Vec<TopicInfo>,
     /// Which topics were read, and what their times are.
     pub note: String,
@@ -612,9 +689,9 @@ pub(crate) fn read(
         path: path.to_path_buf(),
         error: Box::new(error),
     };
-    let events = decode_events(&c.topics[event_topic]).map_err(ros)?;
+    let decoder = Decoder::new(&c, event_topic).map_err(ros)?;
     let imu = match imu_topic {
-        Some(i) => decode_imu(&c.topics[i]).map_err(ros)?,
+        Some(i) => decode_imu(&c, i).map_err(ros)?,
         None => Vec::new(),
     };
     let describe = |t: &Topic| {
@@ -644,92 +721,29 @@ pub(crate) fn read(
             note += ", while IMU times are ROS header stamps";
         }
     }
-    if events.resolution.is_none() {
+    if decoder.stated().is_none() {
         note += "; the event messages state no sensor size (0x0)";
     }
+    let topics = c.infos();
     Ok(BagRecording {
-        events: events.events,
-        imu,
-        triggers: events.triggers,
-        resolution: events.resolution,
-        topics: c.infos(),
+        events: BagEvents::new(c, decoder, imu),
+        topics,
         note,
     })
 }
 
-/// An event topic decoded.
-#[derive(Debug, Default)]
-struct Decoded {
-    events: Vec<Event>,
-    triggers: Vec<Trigger>,
-    resolution: Option<Resolution>,
-}
-
-/// Decodes every message of the event topic `topic`, in receive-time order, checking each
-/// message's events (inside the sensor, time never going backwards) as it goes so that an error
-/// names the message.
-fn decode_events(topic: &Topic) -> Result<Decoded, RosError> {
-    let encoding = topic.msg_encoding()?;
-    let mut out = Decoded::default();
-    let mut first: Option<Resolution> = None;
-    let mut check = EventCheck::new(None);
-    let mut evt3 = Evt3Decoder::default();
-    for (index, m) in topic.in_order().into_iter().enumerate() {
-        let bytes = &topic.buf[m.range.clone()];
-        let fail = |what: &dyn fmt::Display| topic.message_error(index, m.place, what);
-        let start = out.events.len();
-        let size = match topic.kind {
-            Kind::EventArray => {
-                msg::event_array(bytes, encoding, &mut out.events).map_err(|e| fail(&e))?
-            }
-            _ => {
-                let packet = msg::event_packet(bytes, encoding).map_err(|e| fail(&e))?;
-                decode_packet(&packet, &mut evt3, &mut out).map_err(|what| match what {
-                    PacketError::Encoding => RosError::Encoding {
-                        topic: topic.info.name.clone(),
-                        index,
-                        place: m.place.to_string(),
-                        encoding: packet.encoding.to_string(),
-                    },
-                    PacketError::Other(what) => fail(&what),
-                })?;
-                packet.size
-            }
-        };
-        match first {
-            None => {
-                first = Some(size);
-                let stated = (size.pixels() > 0).then_some(size);
-                out.resolution = stated;
-                check.set_resolution(stated);
-            }
-            Some(first) if first != size => {
-                return Err(RosError::Resolution {
-                    topic: topic.info.name.clone(),
-                    index,
-                    found: size,
-                    first,
-                });
-            }
-            Some(_) => {}
-        }
-        check
-            .check(&out.events[start..])
-            .map_err(|e| fail(&format_args!("{e} (counting the topic's events from 0)")))?;
-    }
-    Ok(out)
-}
-
+/// Why an `EventPacket` did not decode.
 enum PacketError {
     Encoding,
     Other(String),
 }
 
-/// Decodes one `EventPacket`'s events into `out`.
+/// Decodes one `EventPacket`'s events into `events` (and the EVT3 triggers into `triggers`).
 fn decode_packet(
     p: &msg::EventPacket<'_>,
     evt3: &mut Evt3Decoder,
-    out: &mut Decoded,
+    events: &mut Vec<Event>,
+    triggers: &mut Vec<Trigger>,
 ) -> Result<(), PacketError> {
     if p.is_bigendian && matches!(p.encoding, "evt3" | "mono") {
         return Err(PacketError::Other(format!(
@@ -754,11 +768,11 @@ fn decode_packet(
     match p.encoding {
         "evt3" => {
             whole(2)?;
-            evt3.decode(p.events, &mut out.events, &mut out.triggers);
+            evt3.decode(p.events, events, triggers);
         }
         "mono" => {
             whole(8)?;
-            out.events.reserve(p.events.len() / 8);
+            events.reserve(p.events.len() / 8);
             for (i, w) in p.events.chunks_exact(8).enumerate() {
                 let word = u64::from_le_bytes(w.try_into().expect("8 bytes"));
                 let ns = u128::from(p.time_base) + u128::from(word & 0xFFFF_FFFF);
@@ -768,7 +782,7 @@ fn decode_packet(
                         p.time_base
                     ))
                 })?;
-                out.events.push(Event {
+                events.push(Event {
                     t,
                     x: (word >> 32) as u16,
                     y: ((word >> 48) & 0x7FFF) as u16,
@@ -781,17 +795,41 @@ fn decode_packet(
     Ok(())
 }
 
-/// Decodes the IMU topic `topic`: one sample per message, ordered by header stamp (stable).
-fn decode_imu(topic: &Topic) -> Result<Vec<ImuSample>, RosError> {
+/// Decodes the IMU topic `topic` of `c`: one sample per message, ordered by header stamp
+/// (stable).
+fn decode_imu(c: &Collector, topic: usize) -> Result<Vec<ImuSample>, RosError> {
+    let topic = &c.topics[topic];
     let encoding = topic.msg_encoding()?;
     let mut samples = Vec::with_capacity(topic.messages.len());
-    for (index, m) in topic.in_order().into_iter().enumerate() {
-        let sample = msg::imu(&topic.buf[m.range.clone()], encoding)
-            .map_err(|e| topic.message_error(index, m.place, e))?;
+    for (index, i) in topic.in_order().into_iter().enumerate() {
+        let m = &topic.messages[i];
+        let sample =
+            msg::imu(c.bytes(m), encoding).map_err(|e| topic.message_error(index, m.place, e))?;
         samples.push(sample);
     }
     samples.sort_by_key(|s| s.t);
     Ok(samples)
+}
+
+/// Decodes every event topic of `c` a message at a time, as a reader would: the events and
+/// triggers decoded, or 0 at the first error.
+fn decode_all(c: &Collector, topic: usize) -> usize {
+    let Ok(mut decoder) = Decoder::new(c, topic) else {
+        return 0;
+    };
+    let (mut events, mut triggers) = (Vec::new(), Vec::new());
+    let mut n = 0;
+    loop {
+        match decoder.decode_next(c, &mut events, &mut triggers) {
+            Ok(true) => {
+                n += events.len() + triggers.len();
+                events.clear();
+                triggers.clear();
+            }
+            Ok(false) => return n,
+            Err(_) => return 0,
+        }
+    }
 }
 
 /// Decodes `data` as a bag of `format` in memory: every event topic and every IMU topic, with
@@ -799,19 +837,17 @@ fn decode_imu(topic: &Topic) -> Result<Vec<ImuSample>, RosError> {
 fn fuzz(data: &[u8], format: Format) -> usize {
     let mut c = Collector::new(true, 1 << 20);
     let scanned = match format {
-        Format::RosBag => bag1::scan(data, &mut c),
-        _ => mcap2::scan(data, &mut c),
+        Format::RosBag => c.scan_file(data.to_vec(), bag1::scan),
+        _ => mcap2::scan(data, data.len() as u64, &mut c),
     };
     if scanned.is_err() {
         return 0;
     }
     let mut n = 0;
-    for topic in &c.topics {
+    for (i, topic) in c.topics.iter().enumerate() {
         n += match topic.kind {
-            Kind::EventArray | Kind::EventPacket => {
-                decode_events(topic).map_or(0, |d| d.events.len() + d.triggers.len())
-            }
-            Kind::Imu => decode_imu(topic).map_or(0, |s| s.len()),
+            Kind::EventArray | Kind::EventPacket => decode_all(&c, i),
+            Kind::Imu => decode_imu(&c, i).map_or(0, |s| s.len()),
             Kind::Other => 0,
         };
     }
@@ -843,7 +879,6 @@ mod tests {
             },
             kind: Kind::of(message_type),
             encoding: "cdr".into(),
-            buf: Vec::new(),
             messages: Vec::new(),
         }
     }

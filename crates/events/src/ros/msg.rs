@@ -281,6 +281,94 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// Decodes `n` `dvs_msgs/Event`s (little-endian) into `out` with no per-field error path,
+    /// the way nearly every message is; `false`, with `out` and the cursor untouched, when a
+    /// field is cut off or a polarity is not 0 or 1 (or the message is big-endian CDR): the
+    /// careful field-by-field loop then finds and names the problem.
+    fn events_fast(&mut self, n: usize, out: &mut Vec<Event>) -> bool {
+        if self.big_endian {
+            return false;
+        }
+        let start = out.len();
+        let end = match self.encoding {
+            Encoding::Ros1 => self.events_packed(n, out),
+            Encoding::Cdr => self.events_aligned(n, out),
+        };
+        match end {
+            Some(end) => {
+                self.pos = end;
+                true
+            }
+            None => {
+                out.truncate(start);
+                false
+            }
+        }
+    }
+
+    /// ROS 1 events: packed 13-byte records (`u16 x, u16 y, u32 sec, u32 nsec, u8 polarity`).
+    fn events_packed(&self, n: usize, out: &mut Vec<Event>) -> Option<usize> {
+        let end = self.pos.checked_add(n.checked_mul(13)?)?;
+        let records = self.bytes.get(self.pos..end)?;
+        let mut ok = true;
+        out.extend(records.chunks_exact(13).map(|r| {
+            let word = |i: usize| u32::from_le_bytes([r[i], r[i + 1], r[i + 2], r[i + 3]]);
+            ok &= r[12] <= 1;
+            Event {
+                t: i64::from(word(4)) * 1_000_000 + i64::from(word(8) / 1000),
+                x: u16::from_le_bytes([r[0], r[1]]),
+                y: u16::from_le_bytes([r[2], r[3]]),
+                polarity: r[12] == 1,
+            }
+        }));
+        ok.then_some(end)
+    }
+
+    /// CDR events: each field aligned to its size from the end of the encapsulation header
+    /// (`x` and `y` to 2, `sec` and `nanosec` to 4), so the first event's layout depends on
+    /// where it starts and the later ones are 16 bytes apart.
+    fn events_aligned(&self, n: usize, out: &mut Vec<Event>) -> Option<usize> {
+        let b = self.bytes;
+        let mut p = self.pos;
+        let mut ok = true;
+        // An event whose `x` starts at `x_at`: `sec` at the next multiple of 4 after `y`.
+        let mut event = |x_at: usize, r: &[u8]| {
+            let s = ((x_at + 4 + 3) & !3) - x_at;
+            let word = |i: usize| u32::from_le_bytes([r[i], r[i + 1], r[i + 2], r[i + 3]]);
+            let polarity = r[s + 8];
+            ok &= polarity <= 1;
+            out.push(Event {
+                // ROS 2's `Time.sec` is signed.
+                t: i64::from(word(s) as i32) * 1_000_000 + i64::from(word(s + 4) / 1000),
+                x: u16::from_le_bytes([r[0], r[1]]),
+                y: u16::from_le_bytes([r[2], r[3]]),
+                polarity: polarity == 1,
+            });
+            x_at + s + 9
+        };
+        if n == 0 {
+            return Some(p);
+        }
+        // The first event, wherever it starts.
+        let x_at = p.checked_add(1)? & !1;
+        let end = ((x_at + 4 + 3) & !3) + 9;
+        p = event(x_at, b.get(x_at..end)?);
+        // It ends one past a multiple of 4, so every later one starts 2 past a multiple of 4:
+        // `x` at 0, `y` at 2, `sec` at 6, `nanosec` at 10, `polarity` at 14 of a 16-byte
+        // stride (the last one without its byte of padding).
+        let rest = n - 1;
+        if rest > 0 {
+            let x_at = p + 1;
+            let end = x_at.checked_add(rest.checked_mul(16)? - 1)?;
+            let region = b.get(x_at..end)?;
+            for (i, r) in region.chunks(16).enumerate() {
+                event(x_at + 16 * i, r);
+            }
+            p = end;
+        }
+        ok.then_some(p)
+    }
+
     /// Checks that the message ends here. CDR messages may end in up to 7 bytes of padding
     /// (serializers pad to 4 or 8); ROS 1 messages have none.
     pub(crate) fn finish(&self) -> Result<(), MsgError> {
@@ -302,6 +390,13 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// The sensor size a `dvs_msgs/EventArray` states, its events not decoded.
+pub(crate) fn event_array_size(message: &[u8], encoding: Encoding) -> Result<Resolution, MsgError> {
+    let mut r = Reader::new(message, encoding)?;
+    r.header()?;
+    r.size()
+}
+
 /// `dvs_msgs/EventArray` (rpg_dvs_ros; ROS 2 `dvs_msgs/msg/EventArray`): appends its events to
 /// `out` and returns the sensor size the message states.
 pub(crate) fn event_array(
@@ -315,6 +410,10 @@ pub(crate) fn event_array(
     // x, y, ts (8 bytes), polarity: at least 13 bytes each.
     let n = r.length("events", 13)?;
     out.reserve(n);
+    if r.events_fast(n, out) {
+        r.finish()?;
+        return Ok(size);
+    }
     for i in 0..n {
         let x = r.u16().map_err(|s| s.named(format!("events[{i}].x")))?;
         let y = r.u16().map_err(|s| s.named(format!("events[{i}].y")))?;
@@ -423,6 +522,93 @@ mod tests {
             m.push(p);
         }
         m
+    }
+
+    /// A CDR `dvs_msgs/msg/EventArray` with `frame_id` and `events` as (x, y, sec, nanosec,
+    /// polarity), each field aligned to its size from the end of the encapsulation header.
+    fn cdr_array(frame_id: &str, events: &[(u16, u16, i32, u32, u8)]) -> Vec<u8> {
+        let mut b = Vec::new();
+        let align = |b: &mut Vec<u8>, n: usize| b.resize(b.len().div_ceil(n) * n, 0);
+        b.extend([0u8; 8]); // stamp
+        b.extend((frame_id.len() as u32 + 1).to_le_bytes());
+        b.extend(frame_id.as_bytes());
+        b.push(0);
+        for v in [480u32, 640, events.len() as u32] {
+            align(&mut b, 4);
+            b.extend(v.to_le_bytes());
+        }
+        for &(x, y, sec, ns, p) in events {
+            align(&mut b, 2);
+            b.extend(x.to_le_bytes());
+            b.extend(y.to_le_bytes());
+            align(&mut b, 4);
+            b.extend(sec.to_le_bytes());
+            b.extend(ns.to_le_bytes());
+            b.push(p);
+        }
+        [vec![0, 1, 0, 0], b].concat()
+    }
+
+    /// The fast paths (packed ROS 1 records; CDR's first event, then a 16-byte stride) against
+    /// the events written, for every alignment the frame id's length gives the first event,
+    /// and a bad polarity still named by the careful loop.
+    #[test]
+    fn event_arrays_decode_alike_at_every_alignment() {
+        let all = [
+            (1u16, 2u16, 3i32, 999_999_999u32, 1u8),
+            (639, 479, -1, 1999, 0),
+            (7, 8, 1_600_000_000, 5_000, 1),
+            (0, 0, 0, 0, 0),
+        ];
+        let want = |events: &[(u16, u16, i32, u32, u8)]| -> Vec<Event> {
+            events
+                .iter()
+                .map(|&(x, y, s, ns, p)| Event {
+                    t: i64::from(s) * 1_000_000 + i64::from(ns / 1000),
+                    x,
+                    y,
+                    polarity: p == 1,
+                })
+                .collect()
+        };
+        for n in 0..=all.len() {
+            let events = &all[..n];
+            for frame in ["", "a", "ab", "abc", "abcd", "cam_0"] {
+                let mut out = Vec::new();
+                event_array(&cdr_array(frame, events), Encoding::Cdr, &mut out).unwrap();
+                assert_eq!(out, want(events), "CDR, frame {frame:?}, {n} events");
+            }
+            // ROS 1's `time.sec` is unsigned: -1 reads as 4294967295 s.
+            let ros1: Vec<_> = events
+                .iter()
+                .map(|&(x, y, s, ns, p)| (x, y, s as u32, ns, p))
+                .collect();
+            let mut out = Vec::new();
+            event_array(&ros1_array(&ros1), Encoding::Ros1, &mut out).unwrap();
+            let unsigned: Vec<Event> = ros1
+                .iter()
+                .map(|&(x, y, s, ns, p)| Event {
+                    t: i64::from(s) * 1_000_000 + i64::from(ns / 1000),
+                    x,
+                    y,
+                    polarity: p == 1,
+                })
+                .collect();
+            assert_eq!(out, unsigned, "ROS 1, {n} events");
+        }
+        let mut bad = all;
+        bad[2].4 = 2;
+        for (m, encoding) in [
+            (cdr_array("ab", &bad), Encoding::Cdr),
+            (
+                ros1_array(&bad.map(|(x, y, s, ns, p)| (x, y, s as u32, ns, p))),
+                Encoding::Ros1,
+            ),
+        ] {
+            let mut out = Vec::new();
+            let err = event_array(&m, encoding, &mut out).unwrap_err();
+            assert_eq!(err.field, "events[2].polarity", "{encoding:?}: {err}");
+        }
     }
 
     #[test]

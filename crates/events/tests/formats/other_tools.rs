@@ -46,6 +46,10 @@ ours["t"], ours["x"], ours["y"], ours["p"] = t, x, y, p
 np.savez(os.path.join(d, "record.npz"), events=ours)
 np.savez_compressed(os.path.join(d, "columns.npz"), timestamp=t.astype(np.int64),
                     x=x.astype(np.uint16), y=y.astype(np.uint16), polarity=p.astype(bool))
+# One array per field, stored (uncompressed), as `np.savez` writes it: the members are read
+# straight from the file.
+np.savez(os.path.join(d, "columns_stored.npz"), t=t.astype(np.int64), x=x.astype(np.uint16),
+         y=y.astype(np.uint16), p=p.astype(np.uint8))
 # CSV: without a header line, and with DV's column names in another order.
 np.savetxt(os.path.join(d, "headerless.csv"), np.stack([t, x, y, p], 1), fmt="%d", delimiter=",")
 np.savetxt(os.path.join(d, "named.csv"), np.stack([x, y, p, t], 1), fmt="%d", delimiter=",",
@@ -68,6 +72,7 @@ fn every_layout_reads_the_same_events() {
         ("int8_minus_one.npy", Format::Npy),
         ("record.npz", Format::Npz),
         ("columns.npz", Format::Npz),
+        ("columns_stored.npz", Format::Npz),
         ("headerless.csv", Format::Csv),
         ("named.csv", Format::Csv),
     ];
@@ -121,4 +126,38 @@ fn what_is_not_events_is_named() {
     assert!(err.contains("NPZ"), "{err}");
     std::fs::copy(dir.path().join("record.npz"), dir.path().join("record.zip")).unwrap();
     assert!(read_recording(dir.path().join("record.zip")).is_err());
+}
+
+/// The per-field members are read from their own offsets, not through the zip crate's reader,
+/// which checked each member's CRC-32: a damaged byte in a stored member's values must still
+/// fail the read, naming the member, and so must a member cut short.
+#[test]
+fn a_damaged_stored_member_fails_its_checksum() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(_) = run_python(WRITE, &[dir.path().to_str().unwrap()]) else {
+        return;
+    };
+    let bytes = std::fs::read(dir.path().join("columns_stored.npz")).unwrap();
+    // The local header of `x.npy`: 30 fixed bytes (the name's length at 26, the extra field's
+    // at 28), the name, the extra field, then the stored NPY file.
+    let local = bytes
+        .windows(35)
+        .position(|w| w.starts_with(b"PK\x03\x04") && &w[30..] == b"x.npy")
+        .expect("x.npy's local header");
+    let le16 = |at: usize| usize::from(u16::from_le_bytes([bytes[at], bytes[at + 1]]));
+    let data = local + 30 + le16(local + 26) + le16(local + 28);
+    assert_eq!(&bytes[data..data + 6], b"\x93NUMPY");
+    let mut damaged = bytes.clone();
+    damaged[data + 200] ^= 0x01;
+    let path = dir.path().join("damaged.npz");
+    std::fs::write(&path, &damaged).unwrap();
+    let err = read_recording(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("damaged.npz") && err.contains("member `x.npy`") && err.contains("CRC-32"),
+        "{err}"
+    );
+    // Cut inside `x.npy`'s values: the central directory is gone, so the zip crate refuses it.
+    let cut = dir.path().join("cut.npz");
+    std::fs::write(&cut, &bytes[..data + 300]).unwrap();
+    assert!(read_recording(&cut).is_err());
 }

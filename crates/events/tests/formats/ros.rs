@@ -375,7 +375,9 @@ fn the_fuzz_entry_points_decode_whole_bags() {
 /// Found by the `mcap` fuzz target: a record inside a chunk declaring 5 PB made the `mcap`
 /// crate's message stream reserve it (the process aborted on the failed allocation); a schema
 /// name declaring 2 GiB is reserved by the crate before it is checked. Both are errors naming
-/// the file, and the first allocates no more than the file backs.
+/// the file, and the first allocates no more than the file backs. (Since evtac opens chunks
+/// itself, the damaged lz4 chunk around the 5 PB record is refused before its records are read:
+/// its frame holds fewer bytes than its header declares.)
 #[test]
 fn damaged_mcap_lengths_are_errors_not_aborts() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/formats/regressions");
@@ -384,7 +386,7 @@ fn damaged_mcap_lengths_are_errors_not_aborts() {
         crate::alloc::largest_allocation_during(|| evtac_events::read_recording(&huge));
     let err = result.unwrap_err().to_string();
     assert!(
-        err.contains("mcap-record-of-5-petabytes.mcap") && err.contains("exceeds limit"),
+        err.contains("mcap-record-of-5-petabytes.mcap") && err.contains("broken MCAP container"),
         "{err}"
     );
     assert!(largest < 64 << 20, "allocated {largest} bytes");
@@ -393,4 +395,58 @@ fn damaged_mcap_lengths_are_errors_not_aborts() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("mcap-string-of-2-gibibytes.mcap"), "{err}");
+}
+
+/// Found by the `mcap` fuzz target on November 27 (an input of its committed corpus, once
+/// allocations above 512 MB counted as crashes): a channel record of a few bytes whose
+/// metadata map holds a string declaring 4 GiB, which the `mcap` crate reserved before reading
+/// it. Every string of a record is now checked against the record before the crate parses it.
+#[test]
+fn a_channel_string_longer_than_its_record_is_an_error_not_a_reservation() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/formats/regressions/mcap-channel-metadata-string-of-4-gibibytes.mcap");
+    let (result, largest) =
+        crate::alloc::largest_allocation_during(|| evtac_events::read_recording(&path));
+    let err = result.unwrap_err().to_string();
+    assert!(
+        err.contains("mcap-channel-metadata-string-of-4-gibibytes.mcap")
+            && err.contains("holds a string longer than the record"),
+        "{err}"
+    );
+    assert!(largest < 64 << 20, "allocated {largest} bytes");
+}
+
+/// Found by the `mcap` fuzz target on November 27, after the fix above: a record the scan has
+/// no use for (an index or attachment record before the data end) with a string declaring
+/// 1.4 GB, reserved by the `mcap` crate as it parsed the record. Only the records the scan uses
+/// are parsed now; the file reads or fails without the reservation.
+#[test]
+fn a_string_in_a_record_evtac_does_not_use_is_not_reserved() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/formats/regressions/mcap-index-string-of-1-gibibyte.mcap");
+    let (_, largest) =
+        crate::alloc::largest_allocation_during(|| evtac_events::read_recording(&path));
+    assert!(largest < 64 << 20, "allocated {largest} bytes");
+    let bytes = std::fs::read(&path).unwrap();
+    let (_, largest) =
+        crate::alloc::largest_allocation_during(|| evtac_events::ros::fuzz_decode_mcap(&bytes));
+    assert!(largest < 64 << 20, "allocated {largest} bytes");
+}
+
+/// Found by the `mcap` fuzz target on November 27: a record inside an uncompressed chunk whose
+/// length reaches past the chunk made the `mcap` crate's linear reader subtract past zero (an
+/// overflow panic where overflow is checked; elsewhere a wrapped count, and records read from
+/// outside the chunk). evtac now walks a chunk's records itself, every length checked.
+#[test]
+fn a_record_reaching_past_its_chunk_is_an_error_not_a_panic() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/formats/regressions/mcap-chunk-record-past-its-chunk.mcap");
+    let err = evtac_events::read_recording(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("mcap-chunk-record-past-its-chunk.mcap")
+            && err.contains("past the chunk's end"),
+        "{err}"
+    );
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(evtac_events::ros::fuzz_decode_mcap(&bytes), 0);
 }
