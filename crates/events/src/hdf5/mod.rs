@@ -16,21 +16,34 @@
 //! larger value is taken as the width (every event camera evtac knows is wider than tall) and
 //! the note says so. A sensor size declared by the user must be the same two numbers.
 //!
-//! The HDF5 library itself is the HDF Group's (`libhdf5`, through the `hdf5-metno` bindings):
-//! the format's B-trees, chunking and filters are too large to rewrite. Data is read in slices of
-//! 65,536 events, so memory holds a slice whatever size a dataset claims; attributes are read
-//! only when they hold a handful of values.
+//! The file is read by `hdf5-pure`, a Rust implementation of the format (no C library): the
+//! HDF Group's libhdf5, which evtac used before, overflowed a heap buffer (SIGSEGV) and tried to
+//! allocate 3.4 PB on damaged files our fuzzing found, and a C library's crash is no error a
+//! user can read. `hdf5-pure` was chosen over the other Rust readers because it reads every
+//! layout h5py writes for these files (contiguous and chunked, gzip and shuffle, the bool enum,
+//! superblocks 0 to 3, HDF5 1.8 to 1.14 formats), reads a window of rows without reading the
+//! rest, parses with no `unsafe`, and is fuzzed and released often; `hdf5-reader` also reads
+//! HDF5 2.0's new chunk layout (version 5) but copies chunks with `unsafe` pointer arithmetic.
+//! Files in HDF5 2.0's format (h5py built on HDF5 2.0 with `libver="latest"`) are refused with
+//! the layout version named, as libhdf5 1.10 refused them.
+//!
+//! Data is read in slices of 65,536 events, so memory holds a slice whatever size a dataset
+//! claims; before reading, each event dataset must be one-dimensional with elements of at most 8
+//! bytes and every chunk inside the file (see `column.rs` for why), and attributes are read only
+//! when they hold a handful of values.
 
-use std::ops::Range;
+mod column;
+
+use std::io::Cursor;
 use std::path::Path;
 
-use hdf5_metno::types::{IntSize, TypeDescriptor};
-use hdf5_metno::{Dataset, File, Group, Location};
+use hdf5_pure::{AttrValue, File, Group, ReadSeekSource};
 
 use crate::check::{CheckError, EventCheck};
 use crate::columns::{Field, Slots};
-use crate::npy::{coordinates, polarity};
+use crate::npy::polarity;
 use crate::{Event, RangeIndex, Resolution};
+use column::Column;
 
 /// Events read per slice.
 const CHUNK: usize = 1 << 16;
@@ -41,12 +54,12 @@ const SMALL_ATTRIBUTE: usize = 16;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Hdf5Error {
-    /// The HDF5 library could not open or read an object.
+    /// The HDF5 reader could not open or read an object (a damaged or unsupported file).
     #[error("{object}: {message}")]
     Library {
         /// The object (file, dataset or attribute path).
         object: String,
-        /// The library's message.
+        /// The reader's message.
         message: String,
     },
     /// No group holds the four event datasets.
@@ -103,160 +116,62 @@ pub enum Hdf5Error {
     },
 }
 
-/// How a dataset's elements are read.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    /// Integers that fit `i64`, read in their own type and widened here (HDF5's own
-    /// conversion is several times slower than a widening loop).
-    Int(IntSize, bool),
-    /// Unsigned 64-bit integers, checked against `i64::MAX` here (HDF5 would clip them).
-    U64,
-    /// Float seconds (timestamps only).
-    Seconds,
-    /// HDF5's bool enum, as h5py writes numpy's bool.
-    Bool,
-}
-
-/// One event field's dataset.
-#[derive(Debug)]
-struct Column {
-    path: String,
-    dataset: Dataset,
-    kind: Kind,
-}
-
-impl Column {
-    fn new(group: &Group, prefix: &str, name: &str, field: Field) -> Result<Self, Hdf5Error> {
-        let path = format!("{prefix}{name}");
-        let dataset = group.dataset(name).map_err(library(&path))?;
-        let descriptor = dataset
-            .dtype()
-            .and_then(|t| t.to_descriptor())
-            .map_err(library(&path))?;
-        let kind = match (&descriptor, field) {
-            (TypeDescriptor::Unsigned(IntSize::U8), _) => Kind::U64,
-            (TypeDescriptor::Integer(size), _) => Kind::Int(*size, true),
-            (TypeDescriptor::Unsigned(size), _) => Kind::Int(*size, false),
-            (TypeDescriptor::Boolean, _) => Kind::Bool,
-            (TypeDescriptor::Float(_), Field::T) => Kind::Seconds,
-            (found, _) => {
-                return Err(Hdf5Error::Type {
-                    dataset: path,
-                    found: format!("{found:?}"),
-                    expected: if field == Field::T {
-                        "times are integer microseconds or float seconds"
-                    } else {
-                        "pixels and polarities are integers (or bool)"
-                    },
-                });
-            }
-        };
-        Ok(Self {
-            path,
-            dataset,
-            kind,
-        })
-    }
-
-    /// The elements `range` as integers (microseconds for times in seconds).
-    fn read(&self, range: Range<usize>) -> Result<Vec<i64>, Hdf5Error> {
-        let start = range.start;
-        let lib = library(&self.path);
-        let value_error = |i: usize, reason: String| Hdf5Error::Value {
-            dataset: self.path.clone(),
-            index: start + i,
-            reason,
-        };
-        match self.kind {
-            Kind::Int(size, signed) => {
-                let d = &self.dataset;
-                macro_rules! widened {
-                    ($t:ty) => {
-                        d.read_slice_1d::<$t, _>(range)
-                            .map_err(lib)?
-                            .iter()
-                            .map(|&v| i64::from(v))
-                            .collect()
-                    };
-                }
-                Ok(match (size, signed) {
-                    (IntSize::U1, true) => widened!(i8),
-                    (IntSize::U2, true) => widened!(i16),
-                    (IntSize::U4, true) => widened!(i32),
-                    (IntSize::U8, true) => widened!(i64),
-                    (IntSize::U1, false) => widened!(u8),
-                    (IntSize::U2, false) => widened!(u16),
-                    // Unsigned 64-bit integers are `Kind::U64`.
-                    (_, false) => widened!(u32),
-                })
-            }
-            Kind::U64 => self
-                .dataset
-                .read_slice_1d::<u64, _>(range)
-                .map_err(lib)?
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| {
-                    i64::try_from(v).map_err(|_| value_error(i, format!("{v} is above 2^63 - 1")))
-                })
-                .collect(),
-            Kind::Bool => Ok(self
-                .dataset
-                .read_slice_1d::<bool, _>(range)
-                .map_err(lib)?
-                .iter()
-                .map(|&b| i64::from(b))
-                .collect()),
-            Kind::Seconds => self
-                .dataset
-                .read_slice_1d::<f64, _>(range)
-                .map_err(lib)?
-                .iter()
-                .enumerate()
-                .map(|(i, &s)| {
-                    let us = s * 1e6;
-                    // i64::MAX as f64 rounds up to 2^63, so `<` keeps the cast in range.
-                    if us.is_finite() && us > i64::MIN as f64 && us < i64::MAX as f64 - 1.0 {
-                        // Rounded half away from zero by a truncating cast (`f64::round` is a
-                        // library call here, a fifth of the read's time).
-                        Ok((us + 0.5f64.copysign(us)) as i64)
-                    } else {
-                        Err(value_error(
-                            i,
-                            format!("{s} s is not a time in microseconds"),
-                        ))
-                    }
-                })
-                .collect(),
-        }
-    }
-}
-
-/// The error of a library call on `object`.
-fn library(object: &str) -> impl Fn(hdf5_metno::Error) -> Hdf5Error + '_ {
+/// The error of a reader call on `object`.
+fn library(object: &str) -> impl Fn(hdf5_pure::Error) -> Hdf5Error + '_ {
     move |e| Hdf5Error::Library {
         object: object.to_string(),
         message: e.to_string(),
     }
 }
 
-/// A small numeric attribute of `location`, if it has one named `name`.
-fn small_attribute(location: &Location, name: &str) -> Result<Option<Vec<f64>>, Hdf5Error> {
-    if !location
-        .attr_names()
-        .is_ok_and(|n| n.iter().any(|a| a == name))
-    {
-        return Ok(None);
+/// The numbers an attribute holds, or `None` for a text or compound one.
+fn numbers(value: &AttrValue) -> Option<Vec<f64>> {
+    if let Some(floats) = value.to_f64s() {
+        return Some(floats);
     }
-    let attr = location.attr(name).map_err(library(name))?;
-    let size = attr.size();
-    if size > SMALL_ATTRIBUTE {
+    macro_rules! widen {
+        ($($one:ident, $many:ident);*) => {
+            match value {
+                $(AttrValue::$one(v) => vec![*v as f64],
+                  AttrValue::$many(v) => v.iter().map(|&v| v as f64).collect(),)*
+                _ => return None,
+            }
+        };
+    }
+    Some(
+        widen!(I8, I8Array; I16, I16Array; I32, I32Array; I64, I64Array; U8, U8Array;
+        U16, U16Array; U32, U32Array; U64, U64Array),
+    )
+}
+
+/// A small numeric attribute of `group` (`at` names it in errors), if it has one named `name`.
+fn small_attribute(group: &Group, at: &str, name: &str) -> Result<Option<Vec<f64>>, Hdf5Error> {
+    let object = format!("{at}{name}");
+    let attrs = group.attrs().map_err(library(&object))?;
+    let Some(value) = attrs.get(name) else {
+        return Ok(None);
+    };
+    let values = numbers(value).ok_or_else(|| Hdf5Error::Metadata {
+        object: object.clone(),
+        reason: format!("is {}, not numbers", value.type_name()),
+    })?;
+    if values.len() > SMALL_ATTRIBUTE {
         return Err(Hdf5Error::Metadata {
-            object: name.to_string(),
-            reason: format!("holds {size} values; expected at most {SMALL_ATTRIBUTE}"),
+            object,
+            reason: format!(
+                "holds {} values; expected at most {SMALL_ATTRIBUTE}",
+                values.len()
+            ),
         });
     }
-    attr.read_raw::<f64>().map(Some).map_err(library(name))
+    Ok(Some(values))
+}
+
+/// The names of a group's datasets and groups.
+fn members(group: &Group) -> Vec<String> {
+    let mut names = group.datasets().unwrap_or_default();
+    names.extend(group.groups().unwrap_or_default());
+    names
 }
 
 /// A streaming reader of HDF5 event files (see the module docs).
@@ -267,7 +182,7 @@ pub struct Hdf5Reader {
     /// Added to integer times (DSEC's `t_offset`).
     t_offset: i64,
     /// DSEC's millisecond index, when the file has one.
-    ms_to_idx: Option<Dataset>,
+    ms_to_idx: Option<Column>,
     len: usize,
     next: usize,
     end: usize,
@@ -277,21 +192,32 @@ pub struct Hdf5Reader {
     /// The element the check's count starts at (where a range read starts).
     checked_from: usize,
     events: Vec<Event>,
-    /// Keeps the file open while its datasets are read.
-    _file: File,
 }
 
 impl Hdf5Reader {
     /// Opens the file at `path` and finds its event datasets.
     pub fn open(path: impl AsRef<Path>) -> Result<Self, Hdf5Error> {
-        let path = path.as_ref();
-        // The caller names the path; the library's message says what failed.
-        let file = File::open(path).map_err(library("the file"))?;
+        // Streaming: metadata and the chunks a slice needs are read on demand, not the file.
+        // The caller names the path; the reader's message says what failed.
+        Self::from_file(File::open_streaming(path.as_ref()).map_err(library("the file"))?)
+    }
+
+    /// Reads an HDF5 event file held in memory.
+    pub fn from_bytes(bytes: Vec<u8>) -> Result<Self, Hdf5Error> {
+        let source = ReadSeekSource::new(Cursor::new(bytes)).map_err(|e| Hdf5Error::Library {
+            object: "the file".into(),
+            message: e.to_string(),
+        })?;
+        Self::from_file(File::from_source(source).map_err(library("the file"))?)
+    }
+
+    fn from_file(file: File) -> Result<Self, Hdf5Error> {
+        let root = file.root();
         let (group, prefix) = match file.group("events") {
             Ok(g) => (g, "events/"),
-            Err(_) => ((*file).clone(), ""),
+            Err(_) => (file.root(), ""),
         };
-        let names = group.member_names().map_err(library(prefix))?;
+        let names = group.datasets().map_err(library(prefix))?;
         let mut slots = Slots::default();
         for name in &names {
             if let Some(field) = Field::of(name) {
@@ -304,31 +230,37 @@ impl Hdf5Reader {
             }
         }
         let found = || {
-            let root = file.member_names().unwrap_or_default();
-            format!("root {root:?}, `{prefix}` {names:?}")
+            format!(
+                "root {:?}, `{prefix}` {:?}",
+                members(&root),
+                members(&group)
+            )
         };
         let [t, x, y, p] = slots
             .complete()
             .map_err(|_| Hdf5Error::NoEvents { found: found() })?;
+        let file_len = file.file_size();
+        let column = |name: &str, field| {
+            let path = format!("{prefix}{name}");
+            let dataset = group.dataset(name).map_err(library(&path))?;
+            Column::new(path, dataset, field, file_len)
+        };
         let columns = [
-            Column::new(&group, prefix, t, Field::T)?,
-            Column::new(&group, prefix, x, Field::X)?,
-            Column::new(&group, prefix, y, Field::Y)?,
-            Column::new(&group, prefix, p, Field::P)?,
+            column(t, Field::T)?,
+            column(x, Field::X)?,
+            column(y, Field::Y)?,
+            column(p, Field::P)?,
         ];
-        let shapes: Vec<Vec<usize>> = columns.iter().map(|c| c.dataset.shape()).collect();
-        let len = shapes[0].first().copied().unwrap_or(0);
-        if shapes.iter().any(|s| s.as_slice() != [len]) {
+        let len = columns[0].len;
+        if columns.iter().any(|c| c.len != len || c.scalar) {
             let shapes = columns
                 .iter()
-                .zip(&shapes)
-                .map(|(c, s)| format!("{} {s:?}", c.path))
+                .map(|c| c.shape())
                 .collect::<Vec<_>>()
                 .join(", ");
             return Err(Hdf5Error::Shapes { shapes });
         }
-        let root: &Location = &file;
-        if let Some(n) = small_attribute(root, "num_events")?
+        if let Some(n) = small_attribute(&root, "", "num_events")?
             && n.first().is_none_or(|&n| n != len as f64)
         {
             return Err(Hdf5Error::Metadata {
@@ -339,23 +271,40 @@ impl Hdf5Reader {
             });
         }
         // On the file (event_utils, the NeuroTac code), else on the `events` group.
-        let sizes = match small_attribute(root, "sensor_resolution")? {
+        let sizes = match small_attribute(&root, "", "sensor_resolution")? {
             Some(v) => Some(v),
-            None => small_attribute(&group, "sensor_resolution")?,
+            None => small_attribute(&group, prefix, "sensor_resolution")?,
         };
         let stated = sizes.as_deref().map(two_sizes).transpose()?;
-        let t_offset = if columns[0].kind != Kind::Seconds && file.link_exists("t_offset") {
-            file.dataset("t_offset")
-                .and_then(|d| d.read_scalar::<i64>())
-                .map_err(library("t_offset"))?
-        } else {
-            0
+        let at_root = root.datasets().map_err(library("the file's root"))?;
+        let root_column = |name: &str| -> Result<Option<Column>, Hdf5Error> {
+            if !at_root.iter().any(|n| n == name) {
+                return Ok(None);
+            }
+            let dataset = file.dataset(name).map_err(library(name))?;
+            Column::new(name.to_string(), dataset, Field::T, file_len).map(Some)
         };
-        let ms_to_idx = if file.link_exists("ms_to_idx") {
-            Some(file.dataset("ms_to_idx").map_err(library("ms_to_idx"))?)
-        } else {
-            None
+        let t_offset = match root_column("t_offset")? {
+            Some(c) if !columns[0].seconds() => {
+                if c.len == 0 || c.seconds() {
+                    return Err(Hdf5Error::Metadata {
+                        object: "t_offset".into(),
+                        reason: "is not an integer of microseconds".into(),
+                    });
+                }
+                c.get(0)?
+            }
+            _ => 0,
         };
+        let ms_to_idx = root_column("ms_to_idx")?;
+        if let Some(index) = &ms_to_idx
+            && (index.seconds() || index.scalar)
+        {
+            return Err(Hdf5Error::Metadata {
+                object: "ms_to_idx".into(),
+                reason: "holds floats, not event indices".into(),
+            });
+        }
         let resolution = stated.map(|[a, b]| Resolution::new(a.max(b), a.min(b)));
         Ok(Self {
             columns,
@@ -368,10 +317,8 @@ impl Hdf5Reader {
             check: EventCheck::new(resolution),
             checked_from: 0,
             events: Vec::new(),
-            _file: file,
         })
     }
-
     /// Number of events in the file.
     pub fn len(&self) -> usize {
         self.len
@@ -406,7 +353,7 @@ impl Hdf5Reader {
     /// sensor size was read.
     pub fn note(&self) -> String {
         let [t, x, y, p] = self.columns.each_ref().map(|c| c.path.as_str());
-        let unit = if self.columns[0].kind == Kind::Seconds {
+        let unit = if self.columns[0].seconds() {
             "float seconds, rounded to microseconds".to_string()
         } else if self.t_offset != 0 {
             format!("microseconds after t_offset = {} us", self.t_offset)
@@ -442,21 +389,17 @@ impl Hdf5Reader {
         let Some(index) = &self.ms_to_idx else {
             return Ok(None);
         };
-        let path = "ms_to_idx";
         let bad = |reason: String| Hdf5Error::Metadata {
-            object: path.into(),
+            object: "ms_to_idx".into(),
             reason,
         };
-        let ms = index.shape().first().copied().unwrap_or(0);
+        let ms = index.len;
         if ms == 0 {
             return Err(bad("is empty".into()));
         }
         // ms_to_idx[k] is the first event with t >= k ms (after t_offset).
         let entry = |k: usize| -> Result<usize, Hdf5Error> {
-            let v = index
-                .read_slice_1d::<u64, _>(k..k + 1)
-                .map_err(library(path))?;
-            let v = usize::try_from(v[0]).unwrap_or(usize::MAX);
+            let v = usize::try_from(index.get(k)?).unwrap_or(usize::MAX);
             if v > self.len {
                 return Err(bad(format!(
                     "entry {k} is {v}, past the {} events",
@@ -484,7 +427,7 @@ impl Hdf5Reader {
         let end = end.max(start);
         // A wrong index would silently drop events: check it against the times at both edges.
         let t_at = |i: usize| -> Result<i64, Hdf5Error> {
-            Ok(self.columns[0].read(i..i + 1)?[0].saturating_add(self.t_offset))
+            Ok(self.columns[0].get(i)?.saturating_add(self.t_offset))
         };
         if start > 0 && t_at(start - 1)? >= from {
             return Err(bad(format!(
@@ -513,28 +456,31 @@ impl Hdf5Reader {
         if self.next >= self.end {
             return Ok(None);
         }
-        let range = self.next..(self.next + CHUNK).min(self.end);
-        let [t, x, y, p] = [0, 1, 2, 3].map(|i| self.columns[i].read(range.clone()));
-        let (t, x, y, p) = (t?, x?, y?, p?);
+        let start = self.next;
+        let n = CHUNK.min(self.end - start);
+        // Each field decoded straight into the reused events, one pass per dataset.
         self.events.clear();
-        let value = |column: usize, i: usize, reason: String| Hdf5Error::Value {
-            dataset: self.columns[column].path.clone(),
-            index: range.start + i,
-            reason,
-        };
-        for i in 0..range.len() {
-            let (ex, ey) = coordinates(Some(x[i]), Some(y[i])).map_err(|r| value(1, i, r))?;
-            let t = t[i]
-                .checked_add(self.t_offset)
-                .ok_or_else(|| value(0, i, format!("{} + t_offset overflows", t[i])))?;
-            let polarity = polarity(Some(p[i])).map_err(|r| value(3, i, r))?;
-            self.events.push(Event {
-                t,
-                x: ex,
-                y: ey,
-                polarity,
-            });
-        }
+        self.events.resize(n, Event::default());
+        let [t, x, y, p] = &self.columns;
+        let t_offset = self.t_offset;
+        t.times(start, &mut self.events, |e, t| {
+            e.t = t
+                .checked_add(t_offset)
+                .ok_or_else(|| format!("{t} + t_offset overflows"))?;
+            Ok(())
+        })?;
+        x.ints(start, &mut self.events, |e, x| {
+            e.x = pixel("x", x)?;
+            Ok(())
+        })?;
+        y.ints(start, &mut self.events, |e, y| {
+            e.y = pixel("y", y)?;
+            Ok(())
+        })?;
+        p.ints(start, &mut self.events, |e, p| {
+            e.polarity = polarity(Some(p))?;
+            Ok(())
+        })?;
         let base = self.checked_from as u64;
         self.check
             .check(&self.events)
@@ -542,9 +488,20 @@ impl Hdf5Reader {
                 index: base + error.index(),
                 error,
             })?;
-        self.next = range.end;
+        self.next = start + n;
         Ok(Some(&self.events))
     }
+}
+
+/// A pixel coordinate, `axis` naming it in the reason it is refused.
+fn pixel(axis: &str, v: i64) -> Result<u16, String> {
+    u16::try_from(v).map_err(|_| {
+        if v < 0 {
+            format!("negative coordinate ({axis}={v})")
+        } else {
+            format!("coordinate beyond 65535 ({axis}={v})")
+        }
+    })
 }
 
 /// Two sizes from a `sensor_resolution` attribute.
@@ -566,17 +523,9 @@ fn two_sizes(values: &[f64]) -> Result<[u16; 2], Hdf5Error> {
 }
 
 /// Reads `bytes` as an HDF5 event file, for the fuzz target: any input gives events or an
-/// error, never a panic. The HDF5 library reads files, so the bytes go to a temporary one.
+/// error, never a panic.
 pub fn fuzz_decode(bytes: &[u8]) -> Result<usize, Hdf5Error> {
-    let file = tempfile::NamedTempFile::new().map_err(|e| Hdf5Error::Library {
-        object: "temporary file".into(),
-        message: e.to_string(),
-    })?;
-    std::fs::write(file.path(), bytes).map_err(|e| Hdf5Error::Library {
-        object: "temporary file".into(),
-        message: e.to_string(),
-    })?;
-    let mut reader = Hdf5Reader::open(file.path())?;
+    let mut reader = Hdf5Reader::from_bytes(bytes.to_vec())?;
     let mut n = 0;
     let _ = reader.select_range(0, 1_000_000);
     while let Some(chunk) = reader.next_chunk()? {
