@@ -266,6 +266,59 @@ impl Column {
         Ok(())
     }
 
+    /// The fast path of [`Self::ints`] and [`Self::times`]: decodes every element through
+    /// `set(item, value)`, which stores it and says whether it is valid, and returns whether all
+    /// were, with no early exit, so the loops vectorise. On `false` the caller reads the slice
+    /// again through the checked path, whose error names the first bad element.
+    pub(super) fn decode<T>(
+        &self,
+        start: usize,
+        out: &mut [T],
+        set: impl Fn(&mut T, i64) -> bool,
+    ) -> Result<bool, Hdf5Error> {
+        let raw = self.raw(start, out.len())?;
+        let mut ok = true;
+        macro_rules! each {
+            ($t:ty, $n:literal) => {
+                each_value!(self, raw, out, $t, $n, |_i, item, v| {
+                    ok &= set(item, i64::from(v));
+                })
+            };
+        }
+        match self.kind {
+            Kind::Int { width: 1, signed } if signed => each!(i8, 1),
+            Kind::Int { width: 1, .. } => each!(u8, 1),
+            Kind::Int { width: 2, signed } if signed => each!(i16, 2),
+            Kind::Int { width: 2, .. } => each!(u16, 2),
+            Kind::Int { width: 4, signed } if signed => each!(i32, 4),
+            Kind::Int { width: 4, .. } => each!(u32, 4),
+            Kind::Int { signed: true, .. } => each!(i64, 8),
+            Kind::Int { .. } => each_value!(self, raw, out, u64, 8, |_i, item, v| {
+                // Above i64::MAX is no event field.
+                ok &= (v <= i64::MAX as u64) & set(item, v as i64);
+            }),
+            Kind::Seconds { width } => {
+                // As `times`: rounded half away from zero; out of range is invalid.
+                let mut us = |item: &mut T, s: f64| {
+                    let us = s * 1e6;
+                    let fits =
+                        us.is_finite() & (us > i64::MIN as f64) & (us < i64::MAX as f64 - 1.0);
+                    ok &= fits & set(item, (us + 0.5f64.copysign(us)) as i64);
+                };
+                if width == 4 {
+                    each_value!(self, raw, out, f32, 4, |_i, item, s| {
+                        us(item, f64::from(s));
+                    });
+                } else {
+                    each_value!(self, raw, out, f64, 8, |_i, item, s| {
+                        us(item, s);
+                    });
+                }
+            }
+        }
+        Ok(ok)
+    }
+
     /// Element `i` as an integer (an index entry, a time at a range's edge, `t_offset`).
     pub(super) fn get(&self, i: usize) -> Result<i64, Hdf5Error> {
         let mut v = [0i64];

@@ -217,7 +217,12 @@ impl Hdf5Reader {
             Ok(g) => (g, "events/"),
             Err(_) => (file.root(), ""),
         };
-        let names = group.datasets().map_err(library(prefix))?;
+        let at = if prefix.is_empty() {
+            "the root group"
+        } else {
+            "the group `events`"
+        };
+        let names = group.datasets().map_err(library(at))?;
         let mut slots = Slots::default();
         for name in &names {
             if let Some(field) = Field::of(name) {
@@ -458,29 +463,47 @@ impl Hdf5Reader {
         }
         let start = self.next;
         let n = CHUNK.min(self.end - start);
-        // Each field decoded straight into the reused events, one pass per dataset.
+        // Each field decoded straight into the reused events, one pass per dataset, checks
+        // folded into a flag; only a slice with a bad value is decoded again to name it.
         self.events.clear();
         self.events.resize(n, Event::default());
         let [t, x, y, p] = &self.columns;
         let t_offset = self.t_offset;
-        t.times(start, &mut self.events, |e, t| {
-            e.t = t
-                .checked_add(t_offset)
-                .ok_or_else(|| format!("{t} + t_offset overflows"))?;
-            Ok(())
+        let ev = &mut self.events;
+        let ok = t.decode(start, ev, |e, t| {
+            let (t, overflow) = t.overflowing_add(t_offset);
+            e.t = t;
+            !overflow
+        })? & x.decode(start, ev, |e, x| {
+            e.x = x as u16;
+            (0..=0xFFFF).contains(&x)
+        })? & y.decode(start, ev, |e, y| {
+            e.y = y as u16;
+            (0..=0xFFFF).contains(&y)
+        })? & p.decode(start, ev, |e, p| {
+            e.polarity = p == 1;
+            (-1..=1).contains(&p)
         })?;
-        x.ints(start, &mut self.events, |e, x| {
-            e.x = pixel("x", x)?;
-            Ok(())
-        })?;
-        y.ints(start, &mut self.events, |e, y| {
-            e.y = pixel("y", y)?;
-            Ok(())
-        })?;
-        p.ints(start, &mut self.events, |e, p| {
-            e.polarity = polarity(Some(p))?;
-            Ok(())
-        })?;
+        if !ok {
+            t.times(start, ev, |e, t| {
+                e.t = t
+                    .checked_add(t_offset)
+                    .ok_or_else(|| format!("{t} + t_offset overflows"))?;
+                Ok(())
+            })?;
+            x.ints(start, ev, |e, x| {
+                e.x = pixel("x", x)?;
+                Ok(())
+            })?;
+            y.ints(start, ev, |e, y| {
+                e.y = pixel("y", y)?;
+                Ok(())
+            })?;
+            p.ints(start, ev, |e, p| {
+                e.polarity = polarity(Some(p))?;
+                Ok(())
+            })?;
+        }
         let base = self.checked_from as u64;
         self.check
             .check(&self.events)
