@@ -4,10 +4,11 @@
 //! The raw bytes come from `hdf5-pure`'s row-window read, so only the chunks a window overlaps
 //! are read and inflated; the decoding is ours because the crate's typed reads allocate a vector
 //! per window and per type, and events need one pass per field into a reused buffer instead.
-//! Before any read, the dataset must be one-dimensional with an element of at most 8 bytes, claim
-//! no more data than the file can hold, and every chunk it stores must lie inside the file: `hdf5-pure` 0.47 sizes a read buffer from a
-//! chunk's stored size before it checks that against the file (a damaged size asked for 4 GiB
-//! in our fuzzing), and sizes a whole read from the dataspace and the element.
+//! Before any read, the dataset must be one-dimensional with an element of at most 8 bytes,
+//! claim no more data than the file can hold, and store every chunk inside the file:
+//! `hdf5-pure` 0.47 sizes a read buffer from a chunk's stored size before it checks that against
+//! the file (a damaged size asked for 4 GiB in our mutation tests), and sizes a whole read, and
+//! the fill values of storage never written, from the dataspace and the element (up to 910 GB).
 
 use hdf5_pure::{Dataset, Datatype, DatatypeByteOrder};
 

@@ -19,18 +19,19 @@
 //! The file is read by `hdf5-pure`, a Rust implementation of the format (no C library): the
 //! HDF Group's libhdf5, which evtac used before, overflowed a heap buffer (SIGSEGV) and tried to
 //! allocate 3.4 PB on damaged files our fuzzing found, and a C library's crash is no error a
-//! user can read. `hdf5-pure` was chosen over the other Rust readers because it reads every
-//! layout h5py writes for these files (contiguous and chunked, gzip and shuffle, the bool enum,
-//! superblocks 0 to 3, HDF5 1.8 to 1.14 formats), reads a window of rows without reading the
-//! rest, parses with no `unsafe`, and is fuzzed and released often; `hdf5-reader` also reads
-//! HDF5 2.0's new chunk layout (version 5) but copies chunks with `unsafe` pointer arithmetic.
+//! user can read. `hdf5-pure` was chosen over the other Rust readers because it reads what h5py
+//! writes for these files up to HDF5 1.14's format (contiguous and chunked, gzip and shuffle,
+//! the bool enum, superblocks 0 and 3, `libver` v110 to v114), reads a window of rows without
+//! reading the rest, parses with no `unsafe`, and is fuzzed and released often; `hdf5-reader`
+//! also reads HDF5 2.0's new chunk layout (version 5) but copies chunks with `unsafe` pointer
+//! arithmetic.
 //! Files in HDF5 2.0's format (h5py built on HDF5 2.0 with `libver="latest"`) are refused with
 //! the layout version named, as libhdf5 1.10 refused them.
 //!
 //! Data is read in slices of 65,536 events, so memory holds a slice whatever size a dataset
 //! claims; before reading, each event dataset must be one-dimensional with elements of at most 8
-//! bytes and every chunk inside the file (see `column.rs` for why), and attributes are read only
-//! when they hold a handful of values.
+//! bytes, claim no more data than the file can hold and store every chunk inside the file (see
+//! `column.rs` for why), and an attribute is used only when it holds a handful of values.
 
 mod column;
 
