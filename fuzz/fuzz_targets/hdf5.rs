@@ -1,7 +1,7 @@
-//! Fuzzes the HDF5 event reader: finding the event datasets, their types and shapes, the
-//! attributes, `ms_to_idx` and the slices, over whatever the HDF5 library (Debian's libhdf5, not
-//! instrumented: coverage is of evtac's side) makes of the input. Any outcome but a panic, a
-//! crash, a hang or a huge allocation is fine.
+//! Fuzzes the HDF5 event reader: the `hdf5-pure` crate's parsing of the file (superblock,
+//! object headers, B-trees, chunk indexes, filters; instrumented with evtac's code), finding the
+//! event datasets, their types and shapes, the attributes, `ms_to_idx` and the slices. Any
+//! outcome but a panic, a crash, a hang or a huge allocation is fine.
 
 #![no_main]
 

@@ -12,6 +12,7 @@ mod csv;
 mod evt;
 mod evt21;
 mod hdf5;
+mod hdf5_damaged;
 mod neurotac;
 mod npy;
 mod other_tools;
