@@ -24,16 +24,21 @@ pub const STEP_US: i64 = 1_000;
 /// last values beyond, see [`LabelSeries::at`]).
 pub const MARGIN_US: i64 = 1_000_000;
 
-/// The commanded tilt at `t_us`.
-pub fn theta_at(motion: &TrialMotion, t_us: i64) -> f64 {
-    // The log's points, in time order.
+/// The log's points of `motion`, in time order: `(t_us, theta_deg)` at the onset, the stop's
+/// start and end, and the end.
+fn knots(motion: &TrialMotion) -> Vec<(i64, f64)> {
     let mut points = vec![(motion.motion_start_us, 0.0)];
     if let Some(s) = motion.stop {
         points.extend([(s.start_us, s.deg), (s.end_us, s.deg)]);
     }
     points.push((motion.motion_end_us, motion.total_deg));
+    points
+}
+
+/// The commanded tilt at `t_us`, straight through `points` (see [`knots`]) and held beyond them.
+fn theta_at(points: &[(i64, f64)], t_us: i64) -> f64 {
     if t_us <= points[0].0 {
-        return 0.0;
+        return points[0].1;
     }
     for w in points.windows(2) {
         let ((a, va), (b, vb)) = (w[0], w[1]);
@@ -44,7 +49,7 @@ pub fn theta_at(motion: &TrialMotion, t_us: i64) -> f64 {
             return va + (vb - va) * (t_us - a) as f64 / (b - a) as f64;
         }
     }
-    motion.total_deg
+    points[points.len() - 1].1
 }
 
 /// The commanded motion as a label series: every [`STEP_US`] from [`MARGIN_US`] before the
@@ -66,7 +71,8 @@ pub fn label_commanded(motion: &TrialMotion) -> LabelSeries {
     }
     t.sort_unstable();
     t.dedup();
-    let theta: Vec<f64> = t.iter().map(|&t| theta_at(motion, t)).collect();
+    let points = knots(motion);
+    let theta: Vec<f64> = t.iter().map(|&t| theta_at(&points, t)).collect();
     let (pitch, roll) = theta
         .iter()
         .map(|&th| geometry::contact_angles(th, motion.direction_deg))

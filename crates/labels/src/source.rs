@@ -68,14 +68,6 @@ impl LabelSource {
     pub fn path(dataset_dir: impl AsRef<Path>) -> PathBuf {
         dataset_dir.as_ref().join(LABEL_SOURCE_FILE)
     }
-
-    /// The name used on the command line and in the file.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Imu => "imu",
-            Self::Commanded => "commanded",
-        }
-    }
 }
 
 fn bad(path: PathBuf, message: String) -> Error {
