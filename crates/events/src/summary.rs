@@ -130,7 +130,12 @@ impl Summary {
                 s.last_t_us = Some(last.t);
             }
             s.events += chunk.events.len() as u64;
-            s.on_events += chunk.events.iter().filter(|e| e.polarity).count() as u64;
+            // A sum rather than `filter().count()`: branch-free, so the compiler vectorises it.
+            s.on_events += chunk
+                .events
+                .iter()
+                .map(|e| u64::from(e.polarity))
+                .sum::<u64>();
             if let (Some(first), Some(last)) = (chunk.imu.first(), chunk.imu.last()) {
                 s.first_imu_t_us.get_or_insert(first.t);
                 s.last_imu_t_us = Some(last.t);

@@ -1,9 +1,11 @@
 //! One event field's HDF5 dataset: its element type checked once, then windows of its raw bytes
-//! decoded straight into the events' fields.
+//! read into a reused buffer and decoded into the events' fields.
 //!
-//! The raw bytes come from `hdf5-pure`'s row-window read, so only the chunks a window overlaps
-//! are read and inflated; the decoding is ours because the crate's typed reads allocate a vector
-//! per window and per type, and events need one pass per field into a reused buffer instead.
+//! A contiguous dataset's window is read at its address (`stored.rs`); a chunked one's comes
+//! from `hdf5-pure`'s row-window read, so only the chunks a window overlaps are read and
+//! inflated. The decoding is ours because the crate's typed reads allocate a vector per window
+//! and per type; the common layouts are decoded by `fused.rs` in one pass over all four
+//! columns, and this file's checked path decodes the rest and names a bad value.
 //! Before any read, the dataset must be one-dimensional with an element of at most 8 bytes,
 //! claim no more data than the file can hold, and store every chunk inside the file:
 //! `hdf5-pure` 0.47 sizes a read buffer from a chunk's stored size before it checks that against
@@ -12,6 +14,10 @@
 
 use hdf5_pure::{Dataset, Datatype, DatatypeByteOrder};
 
+use hdf5_pure::Layout;
+
+use super::fused::microseconds;
+use super::stored::FileBytes;
 use super::{Hdf5Error, library};
 use crate::columns::Field;
 
@@ -48,6 +54,9 @@ pub(super) struct Column {
     dataset: Dataset,
     pub(super) kind: Kind,
     big_endian: bool,
+    /// Where a contiguous dataset's bytes start in the file; `None` for storage `hdf5-pure`
+    /// reads (chunked, compact, or never written).
+    address: Option<u64>,
     /// Elements (the dataset's one dimension; 1 for a scalar).
     pub(super) len: usize,
     /// Whether the dataset is a scalar (DSEC's `t_offset`) rather than one-dimensional.
@@ -114,6 +123,36 @@ impl Column {
                 ),
             });
         }
+        let address = match dataset.layout().map_err(library(&path))? {
+            Layout::Contiguous {
+                address: Some(address),
+                size,
+            } => {
+                if size != claimed {
+                    return Err(Hdf5Error::Metadata {
+                        object: path,
+                        reason: format!(
+                            "stores {size} bytes for {len} elements of {width} bytes (a damaged \
+                             file?)"
+                        ),
+                    });
+                }
+                if address
+                    .checked_add(claimed)
+                    .is_none_or(|end| end > file_len)
+                {
+                    return Err(Hdf5Error::Metadata {
+                        object: path,
+                        reason: format!(
+                            "its {claimed} bytes at byte {address} run past the end of the \
+                             {file_len}-byte file (a damaged or cut file?)"
+                        ),
+                    });
+                }
+                Some(address)
+            }
+            _ => None,
+        };
         if dataset.is_chunked() {
             // `chunks` walks the chunk index: its entries come from the file, so a damaged one
             // is bounded by the file's size.
@@ -139,9 +178,15 @@ impl Column {
             dataset,
             kind,
             big_endian,
+            address,
             len,
             scalar,
         })
+    }
+
+    /// How the elements are stored, when [`super::fused`] may decode them (little-endian).
+    pub(super) fn fused_kind(&self) -> Option<Kind> {
+        (!self.big_endian).then_some(self.kind)
     }
 
     /// Whether the elements are float seconds.
@@ -159,15 +204,50 @@ impl Column {
     }
 
     /// The stored bytes of the elements `start..start + count` (`count` at most a slice of
-    /// events, so at most 8 bytes each).
-    fn raw(&self, start: usize, count: usize) -> Result<Vec<u8>, Hdf5Error> {
+    /// events, so at most 8 bytes each) in `buf`, read from `file` at the dataset's address when
+    /// it is contiguous, else by `hdf5-pure`.
+    pub(super) fn raw_into<'b>(
+        &self,
+        file: &mut FileBytes,
+        start: usize,
+        count: usize,
+        buf: &'b mut Vec<u8>,
+    ) -> Result<&'b [u8], Hdf5Error> {
+        let Some(address) = self.address else {
+            *buf = self.library_raw(start, count)?;
+            return Ok(buf);
+        };
+        let width = self.width();
+        let n = count * width;
+        // Grown once to a slice's size, then reused: no clearing of fresh pages per slice.
+        if buf.len() < n {
+            buf.resize(n, 0);
+        }
+        let window = &mut buf[..n];
+        // `new` checked the whole dataset against the file's length, so this cannot overflow.
+        let offset = address + (start * width) as u64;
+        file.read_at(offset, window)
+            .map_err(|e| Hdf5Error::Library {
+                object: self.path.clone(),
+                message: format!("reading {n} bytes at byte {offset}: {e}"),
+            })?;
+        Ok(window)
+    }
+
+    /// Bytes per element.
+    fn width(&self) -> usize {
+        match self.kind {
+            Kind::Int { width, .. } | Kind::Seconds { width } => width,
+        }
+    }
+
+    /// The stored bytes of the elements `start..start + count`, read by `hdf5-pure`.
+    fn library_raw(&self, start: usize, count: usize) -> Result<Vec<u8>, Hdf5Error> {
         let raw = self
             .dataset
             .read_raw_rows(start as u64, count as u64)
             .map_err(library(&self.path))?;
-        let width = match self.kind {
-            Kind::Int { width, .. } | Kind::Seconds { width } => width,
-        };
+        let width = self.width();
         if raw.len() != count * width {
             return Err(Hdf5Error::Metadata {
                 object: self.path.clone(),
@@ -181,15 +261,15 @@ impl Column {
         Ok(raw)
     }
 
-    /// Decodes the integers `start..start + out.len()` into `out`, through `set(item, value)`,
-    /// whose error is the reason element `start + i` is refused.
+    /// Decodes the integers stored in `raw`, elements `start..start + out.len()`, into `out`,
+    /// through `set(item, value)`, whose error is the reason element `start + i` is refused.
     pub(super) fn ints<T>(
         &self,
+        raw: &[u8],
         start: usize,
         out: &mut [T],
         mut set: impl FnMut(&mut T, i64) -> Result<(), String>,
     ) -> Result<(), Hdf5Error> {
-        let raw = self.raw(start, out.len())?;
         let Kind::Int { width, signed } = self.kind else {
             return Err(Hdf5Error::Metadata {
                 object: self.path.clone(),
@@ -225,32 +305,29 @@ impl Column {
         Ok(())
     }
 
-    /// Decodes the times `start..start + out.len()` into `out` in microseconds (float seconds
-    /// rounded to the nearest microsecond), through `set(item, t)`.
+    /// Decodes the times stored in `raw`, elements `start..start + out.len()`, into `out` in
+    /// microseconds (float seconds rounded to the nearest microsecond), through `set(item, t)`.
     pub(super) fn times<T>(
         &self,
+        raw: &[u8],
         start: usize,
         out: &mut [T],
         mut set: impl FnMut(&mut T, i64) -> Result<(), String>,
     ) -> Result<(), Hdf5Error> {
         let Kind::Seconds { width } = self.kind else {
-            return self.ints(start, out, set);
+            return self.ints(raw, start, out, set);
         };
-        let raw = self.raw(start, out.len())?;
         let fail = |i: usize, reason: String| Hdf5Error::Value {
             dataset: self.path.clone(),
             index: start + i,
             reason,
         };
         let mut each = |i: usize, item: &mut T, s: f64| {
-            let us = s * 1e6;
-            // i64::MAX as f64 rounds up to 2^63, so `<` keeps the cast in range.
-            if !(us.is_finite() && us > i64::MIN as f64 && us < i64::MAX as f64 - 1.0) {
+            let (us, fits) = microseconds(s);
+            if !fits {
                 return Err(fail(i, format!("{s} s is not a time in microseconds")));
             }
-            // Rounded half away from zero by a truncating cast (`f64::round` is a library
-            // call here, a fifth of the read's time).
-            set(item, (us + 0.5f64.copysign(us)) as i64).map_err(|reason| fail(i, reason))
+            set(item, us).map_err(|reason| fail(i, reason))
         };
         macro_rules! each {
             ($t:ty, $n:literal) => {
@@ -267,63 +344,11 @@ impl Column {
         Ok(())
     }
 
-    /// The fast path of [`Self::ints`] and [`Self::times`]: decodes every element through
-    /// `set(item, value)`, which stores it and says whether it is valid, and returns whether all
-    /// were, with no early exit, so the loops vectorise. On `false` the caller reads the slice
-    /// again through the checked path, whose error names the first bad element.
-    pub(super) fn decode<T>(
-        &self,
-        start: usize,
-        out: &mut [T],
-        set: impl Fn(&mut T, i64) -> bool,
-    ) -> Result<bool, Hdf5Error> {
-        let raw = self.raw(start, out.len())?;
-        let mut ok = true;
-        macro_rules! each {
-            ($t:ty, $n:literal) => {
-                each_value!(self, raw, out, $t, $n, |_i, item, v| {
-                    ok &= set(item, i64::from(v));
-                })
-            };
-        }
-        match self.kind {
-            Kind::Int { width: 1, signed } if signed => each!(i8, 1),
-            Kind::Int { width: 1, .. } => each!(u8, 1),
-            Kind::Int { width: 2, signed } if signed => each!(i16, 2),
-            Kind::Int { width: 2, .. } => each!(u16, 2),
-            Kind::Int { width: 4, signed } if signed => each!(i32, 4),
-            Kind::Int { width: 4, .. } => each!(u32, 4),
-            Kind::Int { signed: true, .. } => each!(i64, 8),
-            Kind::Int { .. } => each_value!(self, raw, out, u64, 8, |_i, item, v| {
-                // Above i64::MAX is no event field.
-                ok &= (v <= i64::MAX as u64) & set(item, v as i64);
-            }),
-            Kind::Seconds { width } => {
-                // As `times`: rounded half away from zero; out of range is invalid.
-                let mut us = |item: &mut T, s: f64| {
-                    let us = s * 1e6;
-                    let fits =
-                        us.is_finite() & (us > i64::MIN as f64) & (us < i64::MAX as f64 - 1.0);
-                    ok &= fits & set(item, (us + 0.5f64.copysign(us)) as i64);
-                };
-                if width == 4 {
-                    each_value!(self, raw, out, f32, 4, |_i, item, s| {
-                        us(item, f64::from(s));
-                    });
-                } else {
-                    each_value!(self, raw, out, f64, 8, |_i, item, s| {
-                        us(item, s);
-                    });
-                }
-            }
-        }
-        Ok(ok)
-    }
-
     /// Element `i` as an integer (an index entry, a time at a range's edge, `t_offset`).
     pub(super) fn get(&self, i: usize) -> Result<i64, Hdf5Error> {
         let mut v = [0i64];
-        self.times(i, &mut v, |slot, t| {
+        let raw = self.library_raw(i, 1)?;
+        self.times(&raw, i, &mut v, |slot, t| {
             *slot = t;
             Ok(())
         })?;

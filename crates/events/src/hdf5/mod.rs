@@ -29,14 +29,18 @@
 //! the layout version named, as libhdf5 1.10 refused them.
 //!
 //! Data is read in slices of 65,536 events, so memory holds a slice whatever size a dataset
-//! claims; before reading, each event dataset must be one-dimensional with elements of at most 8
+//! claims (a contiguous dataset's slice straight from its address in the file, `stored.rs`;
+//! the usual type combinations decoded in one pass over the four columns, `fused.rs`); before reading, each event dataset must be one-dimensional with elements of at most 8
 //! bytes, claim no more data than the file can hold and store every chunk inside the file (see
 //! `column.rs` for why), and an attribute is used only when it holds a handful of values.
 
 mod column;
+mod fused;
+mod stored;
 
 use std::io::Cursor;
 use std::path::Path;
+use std::sync::Arc;
 
 use hdf5_pure::{AttrValue, File, Group, ReadSeekSource};
 
@@ -45,6 +49,7 @@ use crate::columns::{Field, Slots};
 use crate::npy::polarity;
 use crate::{Event, RangeIndex, Resolution};
 use column::Column;
+use stored::{FileBytes, Shared};
 
 /// Events read per slice.
 const CHUNK: usize = 1 << 16;
@@ -193,6 +198,10 @@ pub struct Hdf5Reader {
     /// The element the check's count starts at (where a range read starts).
     checked_from: usize,
     events: Vec<Event>,
+    /// The file's bytes, for contiguous datasets' windows.
+    bytes: FileBytes,
+    /// Each column's stored bytes for the slice being decoded, reused from slice to slice.
+    raw: [Vec<u8>; 4],
 }
 
 impl Hdf5Reader {
@@ -200,19 +209,28 @@ impl Hdf5Reader {
     pub fn open(path: impl AsRef<Path>) -> Result<Self, Hdf5Error> {
         // Streaming: metadata and the chunks a slice needs are read on demand, not the file.
         // The caller names the path; the reader's message says what failed.
-        Self::from_file(File::open_streaming(path.as_ref()).map_err(library("the file"))?)
+        let path = path.as_ref();
+        let bytes = std::fs::File::open(path).map_err(|e| Hdf5Error::Library {
+            object: "the file".into(),
+            message: e.to_string(),
+        })?;
+        let file = File::open_streaming(path).map_err(library("the file"))?;
+        Self::from_file(file, FileBytes::Disk(bytes))
     }
 
     /// Reads an HDF5 event file held in memory.
     pub fn from_bytes(bytes: Vec<u8>) -> Result<Self, Hdf5Error> {
-        let source = ReadSeekSource::new(Cursor::new(bytes)).map_err(|e| Hdf5Error::Library {
-            object: "the file".into(),
-            message: e.to_string(),
-        })?;
-        Self::from_file(File::from_source(source).map_err(library("the file"))?)
+        let shared = Shared(Arc::from(bytes));
+        let source =
+            ReadSeekSource::new(Cursor::new(shared.clone())).map_err(|e| Hdf5Error::Library {
+                object: "the file".into(),
+                message: e.to_string(),
+            })?;
+        let file = File::from_source(source).map_err(library("the file"))?;
+        Self::from_file(file, FileBytes::Memory(shared))
     }
 
-    fn from_file(file: File) -> Result<Self, Hdf5Error> {
+    fn from_file(file: File, bytes: FileBytes) -> Result<Self, Hdf5Error> {
         let root = file.root();
         let (group, prefix) = match file.group("events") {
             Ok(g) => (g, "events/"),
@@ -323,6 +341,8 @@ impl Hdf5Reader {
             check: EventCheck::new(resolution),
             checked_from: 0,
             events: Vec::new(),
+            bytes,
+            raw: Default::default(),
         })
     }
     /// Number of events in the file.
@@ -464,54 +484,61 @@ impl Hdf5Reader {
         }
         let start = self.next;
         let n = CHUNK.min(self.end - start);
-        // Each field decoded straight into the reused events, one pass per dataset, checks
-        // folded into a flag; only a slice with a bad value is decoded again to name it.
-        self.events.clear();
-        self.events.resize(n, Event::default());
         let [t, x, y, p] = &self.columns;
+        let [rt, rx, ry, rp] = &mut self.raw;
+        let file = &mut self.bytes;
+        let raw = [
+            t.raw_into(file, start, n, rt)?,
+            x.raw_into(file, start, n, rx)?,
+            y.raw_into(file, start, n, ry)?,
+            p.raw_into(file, start, n, rp)?,
+        ];
         let t_offset = self.t_offset;
-        let ev = &mut self.events;
-        let ok = t.decode(start, ev, |e, t| {
-            let (t, overflow) = t.overflowing_add(t_offset);
-            e.t = t;
-            !overflow
-        })? & x.decode(start, ev, |e, x| {
-            e.x = x as u16;
-            (0..=0xFFFF).contains(&x)
-        })? & y.decode(start, ev, |e, y| {
-            e.y = y as u16;
-            (0..=0xFFFF).contains(&y)
-        })? & p.decode(start, ev, |e, p| {
-            e.polarity = p == 1;
-            (-1..=1).contains(&p)
-        })?;
-        if !ok {
-            t.times(start, ev, |e, t| {
-                e.t = t
-                    .checked_add(t_offset)
-                    .ok_or_else(|| format!("{t} + t_offset overflows"))?;
-                Ok(())
-            })?;
-            x.ints(start, ev, |e, x| {
-                e.x = pixel("x", x)?;
-                Ok(())
-            })?;
-            y.ints(start, ev, |e, y| {
-                e.y = pixel("y", y)?;
-                Ok(())
-            })?;
-            p.ints(start, ev, |e, p| {
-                e.polarity = polarity(Some(p))?;
-                Ok(())
-            })?;
-        }
+        let kinds = [t, x, y, p].map(Column::fused_kind);
+        let fused = match kinds {
+            [Some(kt), Some(kx), Some(ky), Some(kp)] => fused::decode(
+                [kt, kx, ky, kp],
+                raw,
+                t_offset,
+                self.check.resolution(),
+                &mut self.events,
+            ),
+            _ => None,
+        };
         let base = self.checked_from as u64;
-        self.check
-            .check(&self.events)
-            .map_err(|error| Hdf5Error::Event {
-                index: base + error.index(),
-                error,
-            })?;
+        let checked = match fused {
+            Some(d) if d.valid => self.check.check_summarized(&self.events, d.summary),
+            _ => {
+                // The checked path: one pass per column, each value checked as it is decoded, so
+                // the error names the first bad one.
+                let ev = &mut self.events;
+                ev.clear();
+                ev.resize(n, Event::default());
+                t.times(raw[0], start, ev, |e, t| {
+                    e.t = t
+                        .checked_add(t_offset)
+                        .ok_or_else(|| format!("{t} + t_offset overflows"))?;
+                    Ok(())
+                })?;
+                x.ints(raw[1], start, ev, |e, x| {
+                    e.x = pixel("x", x)?;
+                    Ok(())
+                })?;
+                y.ints(raw[2], start, ev, |e, y| {
+                    e.y = pixel("y", y)?;
+                    Ok(())
+                })?;
+                p.ints(raw[3], start, ev, |e, p| {
+                    e.polarity = polarity(Some(p))?;
+                    Ok(())
+                })?;
+                self.check.check(&self.events)
+            }
+        };
+        checked.map_err(|error| Hdf5Error::Event {
+            index: base + error.index(),
+            error,
+        })?;
         self.next = start + n;
         Ok(Some(&self.events))
     }

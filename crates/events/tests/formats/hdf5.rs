@@ -53,6 +53,27 @@ with h5py.File(os.path.join(d, "dsec.h5"), "w") as f:
     f.create_dataset("ms_to_idx", data=np.searchsorted(rel, ms, side="left").astype(np.uint64))
     print(t_offset)
 expected("dsec", t_us)
+# DSEC uncompressed (contiguous storage, read at its address rather than through the library),
+# and event_utils big-endian (no one-pass kernel: the column-at-a-time path).
+with h5py.File(os.path.join(d, "dsec_plain.h5"), "w") as f:
+    for k, v in (("x", x.astype(np.uint16)), ("y", y.astype(np.uint16)), ("t", rel),
+                 ("p", p.astype(np.uint8))):
+        f.create_dataset("events/" + k, data=v)
+    f.create_dataset("t_offset", data=np.int64(t_offset))
+    f.create_dataset("ms_to_idx", data=np.searchsorted(rel, ms, side="left").astype(np.uint64))
+with h5py.File(os.path.join(d, "big_endian.h5"), "w") as f:
+    for k, v in (("xs", x.astype(">i2")), ("ys", y.astype(">i2")), ("ts", (t_us / 1e6).astype(">f8")),
+                 ("ps", p.astype(">i1"))):
+        f.create_dataset("events/" + k, data=v)
+# Bad values the one-pass kernel must notice, in its second slice (65,536 events per slice):
+# a polarity of 2, a negative coordinate, a time that does not fit, each named by element.
+for name, field, value in (("bad_p", "ps", 2), ("bad_x", "xs", -3), ("bad_t", "ts", 1e300)):
+    with h5py.File(os.path.join(d, name + ".h5"), "w") as f:
+        cols = {"xs": x.astype(np.int16), "ys": y.astype(np.int16), "ts": t_us / 1e6,
+                "ps": p.astype(np.int8)}
+        cols[field] = cols[field].copy(); cols[field][70_000] = value
+        for k, v in cols.items():
+            f.create_dataset("events/" + k, data=v)
 # Broken: no event datasets; a string dataset; a count that disagrees; ragged; a wrong index.
 def small(name, **sets):
     with h5py.File(os.path.join(d, name + ".h5"), "w") as f:
@@ -90,16 +111,25 @@ fn the_labs_layouts_read_event_for_event() {
         return;
     };
     let d = dir.path();
-    for name in ["event_utils", "neurotac", "dsec"] {
+    for name in [
+        "event_utils",
+        "neurotac",
+        "dsec",
+        "dsec_plain",
+        "big_endian",
+    ] {
         let rec = read_recording(d.join(format!("{name}.h5"))).unwrap();
         assert_eq!(rec.format, Format::Hdf5);
-        let want = read_expected_csv(&d.join(format!(
-            "{}.expected.csv",
-            name.replace("neurotac", "event_utils")
-        )));
+        let source = if name.starts_with("dsec") {
+            "dsec"
+        } else {
+            "event_utils"
+        };
+        let want = read_expected_csv(&d.join(format!("{source}.expected.csv")));
         assert_eq!(rec.events.len(), want.len(), "{name}");
         assert!(rec.events == want, "{name}: the events differ");
-        let sensor = (name != "dsec").then_some(Resolution::new(640, 480));
+        let stated = ["event_utils", "neurotac"].contains(&name);
+        let sensor = stated.then_some(Resolution::new(640, 480));
         assert_eq!(rec.resolution, sensor, "{name}");
     }
     let note = |name: &str| open(d.join(name)).unwrap().note().unwrap().to_string();
@@ -125,7 +155,7 @@ fn ranges_go_through_ms_to_idx_and_equal_the_filtered_whole() {
     let d = dir.path();
     let whole = read_recording(d.join("dsec.h5")).unwrap();
     let (first, last) = (whole.events[0].t, whole.events.last().unwrap().t);
-    for (from, to) in [
+    for ((from, to), file) in [
         (first + 1_000_000, first + 1_500_000),
         (t_offset + 999, t_offset + 1001),
         (t_offset + 123_456, t_offset + 123_457),
@@ -133,15 +163,18 @@ fn ranges_go_through_ms_to_idx_and_equal_the_filtered_whole() {
         (last - 10, last + 10_000_000),
         (last + 1, last + 2),
         (first - 10, first - 5),
-    ] {
-        let (part, how) = read_recording_range(d.join("dsec.h5"), from, to).unwrap();
+    ]
+    .into_iter()
+    .flat_map(|range| [(range, "dsec.h5"), (range, "dsec_plain.h5")])
+    {
+        let (part, how) = read_recording_range(d.join(file), from, to).unwrap();
         let want: Vec<_> = whole
             .events
             .iter()
             .copied()
             .filter(|e| e.t >= from && e.t < to)
             .collect();
-        assert_eq!(part.events, want, "[{from}, {to})");
+        assert_eq!(part.events, want, "{file} [{from}, {to})");
         let RangeIndex::EventIndex { events, total } = how else {
             panic!("{how:?}");
         };
@@ -178,6 +211,12 @@ fn broken_files_name_the_dataset_or_attribute() {
         ("count", &["num_events", "hold 10"]),
         ("ragged", &["one length", "events/ys [9]"]),
         ("cut", &["cut.h5"]),
+        ("bad_p", &["events/ps", "element 70000", "p = 2 is not"]),
+        (
+            "bad_x",
+            &["events/xs", "element 70000", "negative coordinate (x=-3)"],
+        ),
+        ("bad_t", &["events/ts", "element 70000", "not a time"]),
     ] {
         let path = dir.path().join(format!("{name}.h5"));
         let err = read_recording(&path).unwrap_err().to_string();
