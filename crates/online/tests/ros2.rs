@@ -6,6 +6,7 @@
 //! RustDDS through `Ros2Options::interfaces` and its same-host discovery peers. Each run takes a
 //! domain id of its own so that concurrent runs do not see each other.
 
+use crate::support::dds::{CYCLONE_LOOPBACK, loopback_options, random_domain};
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_learn::Model;
 use evtac_online::input::{MemorySource, Paced};
@@ -13,45 +14,10 @@ use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::ros2::{self, Ros2Options, Ros2Publisher, Time};
 use evtac_online::{Estimate, Estimator};
 use std::io::{BufRead, BufReader};
-use std::net::{IpAddr, Ipv4Addr};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
-
-/// Cyclone DDS on loopback only, discovering peers by unicast to 127.0.0.1 (participant indices
-/// up to 20 on this host).
-const CYCLONE_LOOPBACK: &str = "<CycloneDDS><Domain id=\"any\"><General><Interfaces>\
-     <NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast>\
-     </General><Discovery><ParticipantIndex>auto</ParticipantIndex>\
-     <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/>\
-     </Peers></Discovery></Domain></CycloneDDS>";
-
-/// A domain id for this test in this run: random per run (so that runs at the same time, or
-/// another engineer's, do not cross-talk), and different for each `test` of a run (the tests
-/// run in parallel). 1..=230: never ROS's default 0, and 231 is left to the CLI's test of a
-/// domain without subscribers.
-fn random_domain(test: u32) -> u16 {
-    static RUN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
-    let run = *RUN.get_or_init(|| {
-        let nanos = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .unwrap()
-            .subsec_nanos();
-        (nanos ^ std::process::id().rotate_left(16)) % 230
-    });
-    // 61 is prime to 230: distinct tests get distinct domains.
-    1 + ((run + test * 61) % 230) as u16
-}
-
-fn loopback_options(domain: u16, frame_id: &str) -> Ros2Options {
-    Ros2Options {
-        topic: "/contact_angle".into(),
-        frame_id: frame_id.into(),
-        domain,
-        interfaces: vec![IpAddr::V4(Ipv4Addr::LOCALHOST)],
-    }
-}
 
 /// A running Cyclone subscriber.
 struct Subscriber {

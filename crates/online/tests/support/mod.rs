@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod dds;
+
 use evtac_events::{Event, Resolution};
 use evtac_learn::{Model, ModelBundle, Representation};
 use evtac_online::input::{ChunkInfo, EventSource, MemorySource, Next};

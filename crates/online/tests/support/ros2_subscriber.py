@@ -4,8 +4,12 @@ the topic: the IDL types ROS 2 generates (module `msg::dds_`, names ending in `_
 volatile reader.
 
 argv: domain id, DDS topic (`rt/contact_angle`), seconds without a sample after which to stop
-once samples came, seconds after which to stop in any case. Discovery follows CYCLONEDDS_URI
-(the test confines it to loopback).
+once samples came, seconds after which to stop in any case, and optionally `count`. Discovery
+follows CYCLONEDDS_URI (the test confines it to loopback).
+
+With `count` (the soak test: an hour of samples would not fit a list), nothing is kept: when it
+stops it prints one line `count N backwards B first_us F last_us L` (samples received, stamps not
+later than the one before, first and last stamp in microseconds), then `end`.
 
 Prints `ready` once the reader exists, then, when it stops, one line per sample received,
 `recv_ns sec nanosec frame_id x y z` (recv_ns: wall clock, time.time_ns(), when the sample was
@@ -43,6 +47,8 @@ class Vector3Stamped_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3Stam
     vector: Vector3_
 
 domain, topic, idle_s, deadline_s = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
+count_only = len(sys.argv) > 5 and sys.argv[5] == "count"
+count, backwards, first_us, last_us = 0, 0, None, None
 dp = DomainParticipant(domain)
 tp = Topic(dp, topic, Vector3Stamped_)
 # What a default rclpy subscription asks for (reliable, volatile), with a history deep enough
@@ -68,9 +74,19 @@ while True:
         # The writer leaving comes as an invalid sample (instance state, no data).
         if not isinstance(s, Vector3Stamped_):
             continue
+        if count_only:
+            us = s.header.stamp.sec * 1_000_000 + s.header.stamp.nanosec // 1000
+            if last_us is not None and us <= last_us:
+                backwards += 1
+            first_us = us if first_us is None else first_us
+            last_us, count = us, count + 1
+            continue
         out.append(f"{t} {s.header.stamp.sec} {s.header.stamp.nanosec} {s.header.frame_id} "
                    f"{s.vector.x!r} {s.vector.y!r} {s.vector.z!r}")
     if samples:
         last = time.monotonic()
-print("\n".join(out))
+if count_only:
+    print(f"count {count} backwards {backwards} first_us {first_us} last_us {last_us}")
+else:
+    print("\n".join(out))
 print("end", flush=True)
