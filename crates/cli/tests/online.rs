@@ -422,27 +422,34 @@ fn ros2_flags_are_checked() {
     );
 }
 
+/// In `dir`: a model, 50 ms of events as CSV, and the names of the estimates' CSV and the MCAP
+/// log; returned as `[model, events, est.csv, run.mcap]`.
+fn mcap_run_files(dir: &Path) -> [String; 4] {
+    let model = dir.join("model");
+    bundle(&model);
+    let events = dir.join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    [model, events, dir.join("est.csv"), dir.join("run.mcap")]
+        .map(|p| p.to_str().unwrap().to_owned())
+}
+
+/// Runs `base` with `--output csv --mcap log` and `extra`; returns its standard error and the
+/// CSV's rows.
+fn logged_run(base: &[&str], csv: &str, log: &str, extra: &[&str]) -> (String, Vec<Vec<String>>) {
+    let run = run_ok(&[base, &["--output", csv, "--mcap", log], extra].concat());
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    (stderr, rows(&std::fs::read_to_string(csv).unwrap()))
+}
+
 /// `--mcap`: the log holds what the CSV holds, read back by the `mcap` Python package (schema,
 /// encoding, log time) and by `rosbags` (`AnyReader` on the file, `deserialize_cdr`).
 #[test]
 fn mcap_logs_what_the_csv_holds() {
     let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("model");
-    bundle(&model);
-    let events = dir.path().join("events.csv");
-    std::fs::write(&events, csv_events()).unwrap();
-    let (out, log) = (dir.path().join("est.csv"), dir.path().join("run.mcap"));
-    let [m, e, o, l] = [&model, &events, &out, &log].map(|p| p.to_str().unwrap());
+    let [m, e, o, l] = mcap_run_files(dir.path());
+    let [m, e, o, l] = [&m, &e, &o, &l].map(String::as_str);
     let base = ["online", "--model", m, "--input", e, "--sensor", "640x480"];
-    let run = run_ok(
-        &[
-            &base[..],
-            &["--output", o, "--mcap", l, "--frame-id", "left"],
-        ]
-        .concat(),
-    );
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    let rows = rows(&std::fs::read_to_string(&out).unwrap());
+    let (stderr, rows) = logged_run(&base, o, l, &["--frame-id", "left"]);
     assert!(rows.len() >= 40, "{} rows", rows.len());
     assert!(
         stderr.contains(&format!("logged {} estimate(s) to {l}", rows.len())),
@@ -451,7 +458,7 @@ fn mcap_logs_what_the_csv_holds() {
     // The log is never written over the input.
     let msg = run_err(&[&base[..], &["--mcap", e]].concat());
     assert!(msg.contains("refusing to write over it"), "{msg}");
-    assert!(std::fs::read_to_string(&events).unwrap() == csv_events());
+    assert!(std::fs::read_to_string(e).unwrap() == csv_events());
     let msg = run_err(&[&base[..], &["--output", l, "--mcap", l]].concat());
     assert!(msg.contains("--mcap and --output are both"), "{msg}");
 
@@ -497,6 +504,57 @@ for (name, enc, topic, menc, t), (typ, msg) in zip(times, msgs):
         }
         assert_eq!(f[11], "0.0");
     }
+}
+
+/// `--mcap-frames`: the representation's frames as images beside the estimates (the frames
+/// themselves are checked against offline ones in `evtac-online`'s tests), refused without
+/// `--mcap` or with a rate that is no rate.
+#[test]
+fn mcap_frames_log_the_representation_as_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let [m, e, o, l] = mcap_run_files(dir.path());
+    let [m, e, o, l] = [&m, &e, &o, &l].map(String::as_str);
+    let base = ["online", "--model", m, "--input", e, "--sensor", "640x480"];
+    let (stderr, rows) = logged_run(&base, o, l, &["--mcap-frames", "100"]);
+    // One frame set per 10 ms of estimates (one per millisecond), the first at the first.
+    let sets = rows.len().div_ceil(10);
+    assert!(
+        stderr.contains(&format!(
+            "logged {} estimate(s) and {sets} frame set(s) to {l}",
+            rows.len()
+        )),
+        "{stderr}"
+    );
+    let msg = run_err(&[&base[..], &["--mcap-frames", "10"]].concat());
+    assert!(msg.contains("--mcap"), "{msg}");
+    for bad in ["0", "inf", "nan"] {
+        let msg = run_err(&[&base[..], &["--mcap", l, "--mcap-frames", bad]].concat());
+        assert!(msg.contains("--mcap-frames"), "{bad}: {msg}");
+    }
+
+    if evtac_testkit::python_with("rosbags").is_none() {
+        return;
+    }
+    let script = r#"
+import sys
+from collections import Counter
+from pathlib import Path
+from rosbags.highlevel import AnyReader
+with AnyReader([Path(sys.argv[1])]) as reader:
+    topics = Counter((c.topic, c.msgtype) for c, _, _ in reader.messages())
+for (topic, msgtype), n in sorted(topics.items()):
+    print(topic, msgtype, n)
+"#;
+    let got = evtac_testkit::run_python(script, &[l]).unwrap();
+    let image = "sensor_msgs/msg/Image";
+    let want = format!(
+        "/contact_angle geometry_msgs/msg/Vector3Stamped {}\n\
+         /contact_angle/frames/combined {image} {sets}\n\
+         /contact_angle/frames/dynamic {image} {sets}\n\
+         /contact_angle/frames/static {image} {sets}\n",
+        rows.len()
+    );
+    assert_eq!(got, want);
 }
 
 /// `--mcap` on a replayed dataset trial: the trial's labels and truth at each estimate's time on

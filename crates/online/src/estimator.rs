@@ -27,6 +27,7 @@
 //! interleaved runs; at 300 k events/s the whole estimate's cost about halves,
 //! `benches/latency.rs`).
 
+use crate::frames::{FrameCapture, FrameSet};
 use crate::latency::LatencyStats;
 use crate::schedule::{self, Schedule};
 use evtac_events::{Event, Resolution, Roi};
@@ -97,6 +98,11 @@ pub struct Estimator {
     processing: LatencyStats,
     /// Work done since the previous estimate was handed over, in calls that have returned.
     carried: Duration,
+    /// The representation and mask, for [`Self::capture_frames`].
+    representation: ReprConfig,
+    mask: Option<Mask>,
+    /// Frames taken at a lower rate than the estimates, when asked for.
+    frames: Option<FrameCapture>,
 }
 
 impl std::fmt::Debug for Estimator {
@@ -150,7 +156,34 @@ impl Estimator {
             stats: LatencyStats::new(interval),
             processing: LatencyStats::new(interval),
             carried: Duration::ZERO,
+            representation: *representation,
+            mask: mask.cloned(),
+            frames: None,
         })
+    }
+
+    /// Also takes the representation's binary frames every `every_us` of event time, at the
+    /// estimate times (see [`crate::frames`]); collected with [`Self::take_frames`]. The
+    /// accumulator is then no longer deferred (its potentials are read for the static frame):
+    /// the same estimates, a little more work per estimate. Before the first chunk only.
+    pub fn capture_frames(&mut self, every_us: i64) -> Result<(), Error> {
+        if self.counters.events == 0 {
+            self.extractor = FeatureExtractor::new(
+                std::slice::from_ref(&self.representation),
+                CROP,
+                self.mask.as_ref(),
+            )?;
+            self.frames = Some(FrameCapture::new(every_us));
+        }
+        Ok(())
+    }
+
+    /// The frame sets taken since the last call (none unless [`Self::capture_frames`]).
+    pub fn take_frames(&mut self) -> Vec<FrameSet> {
+        self.frames
+            .as_mut()
+            .map(FrameCapture::take)
+            .unwrap_or_default()
     }
 
     /// Puts the first estimate at `t_us` (then one every interval) instead of at the first
@@ -290,6 +323,9 @@ impl Estimator {
                 latency,
                 processing,
             });
+            if let Some(frames) = &mut self.frames {
+                frames.at_estimate(t, &self.extractor, &self.representation, self.mask.as_ref());
+            }
             // Handing the estimate over is not the estimator's work.
             *started = Instant::now();
         }

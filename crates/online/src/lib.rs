@@ -15,7 +15,8 @@
 //!   dropped events.
 //! - [`ros2`]: each estimate published on a ROS 2 topic (`geometry_msgs/msg/Vector3Stamped`,
 //!   pure Rust over DDS, never holding estimation up).
-//! - [`mcap_log`]: the same messages logged to an MCAP file that Foxglove and `rosbags` open.
+//! - [`mcap_log`]: the same messages logged to an MCAP file that Foxglove and `rosbags` open,
+//!   with the representation's [`frames`] as images when asked for.
 //!
 //! The exact definition of latency is in `docs/online.md`; in short, it runs from the moment the
 //! ingestion thread received the chunk that made an estimate's time final to the end of that
@@ -48,6 +49,8 @@
 
 mod backoff;
 mod estimator;
+pub mod frames;
+pub mod image_msg;
 pub mod input;
 mod latency;
 pub mod mcap_log;

@@ -22,6 +22,10 @@
 //! - with [`McapLog::add_reference`], more channels of the same type beside it
 //!   (`/contact_angle/label`, `/contact_angle/truth`: a replayed dataset trial's labels and the
 //!   simulator's truth at each estimate's time), so Foxglove plots the estimate against them;
+//! - with [`McapLog::write_frames`] (`--mcap-frames HZ`), the representation's binary frames
+//!   ([`crate::frames`]) as `sensor_msgs/msg/Image` ([`crate::image_msg`], `mono8`, 0 and 255)
+//!   on `<topic>/frames/static`, `/dynamic` and `/combined` (the parts the model has), stamped
+//!   and logged at the estimate's time they were taken at;
 //! - chunks are zstd-compressed on the calling thread (no compression threads), with the
 //!   summary, chunk and message indexes readers seek with.
 //!
@@ -31,6 +35,8 @@
 //! ([`refuse_input`]).
 
 use crate::estimator::Estimate;
+use crate::frames::{FrameSet, Part};
+use crate::image_msg::{IMAGE_DEFINITION, IMAGE_TYPE, Image};
 use crate::ros2::{MSG_DEFINITION, MSG_TYPE, Vector3, Vector3Stamped};
 use evtac_events::output::{OutputFile, OutputIsInput, refuse_input};
 use mcap::records::MessageHeader;
@@ -102,6 +108,10 @@ pub struct McapLog {
     channel: u16,
     /// The reference channels, each with its angles.
     references: Vec<(u16, Reference)>,
+    /// The image schema and a channel per frame part, added with the first frames.
+    image_schema: Option<u16>,
+    frame_channels: BTreeMap<Part, u16>,
+    frame_sets: u32,
     frame_id: String,
     sequence: u32,
     buf: Vec<u8>,
@@ -157,6 +167,9 @@ impl McapLog {
             topic: topic.to_owned(),
             channel,
             references: Vec::new(),
+            image_schema: None,
+            frame_channels: BTreeMap::new(),
+            frame_sets: 0,
             frame_id: frame_id.to_owned(),
             sequence: 0,
             buf: Vec::with_capacity(128),
@@ -182,12 +195,7 @@ impl McapLog {
     /// Appends `estimate` as a message (see the module docs), and each reference's angles at
     /// its time.
     pub fn write(&mut self, estimate: &Estimate) -> Result<(), Error> {
-        let time_ns = u64::try_from(estimate.t_us)
-            .ok()
-            .and_then(|us| us.checked_mul(1000))
-            .ok_or(Error::NegativeTime {
-                t_us: estimate.t_us,
-            })?;
+        let time_ns = log_time(estimate.t_us)?;
         self.sequence = self.sequence.wrapping_add(1);
         let message = Vector3Stamped::from_estimate(estimate, &self.frame_id);
         self.append(self.channel, &message, time_ns)?;
@@ -207,6 +215,50 @@ impl McapLog {
         Ok(())
     }
 
+    /// Appends `frames` as one image per part, on `<topic>/frames/<part>` (see the module
+    /// docs).
+    pub fn write_frames(&mut self, frames: &FrameSet) -> Result<(), Error> {
+        let time_ns = log_time(frames.t_us)?;
+        let mcap = |path: &Path| {
+            let path = path.to_owned();
+            move |source| Error::Mcap { path, source }
+        };
+        let schema = match self.image_schema {
+            Some(schema) => schema,
+            None => {
+                let schema = self
+                    .writer
+                    .add_schema(IMAGE_TYPE, SCHEMA_ENCODING, IMAGE_DEFINITION.as_bytes())
+                    .map_err(mcap(&self.path))?;
+                *self.image_schema.insert(schema)
+            }
+        };
+        self.frame_sets = self.frame_sets.wrapping_add(1);
+        for frame in &frames.frames {
+            let channel = match self.frame_channels.get(&frame.part) {
+                Some(&channel) => channel,
+                None => {
+                    let topic = format!(
+                        "{}/frames/{}",
+                        self.topic.trim_end_matches('/'),
+                        frame.part.name()
+                    );
+                    let channel = self
+                        .writer
+                        .add_channel(schema, &topic, MESSAGE_ENCODING, &BTreeMap::new())
+                        .map_err(mcap(&self.path))?;
+                    self.frame_channels.insert(frame.part, channel);
+                    channel
+                }
+            };
+            let image = Image::from_frame(frame, frames.t_us, &self.frame_id);
+            self.buf.clear();
+            image.to_cdr(&mut self.buf).map_err(Error::Serialize)?;
+            self.write_buf(channel, self.frame_sets, time_ns)?;
+        }
+        Ok(())
+    }
+
     /// Appends `message` to `channel` at `time_ns`.
     fn append(
         &mut self,
@@ -216,9 +268,14 @@ impl McapLog {
     ) -> Result<(), Error> {
         self.buf.clear();
         message.to_cdr(&mut self.buf).map_err(Error::Serialize)?;
+        self.write_buf(channel, self.sequence, time_ns)
+    }
+
+    /// Appends the serialized message in `buf` to `channel` at `time_ns`.
+    fn write_buf(&mut self, channel: u16, sequence: u32, time_ns: u64) -> Result<(), Error> {
         let header = MessageHeader {
             channel_id: channel,
-            sequence: self.sequence,
+            sequence,
             log_time: time_ns,
             publish_time: time_ns,
         };
@@ -228,6 +285,11 @@ impl McapLog {
                 path: self.path.clone(),
                 source,
             })
+    }
+
+    /// Frame sets written so far (modulo 2^32).
+    pub fn frame_sets_written(&self) -> u32 {
+        self.frame_sets
     }
 
     /// Messages written so far (modulo 2^32).
@@ -246,4 +308,12 @@ impl McapLog {
             source,
         })
     }
+}
+
+/// The MCAP log time of `t_us`: nanoseconds, unsigned.
+fn log_time(t_us: i64) -> Result<u64, Error> {
+    u64::try_from(t_us)
+        .ok()
+        .and_then(|us| us.checked_mul(1000))
+        .ok_or(Error::NegativeTime { t_us })
 }

@@ -13,6 +13,7 @@
 //! dropped and counted instead.
 
 use crate::estimator::{Error as EstimatorError, Estimate, Estimator};
+use crate::frames::FrameSet;
 use crate::input::{EventSource, InputError};
 use crate::latency::Summary;
 use crate::notice::Notice;
@@ -55,6 +56,9 @@ pub enum Output {
     Estimate(Estimate),
     /// A change in the input's state (connection lost, retried, ...).
     Notice(Notice),
+    /// The representation's frames at an estimate's time, after that estimate (only when the
+    /// estimator captures them: `Estimator::capture_frames`).
+    Frames(FrameSet),
 }
 
 /// Errors of a run.
@@ -344,6 +348,11 @@ fn estimate(
             stopped.set(true);
         }
     };
+    let emit_frames = |f: FrameSet| {
+        if out.send(Output::Frames(f)).is_err() {
+            stopped.set(true);
+        }
+    };
     while !stop.iter().any(|s| s.load(Ordering::Relaxed)) {
         let msg = if busy_poll {
             match rx.try_recv() {
@@ -371,6 +380,9 @@ fn estimate(
                     failure = Some(e);
                     break;
                 }
+                for frames in estimator.take_frames() {
+                    emit_frames(frames);
+                }
                 // A full pool means spare buffers: let this one go.
                 let _ = pool.try_send(events);
             }
@@ -381,6 +393,9 @@ fn estimate(
             }
             Msg::End(at) => {
                 failure = estimator.finish(at, &mut emit).err();
+                for frames in estimator.take_frames() {
+                    emit_frames(frames);
+                }
                 break;
             }
         }

@@ -169,11 +169,42 @@ impl Vector3Stamped {
     /// bytes its data writer puts on the wire after the same header). This is what `rosbag2`
     /// stores and `rclpy.serialization.deserialize_message` reads.
     pub fn to_cdr(&self, out: &mut Vec<u8>) -> Result<(), rustdds::serialization::Error> {
-        out.extend_from_slice(&RepresentationIdentifier::CDR_LE.to_bytes());
-        out.extend_from_slice(&[0, 0]);
-        rustdds::serialization::to_writer_with_rep_id(out, self, RepresentationIdentifier::CDR_LE)
+        to_cdr(self, out)
     }
 }
+
+/// Appends `message`'s CDR encoding with its 4-byte encapsulation header (`00 01 00 00`:
+/// little-endian CDR, no options), as a ROS 2 message is stored in a bag or sent over DDS.
+pub(crate) fn to_cdr<T: Serialize>(
+    message: &T,
+    out: &mut Vec<u8>,
+) -> Result<(), rustdds::serialization::Error> {
+    out.extend_from_slice(&RepresentationIdentifier::CDR_LE.to_bytes());
+    out.extend_from_slice(&[0, 0]);
+    rustdds::serialization::to_writer_with_rep_id(out, message, RepresentationIdentifier::CDR_LE)
+}
+
+/// The `.msg` definitions of `std_msgs/Header` and `builtin_interfaces/Time` as they follow a
+/// stamped message's own definition in an MCAP schema (each after a blank line, a line of 80 `=`
+/// and its `MSG:` line): shared by [`MSG_DEFINITION`] and the image type's
+/// (`crate::image_msg::IMAGE_DEFINITION`).
+macro_rules! header_definitions {
+    () => {
+        concat!(
+            "\n",
+            "================================================================================\n",
+            "MSG: std_msgs/Header\n",
+            "builtin_interfaces/Time stamp\n",
+            "string frame_id\n",
+            "\n",
+            "================================================================================\n",
+            "MSG: builtin_interfaces/Time\n",
+            "int32 sec\n",
+            "uint32 nanosec\n",
+        )
+    };
+}
+pub(crate) use header_definitions;
 
 /// The ROS 2 type name of the message ([`Vector3Stamped`]), as `rosbag2` and MCAP name it.
 pub const MSG_TYPE: &str = "geometry_msgs/msg/Vector3Stamped";
@@ -181,26 +212,17 @@ pub const MSG_TYPE: &str = "geometry_msgs/msg/Vector3Stamped";
 /// The `.msg` definition of [`MSG_TYPE`] with its dependencies, as `rosbag2` stores it in an
 /// MCAP schema (encoding `ros2msg`): the type's own definition, then each type it uses after a
 /// line of 80 `=` and a `MSG: package/Type` line. Field for field the Rust types of this module.
-pub const MSG_DEFINITION: &str = "\
-std_msgs/Header header
-geometry_msgs/Vector3 vector
-
-================================================================================
-MSG: std_msgs/Header
-builtin_interfaces/Time stamp
-string frame_id
-
-================================================================================
-MSG: builtin_interfaces/Time
-int32 sec
-uint32 nanosec
-
-================================================================================
-MSG: geometry_msgs/Vector3
-float64 x
-float64 y
-float64 z
-";
+pub const MSG_DEFINITION: &str = concat!(
+    "std_msgs/Header header\n",
+    "geometry_msgs/Vector3 vector\n",
+    header_definitions!(),
+    "\n",
+    "================================================================================\n",
+    "MSG: geometry_msgs/Vector3\n",
+    "float64 x\n",
+    "float64 y\n",
+    "float64 z\n",
+);
 
 /// An estimate's angle in radians, as published: the `f32` degrees widened to `f64` exactly,
 /// then multiplied by `PI / 180` in `f64` ([`f64::to_radians`], the same operation as Python's

@@ -280,7 +280,7 @@ fn stopping_early_and_dropping_when_behind() {
                 match out {
                     Output::Estimate(_) => std::thread::sleep(Duration::from_micros(200)),
                     Output::Notice(Notice::Dropped { .. }) => notices += 1,
-                    Output::Notice(_) => {}
+                    Output::Notice(_) | Output::Frames(_) => {}
                 }
                 ControlFlow::Continue(())
             },

@@ -110,6 +110,12 @@ pub struct Args {
     /// estimate's time, on `<topic>/label` and `<topic>/truth`.
     #[arg(long, value_name = "FILE")]
     pub mcap: Option<PathBuf>,
+    /// Also log the representation's binary frames to the --mcap file, HZ times per second of
+    /// event time (at the estimate times), as `sensor_msgs/msg/Image` (mono8, 0 and 255) on
+    /// `<topic>/frames/static`, `/dynamic` and `/combined`: the parts the model's
+    /// representation has. E.g. 30 for a video-like log.
+    #[arg(long, value_name = "HZ", requires = "mcap")]
+    pub mcap_frames: Option<f64>,
 }
 
 impl Args {
@@ -235,8 +241,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sensor = opened.resolution.with_context(|| {
         format!("{spec} does not state the sensor size: give it with --sensor WIDTHxHEIGHT")
     })?;
-    let estimator = Estimator::for_model(&model, sensor, interval_us)
+    let mut estimator = Estimator::for_model(&model, sensor, interval_us)
         .with_context(|| format!("setting up the estimator for {}", args.model.display()))?;
+    if let Some(hz) = args.mcap_frames {
+        if !(hz.is_finite() && hz > 0.0 && hz <= 1e6) {
+            anyhow::bail!("--mcap-frames {hz}: give frames per second, above 0 and at most 1e6");
+        }
+        estimator.capture_frames((1e6 / hz).round() as i64)?;
+    }
 
     let to_stdout = args.output.is_none();
     // The file appears when the run ends without error (Ctrl-C included): a run that fails
@@ -323,6 +335,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                         return ControlFlow::Break(());
                     }
                 }
+                Output::Frames(frames) => {
+                    if let Some(log) = &mut log
+                        && let Err(e) = log.write_frames(&frames)
+                    {
+                        log_error = Some(e);
+                        return ControlFlow::Break(());
+                    }
+                }
                 Output::Notice(n) => say(&n),
             }
             if max_duration.is_some_and(|d| started.elapsed() >= d) {
@@ -360,10 +380,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     if let Some(log) = log {
         let written = log.written();
+        let frame_sets = log.frame_sets_written();
         log.finish()?;
         if let Some(path) = &args.mcap {
+            let frames = if args.mcap_frames.is_some() {
+                format!(" and {frame_sets} frame set(s)")
+            } else {
+                String::new()
+            };
             say(&format_args!(
-                "logged {written} estimate(s) to {}",
+                "logged {written} estimate(s){frames} to {}",
                 path.display()
             ));
         }

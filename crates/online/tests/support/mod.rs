@@ -198,6 +198,7 @@ pub fn run_to_end(
         match out {
             Output::Estimate(e) => on_estimate(e),
             Output::Notice(n) => notices.push(n),
+            Output::Frames(_) => {}
         }
         ControlFlow::Continue(())
     })
