@@ -11,6 +11,9 @@ With `count` (the soak test: an hour of samples would not fit a list), nothing i
 stops it prints one line `count N backwards B first_us F last_us L` (samples received, stamps not
 later than the one before, first and last stamp in microseconds), then `end`.
 
+With `poll` (the latency benchmark), the reader is polled in a loop instead of waited on, so
+`recv_ns` is when Cyclone had the sample, not when the operating system woke Python up.
+
 Prints `ready` once the reader exists, then, when it stops, one line per sample received,
 `recv_ns sec nanosec frame_id x y z` (recv_ns: wall clock, time.time_ns(), when the sample was
 taken; floats as repr, which round-trips exactly), then `end`.
@@ -47,7 +50,8 @@ class Vector3Stamped_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3Stam
     vector: Vector3_
 
 domain, topic, idle_s, deadline_s = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
-count_only = len(sys.argv) > 5 and sys.argv[5] == "count"
+mode = sys.argv[5] if len(sys.argv) > 5 else ""
+count_only, poll = mode == "count", mode == "poll"
 count, backwards, first_us, last_us = 0, 0, None, None
 dp = DomainParticipant(domain)
 tp = Topic(dp, topic, Vector3Stamped_)
@@ -67,7 +71,8 @@ while True:
     now = time.monotonic()
     if now - start > deadline_s or (last is not None and now - last > idle_s):
         break
-    ws.wait(duration(milliseconds=50))
+    if not poll:
+        ws.wait(duration(milliseconds=50))
     samples = reader.take(N=1000)
     t = time.time_ns()
     for s in samples:
