@@ -49,6 +49,10 @@ pub enum Error {
     /// mid-stream: events are cropped and put in time order before they reach it).
     #[error("representation: {0}")]
     Representation(#[from] evtac_repr::ReprError),
+    /// Frames were asked for after events had been processed (the representation would have
+    /// to start over).
+    #[error("frames must be asked for before the first events are processed")]
+    FramesTooLate,
 }
 
 /// One estimate of the contact angle.
@@ -167,14 +171,15 @@ impl Estimator {
     /// accumulator is then no longer deferred (its potentials are read for the static frame):
     /// the same estimates, a little more work per estimate. Before the first chunk only.
     pub fn capture_frames(&mut self, every_us: i64) -> Result<(), Error> {
-        if self.counters.events == 0 {
-            self.extractor = FeatureExtractor::new(
-                std::slice::from_ref(&self.representation),
-                CROP,
-                self.mask.as_ref(),
-            )?;
-            self.frames = Some(FrameCapture::new(every_us));
+        if self.counters.events > 0 {
+            return Err(Error::FramesTooLate);
         }
+        self.extractor = FeatureExtractor::new(
+            std::slice::from_ref(&self.representation),
+            CROP,
+            self.mask.as_ref(),
+        )?;
+        self.frames = Some(FrameCapture::new(every_us));
         Ok(())
     }
 

@@ -116,6 +116,21 @@ fn frames_equal_offline_frames_and_change_no_estimate() {
     }
 }
 
+#[test]
+fn frames_asked_for_mid_stream_are_refused() {
+    let (_, repr) = support::representations()[2];
+    let dir = tempfile::tempdir().unwrap();
+    support::seeded_bundle(dir.path(), 5, &repr, None);
+    let model = Model::load(dir.path()).unwrap();
+    let mut estimator = Estimator::for_model(&model, SENSOR, 1000).unwrap();
+    let events = Synthetic::new(3, 300_000.0, 1000, 5_000).collect();
+    estimator
+        .process(&events, None, std::time::Instant::now(), &mut |_| {})
+        .unwrap();
+    let err = estimator.capture_frames(100_000).unwrap_err();
+    assert!(err.to_string().contains("before the first events"), "{err}");
+}
+
 /// Prints, for every image message of the MCAP file `argv[1]`: the reader, topic, type, log
 /// time, stamp, size, encoding, step and a hash of the pixels.
 const READ_IMAGES: &str = r#"
