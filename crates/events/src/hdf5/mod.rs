@@ -30,9 +30,10 @@
 //!
 //! Data is read in slices of 65,536 events, so memory holds a slice whatever size a dataset
 //! claims (a contiguous dataset's slice straight from its address in the file, `stored.rs`;
-//! the usual type combinations decoded in one pass over the four columns, `fused.rs`); before reading, each event dataset must be one-dimensional with elements of at most 8
-//! bytes, claim no more data than the file can hold and store every chunk inside the file (see
-//! `column.rs` for why), and an attribute is used only when it holds a handful of values.
+//! the usual type combinations decoded in one pass over the four columns, `fused.rs`). Before
+//! reading, each event dataset must be one-dimensional with elements of at most 8 bytes, claim
+//! no more data than the file can hold and store every chunk inside the file (see `column.rs`
+//! for why), and an attribute is used only when it holds a handful of values.
 
 mod column;
 mod fused;
