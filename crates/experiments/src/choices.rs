@@ -124,10 +124,25 @@ pub fn of_run(
                  the integrated tilt",
                 labels.filter_order, labels.cutoff_hz
             ),
-            "the paper says \"zero-phase filtered\" only; the cutoff keeps the robot's \
-             acceleration ramps and removes most of the gyroscope's white noise",
+            "the paper says \"zero-phase filtered\" only, and lists the filter before the \
+             integration: evtac reorders the two steps (integrates the rate, then filters the \
+             tilt; both linear, they differ only near the recording's ends); the cutoff keeps \
+             the robot's acceleration ramps and removes most of the gyroscope's white noise",
             "`evtac labels DATASET --cutoff-hz HZ` or `--config FILE` (`filter_order`), before \
              `evtac reproduce --data`",
+        ),
+        row(
+            "Label units and angles",
+            format!(
+                "degrees for labels, predictions and the loss, so SmoothL1's beta = {} is {} \
+                 deg; pitch = atan2(n_x, n_z), roll = atan2(n_y, n_z) of the plane's normal n in \
+                 the sensor frame (positive towards the sensor's +x and +y)",
+                train.huber_beta, train.huber_beta
+            ),
+            "the paper gives beta 1 without a unit and names pitch and roll without axes or \
+             signs; in radians the same beta would make the loss quadratic over the whole tilt \
+             (1 rad is 57 deg)",
+            "`crates/labels/src/geometry.rs`; the unit is fixed",
         ),
         row(
             "Label bias and scale",
@@ -214,12 +229,59 @@ pub fn of_run(
             "`evtac reproduce --scale`; `crates/experiments/src/plan.rs`",
         ),
         row(
+            "Trial timeline",
+            exp1_sim.map_or(recorded.into(), |sim| {
+                let t = &sim.timeline;
+                format!(
+                    "indentation {} s (a cosine ramp), rest {} s, tilt to {} deg at the trial's \
+                     speed with {} deg/s^2 ramps, hold {} s; each trial's representation starts \
+                     at its recording's first event, so at motion onset the accumulator has the \
+                     indentation and the rest behind it",
+                    t.indent_s, t.settle_s, t.total_deg, t.accel_deg_s2, t.hold_s
+                )
+            }),
+            "the paper describes the motion, not the timing around it nor where the \
+             representation starts",
+            "`timeline` in `evtac simulate --params FILE`; `crates/experiments/src/cache.rs`",
+        ),
+        row(
             "Model selection",
             "lowest validation MAE (mean of pitch and roll), checkpoint at the best epoch \
              (earliest on ties)"
                 .into(),
             "the paper says \"best validation performance\" without its metric",
             "`crates/experiments/src/tuning.rs`, `crates/learn/src/training.rs`",
+        ),
+        row(
+            "Experiment 2 checkpoints",
+            "the epoch with the lowest validation MAE over the phases the setting trains on: \
+             motion for pause-motion, motion and stop for pause-motion-stop; continuous-only \
+             keeps Experiment 1's checkpoints"
+                .into(),
+            "the paper says \"best validation performance\" without saying over which phases",
+            "`crates/experiments/src/exp2.rs`",
+        ),
+        row(
+            "Experiment 3 levels and rule",
+            "the Experiment 1 models, not retrained, on a speed-wise and a depth-wise dataset; \
+             a level is seen when its trials are marked `group = seen` (else when Experiment 1 \
+             trained on it); per level, the MAE over all its trials' samples, mean ± std over \
+             the seeds; the levels are evtac's"
+                .into(),
+            "the paper gives 30 trials per level and says unseen levels are interpolated, but \
+             neither the levels nor their count",
+            "`crates/sim/src/protocol.rs` (the datasets' levels); \
+             `crates/experiments/src/exp3.rs`",
+        ),
+        row(
+            "MAE pooling",
+            format!(
+                "over samples: every sampled point of every test trial weighs the same (each \
+                 trial has the same {MOTION_POINTS} motion points, so trials weigh equally \
+                 within a phase)"
+            ),
+            "the paper does not say whether errors are averaged per sample or per trial",
+            "`crates/experiments/src/results.rs` (`Mae::of`)",
         ),
         row(
             "Overall MAE",
@@ -304,7 +366,10 @@ pub fn of_run(
             "Latency study",
             format!(
                 "intervals {} ms, up to {} test trials, the first seed's model of each \
-                 representation, one thread",
+                 representation, one thread; timed: the estimator's processing of each \
+                 estimate (crop, representation update, pooling, MLP, and the work done ahead \
+                 of it between estimates), events at recorded pace; not timed: reading the \
+                 recording, queueing",
                 list(&plan.latency_intervals_ms),
                 plan.latency_trials
             ),
@@ -347,6 +412,16 @@ mod tests {
             l.filter_order, l.cutoff_hz
         )));
         assert!(value(&c, "Label bias and scale").contains("`total-rotation`"));
+        assert!(value(&c, "Label units and angles").starts_with("degrees"));
+        assert!(value(&c, "Label units and angles").contains("beta = 1 is 1 deg"));
+        assert!(
+            value(&c, "Trial timeline")
+                .contains(&format!("indentation {} s", sim.timeline.indent_s))
+        );
+        assert!(value(&c, "MAE pooling").contains(&format!("{MOTION_POINTS} motion points")));
+        assert!(value(&c, "Experiment 2 checkpoints").contains("motion and stop"));
+        assert!(value(&c, "Experiment 3 levels and rule").contains("the levels are evtac's"));
+        assert!(value(&c, "Latency study").contains("not timed: reading"));
         assert!(value(&c, "Tuning grids").contains("a cross through 1000 ms, threshold 2"));
         assert!(value(&c, "Seeds").contains("seeds 7, 8"));
         assert!(value(&c, "Split balancing").starts_with("70:15:15"));
@@ -368,6 +443,7 @@ mod tests {
         let recorded = of_run(&Plan::for_scale(Scale::Paper), 0, None, None);
         assert!(value(&recorded, "Tuning grids").contains("every combination"));
         assert!(value(&recorded, "Simulated sensor").starts_with("recorded data"));
+        assert!(value(&recorded, "Trial timeline").starts_with("recorded data"));
         for choice in &c {
             assert!(
                 [&choice.what, &choice.value, &choice.why, &choice.change]

@@ -135,9 +135,9 @@ fn paper(v: (f64, f64)) -> String {
 }
 
 /// One sentence on an Experiment 3 axis's design: the seen and unseen levels of `axis` (e.g.
-/// `speed`) in `unit`, and how far each unseen level is from the nearest seen one, against the
-/// paper's `paper_gap` (1 deg/s, 0.25 mm).
-fn exp3_design(values: &[(f64, bool)], axis: &str, unit: &str, paper_gap: f64) -> String {
+/// `speed`) in `unit`, and how far each unseen level is from the nearest seen one. The paper
+/// gives neither its levels nor their count, so the sentence says these are evtac's.
+fn exp3_design(values: &[(f64, bool)], axis: &str, unit: &str) -> String {
     let list = |seen: bool| {
         let v: Vec<String> = values
             .iter()
@@ -157,35 +157,36 @@ fn exp3_design(values: &[(f64, bool)], axis: &str, unit: &str, paper_gap: f64) -
             .map(|&(s, _)| (s - v).abs())
             .min_by(f64::total_cmp)
     };
-    let widest = values
+    let gaps: Vec<f64> = values
         .iter()
         .filter(|&&(_, seen)| !seen)
         .filter_map(|&(v, _)| nearest_seen(v))
-        .fold(None, |m: Option<f64>, g| Some(m.map_or(g, |m| m.max(g))));
-    let spacing = match widest {
-        None => String::new(),
-        Some(w) if (w - paper_gap).abs() < 1e-9 => {
-            format!(" Each unseen {axis} is {w} {unit} from the nearest seen one, as in the paper.")
+        .collect();
+    let widest = gaps.iter().copied().reduce(f64::max);
+    let narrowest = gaps.iter().copied().reduce(f64::min);
+    let spacing = match (narrowest, widest) {
+        (Some(n), Some(w)) if (w - n).abs() < 1e-9 => {
+            format!(" Each unseen {axis} is {w} {unit} from the nearest seen one.")
         }
-        Some(w) => format!(
-            " Unseen {axis}s are up to {w} {unit} from the nearest seen one (the paper: \
-             {paper_gap} {unit}), so interpolation here is {} than in the paper.",
-            if w > paper_gap { "harder" } else { "easier" }
-        ),
+        (Some(n), Some(w)) => {
+            format!(" Unseen {axis}s are {n} to {w} {unit} from the nearest seen one.")
+        }
+        _ => String::new(),
     };
     format!(
-        "Seen {axis}s (in the training set, {unit}): {}; unseen: {}.{spacing}",
+        "Seen {axis}s (in the training set, {unit}): {}; unseen: {}.{spacing} The paper gives \
+         neither its levels nor their count: these are evtac's.",
         list(true),
         list(false)
     )
 }
 
 /// An Experiment 3 table, after the sentence on its design.
-fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str), paper_gap: f64) {
+fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str)) {
     let mut values: Vec<(f64, bool)> = points.iter().map(|p| (p.value, p.seen)).collect();
     values.sort_by(|a, b| a.0.total_cmp(&b.0));
     values.dedup_by(|a, b| a.0 == b.0);
-    let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit, paper_gap));
+    let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit));
     let unit = format!("{axis} ({unit})");
     let names = ReprKind::in_order(points.iter().map(|p| p.name));
     let _ = writeln!(
@@ -388,11 +389,11 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         let _ = writeln!(md, "Not run: no speed-wise or depth-wise dataset.\n");
     } else {
         if !r.exp3_speed.is_empty() {
-            exp3_table(&mut md, &r.exp3_speed, ("speed", "deg/s"), 1.0);
+            exp3_table(&mut md, &r.exp3_speed, ("speed", "deg/s"));
             let _ = writeln!(md);
         }
         if !r.exp3_depth.is_empty() {
-            exp3_table(&mut md, &r.exp3_depth, ("depth", "mm"), 0.25);
+            exp3_table(&mut md, &r.exp3_depth, ("depth", "mm"));
             let _ = writeln!(md);
         }
     }
@@ -730,24 +731,34 @@ mod tests {
     }
 
     #[test]
-    fn the_exp3_design_sentence_compares_the_spacing_with_the_paper() {
-        let paper = [
+    fn the_exp3_design_sentence_gives_the_spacing_and_whose_levels_they_are() {
+        let even = [
             (2.0, true),
             (3.0, false),
             (4.0, true),
             (5.0, false),
             (6.0, true),
         ];
-        let s = exp3_design(&paper, "speed", "deg/s", 1.0);
+        let s = exp3_design(&even, "speed", "deg/s");
         assert!(s.starts_with("Seen speeds (in the training set, deg/s): 2, 4, 6; unseen: 3, 5."));
         assert!(
-            s.ends_with("1 deg/s from the nearest seen one, as in the paper."),
+            s.contains("Each unseen speed is 1 deg/s from the nearest seen one."),
             "{s}"
         );
-        let coarse = [(1.0, true), (1.5, false), (2.0, true)];
-        let s = exp3_design(&coarse, "depth", "mm", 0.25);
-        assert!(s.contains("up to 0.5 mm") && s.contains("harder"), "{s}");
+        assert!(
+            s.ends_with("The paper gives neither its levels nor their count: these are evtac's.")
+        );
+        assert!(!s.contains("as in the paper"));
+        let uneven = [
+            (1.0, true),
+            (1.25, false),
+            (2.0, true),
+            (2.5, false),
+            (3.0, true),
+        ];
+        let s = exp3_design(&uneven, "depth", "mm");
+        assert!(s.contains("0.25 to 0.5 mm"), "{s}");
         let none = [(1.0, true)];
-        assert!(exp3_design(&none, "depth", "mm", 0.25).ends_with("unseen: none."));
+        assert!(exp3_design(&none, "depth", "mm").contains("unseen: none. The paper"));
     }
 }
