@@ -464,7 +464,9 @@ fn noise_stats(
 type Gap = (f64, f64, f64);
 
 /// One sentence on what drives the dynamic - static gap, from the gaps measured at each noise
-/// level (ascending): whether it grows with the noise beyond the seeds' spread, and whether it
+/// level (ascending). Every pair of levels is compared, not only the ends: a change counts when
+/// two levels' gaps differ by more than their seeds' spreads added. The sentence says whether
+/// the gap changes at all, whether every change goes the same way as the noise, and whether it
 /// is there without noise (the lowest level).
 fn noise_verdict(gaps: &[Gap]) -> String {
     let list: Vec<String> = gaps
@@ -472,35 +474,68 @@ fn noise_verdict(gaps: &[Gap]) -> String {
         .map(|(l, g, _)| format!("{g:+.3} deg at x{l}"))
         .collect();
     let head = format!("Dynamic minus static test MAE: {}.", list.join(", "));
-    let (Some(&(lo, low, low_spread)), Some(&(hi, high, high_spread))) =
-        (gaps.first(), gaps.last())
-    else {
-        return head;
-    };
     if gaps.len() < 2 {
         return head;
     }
+    let levels: Vec<String> = gaps.iter().map(|(l, _, _)| format!("x{l}")).collect();
+    let levels = levels.join(", ");
+    // (lower level, higher level, change of the gap) for each pair that differs beyond spread.
+    let mut changes: Vec<(f64, f64, f64)> = Vec::new();
+    for (i, &(li, gi, si)) in gaps.iter().enumerate() {
+        for &(lj, gj, sj) in &gaps[i + 1..] {
+            if (gj - gi).abs() > si + sj {
+                changes.push((li, lj, gj - gi));
+            }
+        }
+    }
+    let (lo, low, _) = gaps[0];
     let reference = gaps
         .iter()
         .find(|(l, _, _)| *l == 1.0)
-        .map_or(high, |&(_, g, _)| g);
-    let verdict = if high - low <= low_spread + high_spread {
+        .map_or(gaps[gaps.len() - 1].1, |&(_, g, _)| g);
+    let pairs = |sign: f64| {
+        let v: Vec<String> = changes
+            .iter()
+            .filter(|c| c.2 * sign > 0.0)
+            .map(|(a, b, _)| format!("x{a} to x{b}"))
+            .collect();
+        v.join(", ")
+    };
+    let verdict = if changes.is_empty() {
         format!(
-            "From x{lo} to x{hi} the gap does not grow beyond the seeds' spread, so these runs \
-             do not tie it to the simulator's background noise: in evtac's data it is the \
-             representations' own."
+            "At no two of the levels ({levels}) do the gaps differ by more than the seeds' \
+             spread, so these runs do not tie the gap to the simulator's background noise: in \
+             evtac's data it is the representations' own."
         )
-    } else if low.abs() < 0.5 * reference.abs() {
+    } else if changes.iter().all(|c| c.2 > 0.0) {
+        let grows = pairs(1.0);
+        if low.abs() < 0.5 * reference.abs() {
+            format!(
+                "The gap grows with the noise beyond the seeds' spread ({grows}; no pair of \
+                 levels shows it shrink) and mostly vanishes without noise (x{lo}), so in \
+                 evtac's data the simulator's background noise drives it (the dynamic window at \
+                 threshold 0 keeps every noise event; the static threshold and mask remove \
+                 most), not the representations themselves."
+            )
+        } else {
+            format!(
+                "The gap grows with the noise beyond the seeds' spread ({grows}; no pair of \
+                 levels shows it shrink) but stays at x{lo}, so background noise widens it while \
+                 most of it is the representations' own in evtac's data."
+            )
+        }
+    } else if changes.iter().all(|c| c.2 < 0.0) {
         format!(
-            "The gap grows from x{lo} to x{hi} and mostly vanishes without noise, so in evtac's \
-             data the simulator's background noise drives it (the dynamic window at threshold 0 \
-             keeps every noise event; the static threshold and mask remove most), not the \
-             representations themselves."
+            "The gap shrinks as the noise grows, beyond the seeds' spread ({}), so background \
+             noise does not drive it in evtac's data.",
+            pairs(-1.0)
         )
     } else {
         format!(
-            "The gap grows from x{lo} to x{hi} but stays at x{lo}, so background noise widens it \
-             while most of it is the representations' own in evtac's data."
+            "The gap rises ({}) and falls ({}) between levels beyond the seeds' spread: no trend \
+             with the noise, so these runs do not tie it to the background noise either way.",
+            pairs(1.0),
+            pairs(-1.0)
         )
     };
     format!("{head} {verdict}")
@@ -721,12 +756,21 @@ mod tests {
         assert!(own.contains("widens it"), "{own}");
         let flat = noise_verdict(&[(0.0, 0.3, 0.05), (1.0, 0.2, 0.05), (3.0, 0.2, 0.05)]);
         assert!(
-            flat.contains("does not grow beyond the seeds' spread"),
+            flat.contains("At no two of the levels (x0, x1, x3)"),
             "{flat}"
         );
         // A rise within the seeds' spread is no evidence.
         let spread = noise_verdict(&[(0.0, 0.01, 0.3), (1.0, 0.4, 0.3), (3.0, 0.5, 0.3)]);
-        assert!(spread.contains("does not grow beyond"), "{spread}");
+        assert!(spread.contains("At no two of the levels"), "{spread}");
+        // The ends alike, the middle apart: seen only by comparing every level.
+        let middle = noise_verdict(&[(0.0, 0.1, 0.01), (1.0, 0.5, 0.01), (3.0, 0.1, 0.01)]);
+        assert!(
+            middle.contains("rises (x0 to x1) and falls (x1 to x3)"),
+            "{middle}"
+        );
+        let shrinks = noise_verdict(&[(0.0, 0.5, 0.01), (1.0, 0.3, 0.01), (3.0, 0.3, 0.01)]);
+        assert!(shrinks.contains("shrinks"), "{shrinks}");
+        assert!(shrinks.contains("x0 to x1, x0 to x3"), "{shrinks}");
         assert!(!noise_verdict(&[(1.0, 0.3, 0.0)]).contains("gap"));
     }
 

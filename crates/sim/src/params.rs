@@ -353,6 +353,14 @@ impl Default for TimelineParams {
     }
 }
 
+/// The ABB IRB 120's position repeatability (ISO 9283 RP), millimetres: its product
+/// specification's figure. The paper's robot.
+pub const IRB120_RP_MM: f64 = 0.01;
+
+/// The lever from the robot's wrist to the sensor's tip, millimetres (assumed: the NeuroTac's
+/// length plus its mount), over which a position error becomes a tilt error.
+pub const WRIST_TO_TIP_MM: f64 = 150.0;
+
 /// The rig's imperfections, drawn per trial ([`crate::rig::TrialErrors`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -371,10 +379,16 @@ pub struct RigParams {
 }
 
 impl Default for RigParams {
+    /// The robot's figures from the paper's robot's specification, not tuned to any result:
+    /// the ABB IRB 120's position repeatability is 0.01 mm (ISO 9283 RP, which is about three
+    /// standard deviations), so one standard deviation is 0.0033 mm of height, and over the
+    /// ~150 mm from the wrist to the tip 0.0033 / 150 rad = 0.0013 deg of tilt (both rounded
+    /// to two figures, as `docs/simulator.md` states them; the test `rig_from_the_irb120`
+    /// checks the rounding against [`IRB120_RP_MM`] and [`WRIST_TO_TIP_MM`]).
     fn default() -> Self {
         Self {
-            angle_sd_deg: 0.035,
-            plane_height_sd_mm: 0.03,
+            angle_sd_deg: 0.0013,
+            plane_height_sd_mm: 0.0033,
             rolling_centre_sd_mm: 0.5,
             patch_offset_sd_mm: 0.02,
         }
@@ -395,6 +409,19 @@ impl RigParams {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn rig_from_the_irb120() {
+        let sd_mm = IRB120_RP_MM / 3.0;
+        let sd_deg = (sd_mm / WRIST_TO_TIP_MM).to_degrees();
+        let rig = RigParams::default();
+        let two_figures = |v: f64| {
+            let scale = 10f64.powf(1.0 - v.log10().floor());
+            (v * scale).round() / scale
+        };
+        assert_eq!(rig.plane_height_sd_mm, two_figures(sd_mm));
+        assert_eq!(rig.angle_sd_deg, two_figures(sd_deg));
+    }
     use super::*;
 
     #[test]

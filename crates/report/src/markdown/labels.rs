@@ -39,9 +39,11 @@ pub fn section(check: Option<&LabelCheck>) -> String {
     if let Some(r) = &check.truth_rms_deg {
         md.push_str(&format!(
             " Against the simulator's exact ground truth, the labels' RMS error over pitch and \
-             roll is {:.3} deg per trial on average (at most {:.3}, {} trials): on simulated \
-             data the stop check measures mostly the robot's repeatability, which the simulator \
-             draws (`rig.angle_sd_deg` in `docs/simulator.md`).",
+             roll is {:.3} deg per trial on average (at most {:.3}, {} trials). On simulated \
+             data the stop check measures the labels' own error together with the robot's \
+             repeatability, which the simulator takes from the ABB IRB 120's specification \
+             (`rig.angle_sd_deg` in `docs/simulator.md`), not tuned to the paper's spread: a \
+             tighter or wider spread than the paper's is a finding about the simulated rig.",
             r.mean, r.max, r.n
         ));
     }
