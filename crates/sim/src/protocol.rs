@@ -113,11 +113,12 @@ impl Scale {
 
     /// The levels and trial counts of this scale.
     ///
-    /// Every scale keeps the paper's Experiment 3 design: the unseen speeds lie halfway between
-    /// seen ones, 1 deg/s from the nearest (seen 2, 4, ..., 10; unseen 3, 5, ..., 9), and the
-    /// unseen depths 0.25 mm from the nearest (seen 1.0, 1.5, ..., 3.0; unseen the quarter
-    /// steps), so an unseen level is as far from training data as in the paper. Smaller scales
-    /// take fewer levels or directions, never a coarser spacing.
+    /// Every scale keeps one Experiment 3 design, evtac's (the paper gives neither its levels
+    /// nor their count, only 30 trials per level and that unseen levels are interpolated): the
+    /// unseen speeds lie halfway between seen ones, 1 deg/s from the nearest (seen 2, 4, ..., 10;
+    /// unseen 3, 5, ..., 9), and the unseen depths 0.25 mm from the nearest (seen 1.0, 1.5, ...,
+    /// 3.0; unseen the quarter steps). Smaller scales take fewer levels or directions, never a
+    /// coarser spacing.
     pub fn design(self) -> Design {
         let directions = |n: usize| (0..n).map(|i| 360.0 * i as f64 / n as f64).collect();
         match self {
