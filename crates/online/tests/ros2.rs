@@ -483,14 +483,18 @@ fn waits(attempts: u32) -> NetworkOptions {
     }
 }
 
-/// Opening a ROS 2 input in `domain` on loopback, the type from discovery.
-fn loopback_input(domain: u16, network: NetworkOptions) -> OpenOptions {
+/// Opening a ROS 2 input in `domain` on loopback, of type `message` (`None`: from discovery).
+fn loopback_input(
+    domain: u16,
+    network: NetworkOptions,
+    message: Option<EventMessage>,
+) -> OpenOptions {
     OpenOptions {
         network,
         ros2: Ros2InputOptions {
             domain,
             interfaces: vec![IpAddr::V4(Ipv4Addr::LOCALHOST)],
-            message: None,
+            message,
         },
         ..OpenOptions::default()
     }
@@ -498,11 +502,10 @@ fn loopback_input(domain: u16, network: NetworkOptions) -> OpenOptions {
 
 /// Subscribes to `/event_camera/events` in `domain` on loopback and estimates until the input
 /// ends.
-fn live_run(domain: u16, model: &Model, network: NetworkOptions) -> LiveRun {
+fn live_run(domain: u16, model: &Model, options: &OpenOptions) -> LiveRun {
     let spec: SourceSpec = "ros2:///event_camera/events".parse().unwrap();
-    let options = loopback_input(domain, network);
     let mut notices = Vec::new();
-    let opened = input::open(&spec, &options, &mut |n| notices.push(n)).unwrap();
+    let opened = input::open(&spec, options, &mut |n| notices.push(n)).unwrap();
     let report = opened.ros2_input.clone().expect("a ROS 2 input reports");
     let sensor = opened
         .resolution
@@ -564,11 +567,12 @@ struct Published {
 }
 
 /// Starts a publisher (see [`EventPublisher::start`]) in a domain of its own for `test`,
-/// estimates from its topic (ending after 1 s of silence and `attempts` waits of 200 ms), and
-/// replays the bag of what it sent; `None` when the tools are missing outside CI.
+/// estimates from its topic (of type `message`, else the discovered one; ending after 1 s of
+/// silence and `attempts` waits of 200 ms), and replays the bag of what it sent; `None` when
+/// the tools are missing outside CI.
 fn publish_and_estimate(
     test: u32,
-    kind: &str,
+    (kind, message): (&str, Option<EventMessage>),
     reliability: &str,
     count_end_broken: [&str; 3],
     attempts: u32,
@@ -578,7 +582,11 @@ fn publish_and_estimate(
     let bag = dir.path().join("published.mcap");
     let mut publisher = EventPublisher::start(domain, kind, reliability, count_end_broken, &bag)?;
     let model = model(&dir.path().join("model"));
-    let run = live_run(domain, &model, waits(attempts));
+    let run = live_run(
+        domain,
+        &model,
+        &loopback_input(domain, waits(attempts), message),
+    );
     let published = publisher.published();
     let from_bag = file_run(&bag, &model);
     Some(Published {
@@ -601,7 +609,8 @@ fn assert_varied(estimates: &[Estimate]) {
 #[test]
 fn evt3_packets_from_a_ros2_publisher_estimate_as_their_bag_and_the_raw_file() {
     // A default rclpy publisher's QoS: reliable.
-    let Some(p) = publish_and_estimate(4, "packet", "reliable", ["all", "leave", "-1"], 0) else {
+    let Some(p) = publish_and_estimate(4, ("packet", None), "reliable", ["all", "leave", "-1"], 0)
+    else {
         return;
     };
     let stats = &p.run.stats;
@@ -643,7 +652,9 @@ fn evt3_packets_from_a_ros2_publisher_estimate_as_their_bag_and_the_raw_file() {
 #[test]
 fn dvs_event_arrays_from_a_best_effort_publisher_estimate_as_their_bag() {
     // A sensor driver's QoS: best effort, which a reliable reader would not match.
-    let Some(p) = publish_and_estimate(5, "array", "best_effort", ["all", "leave", "-1"], 0) else {
+    let Some(p) =
+        publish_and_estimate(5, ("array", None), "best_effort", ["all", "leave", "-1"], 0)
+    else {
         return;
     };
     let stats = &p.run.stats;
@@ -663,9 +674,29 @@ fn dvs_event_arrays_from_a_best_effort_publisher_estimate_as_their_bag() {
 }
 
 #[test]
+fn a_type_given_by_option_subscribes_best_effort_and_matches_a_reliable_publisher() {
+    let message = Some(EventMessage::EventArray);
+    let Some(p) =
+        publish_and_estimate(8, ("array", message), "reliable", ["all", "leave", "-1"], 0)
+    else {
+        return;
+    };
+    let stats = &p.run.stats;
+    assert_eq!(stats.message, message);
+    assert!(!stats.reliable, "nothing known of the writers: best effort");
+    assert_eq!(
+        (stats.samples, stats.lost, stats.malformed, stats.events),
+        (p.published, 0, 0, 219_596),
+        "{stats}"
+    );
+    support::assert_same_estimates(&p.run.estimates, &p.from_bag);
+}
+
+#[test]
 fn a_broken_packet_is_skipped_and_a_publisher_that_stops_is_reported_and_the_run_ends() {
     // 40 packets, the 20th cut by a byte, then silence while the publisher stays in the domain.
-    let Some(p) = publish_and_estimate(6, "packet", "reliable", ["40", "stay", "19"], 2) else {
+    let Some(p) = publish_and_estimate(6, ("packet", None), "reliable", ["40", "stay", "19"], 2)
+    else {
         return;
     };
     let stats = &p.run.stats;
@@ -727,7 +758,7 @@ fn a_topic_nobody_publishes_fails_naming_topic_and_domain() {
         connect_timeout: Duration::from_millis(300),
         ..waits(1)
     };
-    let options = loopback_input(domain, network);
+    let options = loopback_input(domain, network, None);
     let mut notices = Vec::new();
     let started = Instant::now();
     let e = input::open(&spec, &options, &mut |n| notices.push(n.to_string())).unwrap_err();
