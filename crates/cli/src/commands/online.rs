@@ -5,6 +5,9 @@
 //! would be mostly time spent queueing; its summary reports the processing time per estimate
 //! instead and says that latency needs `--realtime`.
 //!
+//! With `--input ros2:///TOPIC` the events come from a ROS 2 camera driver's topic over DDS
+//! (`evtac_online::input::Ros2Source`).
+//!
 //! With `--ros2 TOPIC` every estimate is also published on ROS 2 (`evtac_online::ros2`), without
 //! holding the estimation up; the CSV output goes on alongside. With `--mcap FILE` the same
 //! messages are logged to an MCAP file (`evtac_online::mcap_log`) that Foxglove and `rosbags`
