@@ -24,6 +24,11 @@ const SKIP: &[(&str, &str)] = &[
         "a live DV network stream (tests/online.rs serves one on loopback)",
     ),
     (
+        "--input ros2://",
+        "a ROS 2 camera driver's topic (tests/online.rs and the online crate's tests/ros2.rs \
+         publish one on loopback)",
+    ),
+    (
         "--executor slurm",
         "a Slurm cluster (tests/slurm.rs runs reproduce on a local slurmctld/slurmd)",
     ),

@@ -26,6 +26,14 @@ fn csv_events() -> String {
     csv.replace("true", "1").replace("false", "0")
 }
 
+/// Cyclone DDS on loopback only, discovering peers by unicast to 127.0.0.1 (as the online
+/// crate's ROS 2 tests run it).
+const CYCLONE_LOOPBACK: &str = "<CycloneDDS><Domain id=\"any\"><General><Interfaces>\
+     <NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast>\
+     </General><Discovery><ParticipantIndex>auto</ParticipantIndex>\
+     <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers>\
+     <Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
+
 fn rows(csv: &str) -> Vec<Vec<String>> {
     csv.lines()
         .skip(1)
@@ -296,15 +304,10 @@ fn ros2_publishes_what_the_csv_holds() {
         1 + (std::process::id() ^ std::time::UNIX_EPOCH.elapsed().unwrap().subsec_nanos()) % 230;
     let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../online/tests/support/ros2_subscriber.py");
-    let cyclone_loopback = "<CycloneDDS><Domain id=\"any\"><General><Interfaces>\
-         <NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast>\
-         </General><Discovery><ParticipantIndex>auto</ParticipantIndex>\
-         <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers>\
-         <Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
     let mut subscriber = std::process::Command::new(python)
         .arg(script)
         .args([&domain.to_string(), "rt/robot/contact_angle", "3", "120"])
-        .env("CYCLONEDDS_URI", cyclone_loopback)
+        .env("CYCLONEDDS_URI", CYCLONE_LOOPBACK)
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
@@ -420,6 +423,175 @@ fn ros2_flags_are_checked() {
         msg.contains("0 of 1 ROS 2 subscriber(s) matched on /contact_angle in domain 231"),
         "{msg}"
     );
+    // The ROS 2 input's flags.
+    let msg = run_err(&with(&["--ros-domain", "9"]));
+    assert!(
+        msg.contains("--ros-domain and --ros-interface are for --ros2 and ros2:// inputs"),
+        "{msg}"
+    );
+    let msg = run_err(&with(&["--ros-event-type", "dvs_msgs/msg/EventArray"]));
+    assert!(
+        msg.contains("--ros-event-type is the message type of a ros2:// input"),
+        "{msg}"
+    );
+    let ros2_input = ["online", "--model", m, "--input", "ros2:///nobody/events"];
+    let msg = run_err(
+        &[
+            &ros2_input[..],
+            &["--ros-event-type", "sensor_msgs/msg/Image"],
+        ]
+        .concat(),
+    );
+    assert!(
+        msg.contains("not an event message type evtac reads"),
+        "{msg}"
+    );
+    let msg = run_err(&["online", "--model", m, "--input", "ros2:///cam-0/events"]);
+    assert!(
+        msg.contains("input `ros2:///cam-0/events`: invalid ROS 2 topic name"),
+        "{msg}"
+    );
+    // Nobody publishes in this domain: opening fails, naming the topic and domain.
+    let started = std::time::Instant::now();
+    let msg = run_err(
+        &[
+            &ros2_input[..],
+            &["--ros-domain", "231", "--ros-interface", "127.0.0.1"],
+            &["--connect-timeout-s", "0.3", "--reconnect-attempts", "0"],
+        ]
+        .concat(),
+    );
+    assert!(
+        msg.contains(
+            "could not reach ros2:///nobody/events: no publisher of /nobody/events (DDS \
+             rt/nobody/events) discovered in domain 231 within 0.3 s"
+        ) && msg.contains(
+            "no sample on ROS 2 topic /nobody/events (DDS rt/nobody/events) in domain 231 after 1 \
+             attempts"
+        ),
+        "{msg}"
+    );
+    assert!(started.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// `--input ros2://`: a Cyclone DDS publisher (the online crate's
+/// `tests/support/ros2_publisher.py`, a default rclpy publisher's QoS) sends the real EVT3
+/// fixture's words as `event_camera_msgs/msg/EventPacket`s; the estimates equal, row for row
+/// and bit for bit, those of the same events from files: the MCAP bag of the messages sent,
+/// and the camera's `.raw` file. The publisher leaves after its last packet, and the run ends a
+/// stall timeout later with the input's summary line.
+#[test]
+fn ros2_input_estimates_as_the_same_events_from_files() {
+    use std::io::{BufRead, BufReader};
+    let Some(python) = evtac_testkit::python_with("cyclonedds") else {
+        return;
+    };
+    if evtac_testkit::python_with("mcap").is_none() {
+        return;
+    }
+    let (Some(raw), Some(npy)) = (
+        evtac_testkit::real_fixture("prophesee_gen4_1280x720.evt3.raw"),
+        evtac_testkit::real_fixture("prophesee_gen4_1280x720.evt3.expected.npy"),
+    ) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    bundle(&model);
+    let bag = dir.path().join("published.mcap");
+    let domain =
+        1 + (std::process::id() ^ std::time::UNIX_EPOCH.elapsed().unwrap().subsec_nanos()) % 230;
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../online/tests/support/ros2_publisher.py");
+    let mut publisher = std::process::Command::new(python)
+        .arg(script)
+        .args([
+            &domain.to_string(),
+            "rt/event_camera/events",
+            "packet",
+            "reliable",
+        ])
+        .args([raw.as_os_str(), npy.as_os_str(), bag.as_os_str()])
+        .args(["all", "leave"])
+        .env("CYCLONEDDS_URI", CYCLONE_LOOPBACK)
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let m = model.to_str().unwrap();
+    let estimate = |input: &str, out: &Path, extra: &[&str]| {
+        evtac()
+            .args([
+                "online",
+                "--model",
+                m,
+                "--input",
+                input,
+                "--interval-ms",
+                "0.1",
+            ])
+            .args(["--output", out.to_str().unwrap()])
+            .args(extra)
+            .env_remove("ROS_DOMAIN_ID")
+            .output()
+            .unwrap()
+    };
+    let live = dir.path().join("live.csv");
+    let run = estimate(
+        "ros2:///event_camera/events",
+        &live,
+        &[
+            "--ros-domain",
+            &domain.to_string(),
+            "--ros-interface",
+            "127.0.0.1",
+            "--connect-timeout-s",
+            "60",
+            "--stall-timeout-s",
+            "1",
+            "--reconnect-attempts",
+            "0",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let said: Vec<String> = BufReader::new(publisher.stdout.take().unwrap())
+        .lines()
+        .map(Result::unwrap)
+        .collect();
+    let _ = publisher.kill();
+    assert!(run.status.success(), "evtac online failed: {stderr}");
+    assert!(publisher.wait().is_ok());
+    let published = said
+        .iter()
+        .find_map(|l| l.strip_prefix("published "))
+        .unwrap_or_else(|| panic!("the publisher said {said:?}"));
+    assert!(
+        stderr.contains(&format!(
+            "ROS 2 input /event_camera/events (DDS rt/event_camera/events, \
+             event_camera_msgs/msg/EventPacket, reliable, domain {domain}): {published} samples, \
+             219596 events, 0 lost (sequence gaps), 0 malformed (skipped)"
+        )),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("lost ros2:///event_camera/events: no sample for 1.0 s"),
+        "{stderr}"
+    );
+    let live = rows(&std::fs::read_to_string(&live).unwrap());
+    assert!(live.len() >= 80, "{} estimates: {stderr}", live.len());
+    for file in [&bag, &raw] {
+        let out = dir.path().join("file.csv");
+        let run = estimate(file.to_str().unwrap(), &out, &[]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let from_file = rows(&std::fs::read_to_string(&out).unwrap());
+        assert_eq!(live.len(), from_file.len(), "{}", file.display());
+        for (a, b) in live.iter().zip(&from_file) {
+            assert_eq!(a[..3], b[..3], "{}", file.display());
+        }
+    }
 }
 
 /// In `dir`: a model, 50 ms of events as CSV, and the names of the estimates' CSV and the MCAP

@@ -125,6 +125,9 @@ pub struct Summary {
     /// What publishing on ROS 2 did, when the run published (set by the caller, who owns the
     /// publisher: see [`crate::ros2::Ros2Publisher::finish`]).
     pub ros2: Option<crate::ros2::PublishStats>,
+    /// What a ROS 2 input received, lost and skipped (set by the caller, who holds its
+    /// [`crate::input::Ros2InputReport`]).
+    pub ros2_input: Option<crate::input::Ros2InputStats>,
 }
 
 impl Summary {
@@ -150,6 +153,7 @@ impl Summary {
             span_us: None,
             wall: Duration::ZERO,
             ros2: None,
+            ros2_input: None,
         }
     }
 }
@@ -206,6 +210,9 @@ impl std::fmt::Display for Summary {
         }
         if self.reconnects > 0 {
             writeln!(f, "reconnections: {}", self.reconnects)?;
+        }
+        if let Some(input) = &self.ros2_input {
+            writeln!(f, "{input}")?;
         }
         if let Some(ros2) = &self.ros2 {
             writeln!(f, "{ros2}")?;

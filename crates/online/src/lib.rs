@@ -7,7 +7,7 @@
 //!
 //! - [`input`]: where events come from: a recording replayed as fast as possible or at
 //!   recorded pace ([`input::Paced`]), a live DV network stream with reconnection and backoff,
-//!   standard input, or memory.
+//!   a ROS 2 event topic over DDS ([`input::Ros2Source`]), standard input, or memory.
 //! - [`Estimator`]: the single-threaded core (crop, representation, MLP, latency and
 //!   processing-time stamps).
 //! - [`pipeline::run`]: ingestion and estimation on two threads with a bounded queue between.

@@ -1,4 +1,5 @@
-//! Things worth telling the user while a run goes on: connections lost, retried, given up.
+//! Things worth telling the user while a run goes on: connections lost, retried, given up;
+//! input skipped.
 //!
 //! The library never prints; the pipeline hands notices to its caller (the `evtac` binary prints
 //! them on stderr).
@@ -41,6 +42,25 @@ pub enum Notice {
         /// Why it failed.
         reason: String,
     },
+    /// Waiting for a silent input that cannot be reconnected to (a ROS 2 topic: DDS
+    /// delivers whatever comes); the first sample ends the wait.
+    Waiting {
+        /// The input.
+        input: String,
+        /// 1-based attempt number.
+        attempt: u32,
+        /// Attempts allowed in a row.
+        attempts: u32,
+        /// The longest this attempt waits.
+        wait: Duration,
+    },
+    /// A piece of the input that did not decode was skipped (a ROS 2 sample); the rest goes on.
+    Skipped {
+        /// The input.
+        input: String,
+        /// What was skipped and why.
+        reason: String,
+    },
     /// All reconnection attempts failed; the run ends after estimating what arrived.
     GaveUp {
         /// The input.
@@ -70,6 +90,17 @@ impl std::fmt::Display for Notice {
                 "reconnecting to {input} in {:.1} s (attempt {attempt} of {attempts})",
                 delay.as_secs_f64()
             ),
+            Self::Waiting {
+                input,
+                attempt,
+                attempts,
+                wait,
+            } => write!(
+                f,
+                "waiting up to {:.1} s more for {input} (attempt {attempt} of {attempts})",
+                wait.as_secs_f64()
+            ),
+            Self::Skipped { input, reason } => write!(f, "{input}: skipped {reason}"),
             Self::AttemptFailed {
                 input,
                 attempt,

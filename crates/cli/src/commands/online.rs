@@ -5,6 +5,9 @@
 //! would be mostly time spent queueing; its summary reports the processing time per estimate
 //! instead and says that latency needs `--realtime`.
 //!
+//! With `--input ros2:///TOPIC` the events come from a ROS 2 camera driver's topic over DDS
+//! (`evtac_online::input::Ros2Source`).
+//!
 //! With `--ros2 TOPIC` every estimate is also published on ROS 2 (`evtac_online::ros2`), without
 //! holding the estimation up; the CSV output goes on alongside. With `--mcap FILE` the same
 //! messages are logged to an MCAP file (`evtac_online::mcap_log`) that Foxglove and `rosbags`
@@ -12,8 +15,9 @@
 
 use anyhow::Context;
 use evtac_events::output::{OutputFile, refuse_input};
+use evtac_events::ros::EventMessage;
 use evtac_learn::Model;
-use evtac_online::input::{self, NetworkOptions, OpenOptions, SourceSpec};
+use evtac_online::input::{self, NetworkOptions, OpenOptions, Ros2InputOptions, SourceSpec};
 use evtac_online::mcap_log::{self, McapLog};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::ros2::{self, Ros2Options, Ros2Publisher};
@@ -32,9 +36,11 @@ pub struct Args {
     /// Model bundle folder (from `evtac train`): weights, representation settings, mask.
     #[arg(long)]
     pub model: PathBuf,
-    /// Event source: a recording (any format evtac reads: AEDAT, EVT, CSV, NPY, NPZ, HDF5, the
-    /// NeuroTac pickles), a live DV network stream `tcp://HOST:PORT`, or `-` for standard input
-    /// (AEDAT4 or CSV).
+    /// Event source: a recording (any format evtac reads: AEDAT, EVT, CSV, NPY, NPZ, HDF5, ROS
+    /// bags, the NeuroTac pickles), a live DV network stream `tcp://HOST:PORT`, a ROS 2 topic
+    /// `ros2:///TOPIC` (event_camera_msgs/msg/EventPacket or dvs_msgs/msg/EventArray, over DDS,
+    /// no ROS installation needed; see docs/online.md), or `-` for standard input (AEDAT4 or
+    /// CSV).
     #[arg(long)]
     pub input: String,
     /// Interval between estimates, in milliseconds of event time.
@@ -66,7 +72,8 @@ pub struct Args {
     /// tails, see docs/online.md).
     #[arg(long)]
     pub busy_poll: bool,
-    /// Reconnection attempts in a row for a network input before the run ends.
+    /// Reconnection attempts in a row for a network input before the run ends (for a ROS 2
+    /// input: waits for a silent topic, each as long as the reconnection delay).
     #[arg(long, default_value_t = Backoff::default().attempts)]
     pub reconnect_attempts: u32,
     /// First reconnection delay in milliseconds (doubling up to `--reconnect-max-ms`).
@@ -75,9 +82,14 @@ pub struct Args {
     /// Longest reconnection delay in milliseconds.
     #[arg(long, default_value_t = Backoff::default().max.as_millis() as u64)]
     pub reconnect_max_ms: u64,
-    /// Seconds without data after which a network stream counts as stalled and is reopened.
+    /// Seconds without data after which a network stream counts as stalled and is reopened (a
+    /// ROS 2 input: reported lost and waited for).
     #[arg(long, default_value_t = NetworkOptions::default().stall_timeout.as_secs_f64())]
     pub stall_timeout_s: f64,
+    /// Seconds to wait for a network input's connection, or for a ROS 2 input's publisher and
+    /// first sample, before the reconnection attempts begin.
+    #[arg(long, default_value_t = NetworkOptions::default().connect_timeout.as_secs_f64())]
+    pub connect_timeout_s: f64,
     /// Stop after this many seconds of wall-clock time (checked at each estimate).
     #[arg(long)]
     pub max_duration_s: Option<f64>,
@@ -89,13 +101,20 @@ pub struct Args {
     /// `header.frame_id` of the ROS 2 messages and of the MCAP log's (default `neurotac`).
     #[arg(long)]
     pub frame_id: Option<String>,
-    /// ROS 2 (DDS) domain id, 0 to 232; `ROS_DOMAIN_ID` when absent, else 0.
-    #[arg(long, requires = "ros2")]
+    /// ROS 2 (DDS) domain id, 0 to 232, of `--ros2` and of a `ros2://` input; `ROS_DOMAIN_ID`
+    /// when absent, else 0.
+    #[arg(long)]
     pub ros_domain: Option<u16>,
     /// Use only the network interface with this address for ROS 2 discovery and data (e.g.
-    /// `127.0.0.1` to stay on this host); repeat for several. Every interface when absent.
-    #[arg(long, value_name = "ADDR", requires = "ros2")]
+    /// `127.0.0.1` to stay on this host), for `--ros2` and a `ros2://` input; repeat for
+    /// several. Every interface when absent.
+    #[arg(long, value_name = "ADDR")]
     pub ros_interface: Vec<IpAddr>,
+    /// The message type of a `ros2://` input, `event_camera_msgs/msg/EventPacket` or
+    /// `dvs_msgs/msg/EventArray`, instead of the type its publisher is discovered with (the
+    /// reader is then best effort; see docs/online.md).
+    #[arg(long, value_name = "TYPE", value_parser = parse_event_message)]
+    pub ros_event_type: Option<EventMessage>,
     /// Before reading the input, wait until this many ROS 2 subscribers are matched (so that
     /// none misses the first estimates), for at most `--ros2-wait-timeout-s`.
     #[arg(long, value_name = "COUNT", requires = "ros2")]
@@ -123,6 +142,25 @@ impl Args {
     fn frame_id(&self) -> &str {
         self.frame_id.as_deref().unwrap_or("neurotac")
     }
+}
+
+/// `--ros-event-type`: a ROS 2 event message type in any spelling.
+fn parse_event_message(s: &str) -> Result<EventMessage, String> {
+    EventMessage::of(s).ok_or_else(|| {
+        format!(
+            "`{s}` is not an event message type evtac reads ({} or {})",
+            EventMessage::EventPacket,
+            EventMessage::EventArray
+        )
+    })
+}
+
+/// The ROS 2 domain: `--ros-domain`, else `ROS_DOMAIN_ID`, else 0.
+fn ros_domain(args: &Args) -> anyhow::Result<u16> {
+    Ok(match args.ros_domain {
+        Some(domain) => domain,
+        None => ros2::domain_from_env()?.unwrap_or(0),
+    })
 }
 
 fn seconds(what: &str, s: f64) -> anyhow::Result<Duration> {
@@ -154,10 +192,7 @@ fn ros2_publisher(
     topic: &str,
     say: &dyn Fn(&dyn std::fmt::Display),
 ) -> anyhow::Result<Ros2Publisher> {
-    let domain = match args.ros_domain {
-        Some(domain) => domain,
-        None => ros2::domain_from_env()?.unwrap_or(0),
-    };
+    let domain = ros_domain(args)?;
     let publisher = Ros2Publisher::new(Ros2Options {
         topic: topic.to_owned(),
         frame_id: args.frame_id().to_owned(),
@@ -194,6 +229,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let interval_us = interval_us as i64;
     let spec: SourceSpec = args.input.parse()?;
+    let ros2_input = matches!(spec, SourceSpec::Ros2 { .. });
+    if (args.ros_domain.is_some() || !args.ros_interface.is_empty())
+        && args.ros2.is_none()
+        && !ros2_input
+    {
+        anyhow::bail!(
+            "--ros-domain and --ros-interface are for --ros2 and ros2:// inputs: give either"
+        );
+    }
+    if args.ros_event_type.is_some() && !ros2_input {
+        anyhow::bail!("--ros-event-type is the message type of a ros2:// input: give one");
+    }
     // A file without --realtime is the one source that runs ahead of the estimator; live
     // streams (network, standard input) come at their own pace.
     let paced = args.realtime || !matches!(spec, SourceSpec::File(_));
@@ -209,9 +256,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 attempts: args.reconnect_attempts,
             },
             stall_timeout: seconds("--stall-timeout-s", args.stall_timeout_s)?,
-            ..NetworkOptions::default()
+            connect_timeout: seconds("--connect-timeout-s", args.connect_timeout_s)?,
         },
         streams: args.streams.selection(),
+        ros2: Ros2InputOptions {
+            domain: if ros2_input { ros_domain(&args)? } else { 0 },
+            interfaces: args.ros_interface.clone(),
+            message: args.ros_event_type,
+        },
     };
     let max_duration = args
         .max_duration_s
@@ -353,9 +405,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     let flushed = out.flush();
     let ros2 = publisher.map(Ros2Publisher::finish);
+    let ros2_input = opened
+        .ros2_input
+        .as_ref()
+        .map(input::Ros2InputReport::stats);
     let with_pace = |mut summary: Summary| {
         summary.paced = paced;
         summary.ros2 = ros2;
+        summary.ros2_input = ros2_input;
         summary
     };
     let summary = match result {

@@ -52,6 +52,7 @@
 
 mod bag1;
 mod mcap2;
+mod message;
 mod msg;
 mod stream;
 
@@ -63,11 +64,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::aedat::{SelectionError, StreamChoice, StreamSelection};
-use crate::evt::Evt3Decoder;
-use crate::{Error, Event, Format, ImuSample, Resolution, Trigger};
+use crate::{Error, Format, ImuSample, Resolution};
 pub(crate) use stream::BagEvents;
 use stream::Decoder;
 
+pub use message::{EventMessage, MessageDecoder, MessageError};
 pub use msg::STANDARD_GRAVITY;
 
 /// The ROS 1 bag magic (version 2.0, the only one in use since ROS C Turtle).
@@ -730,69 +731,6 @@ pub(crate) fn read(
         topics,
         note,
     })
-}
-
-/// Why an `EventPacket` did not decode.
-enum PacketError {
-    Encoding,
-    Other(String),
-}
-
-/// Decodes one `EventPacket`'s events into `events` (and the EVT3 triggers into `triggers`).
-fn decode_packet(
-    p: &msg::EventPacket<'_>,
-    evt3: &mut Evt3Decoder,
-    events: &mut Vec<Event>,
-    triggers: &mut Vec<Trigger>,
-) -> Result<(), PacketError> {
-    if p.is_bigendian && matches!(p.encoding, "evt3" | "mono") {
-        return Err(PacketError::Other(format!(
-            "field `is_bigendian` is true; the drivers write `{}` words little-endian and evtac \
-             reads no other",
-            p.encoding
-        )));
-    }
-    let whole = |word: usize| {
-        if p.events.len().is_multiple_of(word) {
-            Ok(())
-        } else {
-            Err(PacketError::Other(format!(
-                "field `events` at byte {} of the message holds {} bytes, not whole {word}-byte \
-                 `{}` words",
-                p.events_offset,
-                p.events.len(),
-                p.encoding
-            )))
-        }
-    };
-    match p.encoding {
-        "evt3" => {
-            whole(2)?;
-            evt3.decode(p.events, events, triggers);
-        }
-        "mono" => {
-            whole(8)?;
-            events.reserve(p.events.len() / 8);
-            for (i, w) in p.events.chunks_exact(8).enumerate() {
-                let word = u64::from_le_bytes(w.try_into().expect("8 bytes"));
-                let ns = u128::from(p.time_base) + u128::from(word & 0xFFFF_FFFF);
-                let t = i64::try_from(ns / 1000).map_err(|_| {
-                    PacketError::Other(format!(
-                        "event {i}: time_base {} + dt overflows the microsecond clock",
-                        p.time_base
-                    ))
-                })?;
-                events.push(Event {
-                    t,
-                    x: (word >> 32) as u16,
-                    y: ((word >> 48) & 0x7FFF) as u16,
-                    polarity: word >> 63 == 1,
-                });
-            }
-        }
-        _ => return Err(PacketError::Encoding),
-    }
-    Ok(())
 }
 
 /// Decodes the IMU topic `topic` of `c`: one sample per message, ordered by header stamp

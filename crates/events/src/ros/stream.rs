@@ -8,20 +8,19 @@
 //! (a sample per message) is still decoded whole, so that each chunk carries the samples up to
 //! its last event. An `EventPacket`'s triggers are handed out with the events of their message.
 
-use super::{Collector, Kind, PacketError, RosError, decode_packet, msg};
+use super::{Collector, EventMessage, Kind, MessageDecoder, MessageError, RosError};
 use crate::check::EventCheck;
-use crate::evt::Evt3Decoder;
 use crate::{Chunk, Event, ImuSample, Resolution, Trigger};
 
 /// Events per chunk handed out (a chunk ends at a message boundary past this many).
 const CHUNK: usize = 1 << 16;
 
 /// The decoding state of one event topic: which message is next, the sensor size the first
-/// message stated, the checks and the EVT3 decoder whose state carries across packets.
+/// message stated, the checks and the message decoder (whose EVT3 state carries across
+/// packets; the same one a live ROS 2 input decodes its samples with).
 #[derive(Debug)]
 pub(super) struct Decoder {
     topic: usize,
-    encoding: msg::Encoding,
     /// The topic's messages (indexes into its kept messages) in receive-time order.
     order: Vec<usize>,
     /// The next message, as an index into `order`.
@@ -29,7 +28,7 @@ pub(super) struct Decoder {
     /// The size the first message states.
     first: Option<Resolution>,
     check: EventCheck,
-    evt3: Evt3Decoder,
+    messages: MessageDecoder,
 }
 
 impl Decoder {
@@ -38,28 +37,28 @@ impl Decoder {
     pub(super) fn new(c: &Collector, topic: usize) -> Result<Self, RosError> {
         let t = &c.topics[topic];
         let encoding = t.msg_encoding()?;
+        let message = match t.kind {
+            Kind::EventArray => EventMessage::EventArray,
+            _ => EventMessage::EventPacket,
+        };
+        let messages = MessageDecoder::new(message, encoding);
         let order = t.in_order();
         let first = match order.first() {
             None => None,
             Some(&i) => {
                 let kept = &t.messages[i];
-                let bytes = c.bytes(kept);
-                let size = match t.kind {
-                    Kind::EventArray => msg::event_array_size(bytes, encoding),
-                    _ => msg::event_packet(bytes, encoding).map(|p| p.size),
-                };
+                let size = messages.size(c.bytes(kept));
                 Some(size.map_err(|e| t.message_error(0, kept.place, e))?)
             }
         };
         let stated = first.filter(|s| s.pixels() > 0);
         Ok(Self {
             topic,
-            encoding,
             order,
             next: 0,
             first,
             check: EventCheck::new(stated),
-            evt3: Evt3Decoder::default(),
+            messages,
         })
     }
 
@@ -92,26 +91,18 @@ impl Decoder {
         let bytes = c.bytes(m);
         let fail = |what: &dyn std::fmt::Display| topic.message_error(index, m.place, what);
         let start = events.len();
-        let size = match topic.kind {
-            Kind::EventArray => {
-                msg::event_array(bytes, self.encoding, events).map_err(|e| fail(&e))?
-            }
-            _ => {
-                let packet = msg::event_packet(bytes, self.encoding).map_err(|e| fail(&e))?;
-                decode_packet(&packet, &mut self.evt3, events, triggers).map_err(
-                    |what| match what {
-                        PacketError::Encoding => RosError::Encoding {
-                            topic: topic.info.name.clone(),
-                            index,
-                            place: m.place.to_string(),
-                            encoding: packet.encoding.to_string(),
-                        },
-                        PacketError::Other(what) => fail(&what),
-                    },
-                )?;
-                packet.size
-            }
-        };
+        let size = self
+            .messages
+            .decode(bytes, events, triggers)
+            .map_err(|e| match e {
+                MessageError::Encoding { encoding } => RosError::Encoding {
+                    topic: topic.info.name.clone(),
+                    index,
+                    place: m.place.to_string(),
+                    encoding,
+                },
+                other => fail(&other),
+            })?;
         if let Some(first) = self.first
             && first != size
         {

@@ -2,13 +2,15 @@
 //!
 //! [`EventSource`] is the one interface the ingestion thread pulls from. Implementations: a
 //! recording on disk ([`FileSource`]), a live DV network stream with reconnection
-//! ([`NetworkSource`]), standard input ([`StdinSource`]), events in memory ([`MemorySource`]),
-//! and [`Paced`], which replays any of them at recorded pace.
+//! ([`NetworkSource`]), a ROS 2 event topic over DDS ([`Ros2Source`]), standard input
+//! ([`StdinSource`]), events in memory ([`MemorySource`]), and [`Paced`], which replays any of
+//! them at recorded pace.
 
 mod file;
 mod memory;
 mod network;
 mod paced;
+mod ros2;
 mod spec;
 mod stdin;
 
@@ -16,6 +18,7 @@ pub use file::FileSource;
 pub use memory::MemorySource;
 pub use network::{NetworkOptions, NetworkSource};
 pub use paced::Paced;
+pub use ros2::{Ros2InputOptions, Ros2InputReport, Ros2InputStats, Ros2Source};
 pub use spec::{Error as SpecError, SourceSpec};
 pub use stdin::StdinSource;
 
@@ -100,8 +103,11 @@ pub struct OpenOptions {
     pub slice_us: i64,
     /// Sensor size for inputs that do not state it (CSV, NPY); checked against those that do.
     pub sensor: Option<Resolution>,
-    /// Connection and reconnection of network inputs.
+    /// Connection and reconnection of network inputs; for a ROS 2 topic, the stall timeout
+    /// and the attempts to wait for it.
     pub network: NetworkOptions,
+    /// Domain, interfaces and message type of a ROS 2 input.
+    pub ros2: Ros2InputOptions,
     /// Which streams of an AEDAT4 file with several (two cameras) to replay.
     pub streams: evtac_events::aedat::StreamSelection,
 }
@@ -112,6 +118,8 @@ pub struct Opened {
     pub source: Box<dyn EventSource>,
     /// The sensor size (from the input, else the declared one), if known.
     pub resolution: Option<Resolution>,
+    /// For a ROS 2 input, its samples, losses and skips, readable while and after it runs.
+    pub ros2_input: Option<Ros2InputReport>,
 }
 
 impl std::fmt::Debug for Opened {
@@ -123,7 +131,8 @@ impl std::fmt::Debug for Opened {
 }
 
 /// Opens `spec`: a file (paced when `options.realtime`), a network stream (connected, header
-/// read, with retries), or standard input. `notify` hears about connection attempts.
+/// read, with retries), a ROS 2 topic (its publisher found and its first sample received, with
+/// retries), or standard input. `notify` hears about connection attempts.
 pub fn open(
     spec: &SourceSpec,
     options: &OpenOptions,
@@ -148,22 +157,23 @@ pub fn open(
             Opened {
                 source: pace(Box::new(source)),
                 resolution,
+                ros2_input: None,
             }
         }
         SourceSpec::Tcp { host, port } => {
             let source = NetworkSource::connect(host, *port, options.network, notify)?;
-            if let (Some(declared), Some(found)) = (options.sensor, source.resolution())
-                && declared != found
-            {
-                return Err(InputError::Format {
-                    input: source.name().to_string(),
-                    reason: format!(
-                        "the stream says the sensor is {found}, but {declared} was given"
-                    ),
-                });
-            }
-            let resolution = source.resolution().or(options.sensor);
+            let resolution = stated(source.name(), options.sensor, source.resolution())?;
             Opened {
+                source: Box::new(source),
+                resolution,
+                ros2_input: None,
+            }
+        }
+        SourceSpec::Ros2 { topic } => {
+            let source = Ros2Source::open(topic, options.ros2.clone(), options.network, notify)?;
+            let resolution = stated(source.name(), options.sensor, source.resolution())?;
+            Opened {
+                ros2_input: Some(source.report()),
                 source: Box::new(source),
                 resolution,
             }
@@ -174,7 +184,26 @@ pub fn open(
             Opened {
                 source: pace(Box::new(source)),
                 resolution,
+                ros2_input: None,
             }
         }
     })
+}
+
+/// The sensor size of a live input: the one it states, checked against a declared one, else the
+/// declared one.
+fn stated(
+    input: &str,
+    declared: Option<Resolution>,
+    found: Option<Resolution>,
+) -> Result<Option<Resolution>, InputError> {
+    if let (Some(declared), Some(found)) = (declared, found)
+        && declared != found
+    {
+        return Err(InputError::Format {
+            input: input.to_string(),
+            reason: format!("the stream says the sensor is {found}, but {declared} was given"),
+        });
+    }
+    Ok(found.or(declared))
 }

@@ -21,7 +21,8 @@ use std::time::Duration;
 pub struct NetworkOptions {
     /// Retry policy after a loss (also used for the first connection).
     pub backoff: Backoff,
-    /// Longest wait for a TCP connection to open.
+    /// Longest wait for a TCP connection to open; for a ROS 2 input, for its publisher to be
+    /// discovered and its first sample to arrive.
     pub connect_timeout: Duration,
     /// A connection silent for this long is considered stalled and reopened.
     pub stall_timeout: Duration,

@@ -1,7 +1,7 @@
-//! Where events come from: a file, a live DV network stream, or standard input.
+//! Where events come from: a file, a live DV network stream, a ROS 2 topic, or standard input.
 //!
 //! A [`SourceSpec`] is what the user typed (`--input`); it is parsed once, up front, so that a
-//! typo in `tcp://host:port` is reported before any model is loaded.
+//! typo in `tcp://host:port` or a ROS 2 topic name is reported before any model is loaded.
 
 use std::path::PathBuf;
 
@@ -17,6 +17,11 @@ pub enum SourceSpec {
         host: String,
         /// TCP port.
         port: u16,
+    },
+    /// A ROS 2 topic of events (`ros2:///event_camera/events`), subscribed to over DDS.
+    Ros2 {
+        /// The ROS 2 topic, absolute (`/event_camera/events`).
+        topic: String,
     },
     /// Standard input: an AEDAT4 file or network stream, or CSV text (told apart by the first
     /// bytes).
@@ -41,22 +46,44 @@ pub enum Error {
         /// The port text.
         port: String,
     },
+    /// A `ros2://` input whose topic name ROS 2 would refuse.
+    #[error(
+        "input `{input}`: {source} (the form is ros2:///TOPIC, e.g. ros2:///event_camera/events)"
+    )]
+    Ros2Topic {
+        /// The input as given.
+        input: String,
+        /// What is wrong with the name.
+        #[source]
+        source: crate::ros2::Error,
+    },
     /// An empty input string.
-    #[error("the input is empty (give a file path, tcp://HOST:PORT, or - for standard input)")]
+    #[error(
+        "the input is empty (give a file path, tcp://HOST:PORT, ros2:///TOPIC, or - for standard \
+         input)"
+    )]
     Empty,
 }
 
 impl std::str::FromStr for SourceSpec {
     type Err = Error;
 
-    /// Parses `-` (standard input), `tcp://HOST:PORT` (IPv6 hosts in brackets, `tcp://[::1]:7777`)
-    /// or a file path.
+    /// Parses `-` (standard input), `tcp://HOST:PORT` (IPv6 hosts in brackets, `tcp://[::1]:7777`),
+    /// `ros2:///TOPIC` (`ros2://TOPIC` too: ROS 2 topics are absolute here) or a file path.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         if s.is_empty() {
             return Err(Error::Empty);
         }
         if s == "-" {
             return Ok(Self::Stdin);
+        }
+        if let Some(rest) = s.strip_prefix("ros2://") {
+            let topic = format!("/{}", rest.trim_start_matches('/'));
+            crate::ros2::dds_topic_name(&topic).map_err(|source| Error::Ros2Topic {
+                input: s.to_string(),
+                source,
+            })?;
+            return Ok(Self::Ros2 { topic });
         }
         let Some(rest) = s.strip_prefix("tcp://") else {
             return Ok(Self::File(PathBuf::from(s)));
@@ -92,6 +119,7 @@ impl std::fmt::Display for SourceSpec {
             Self::File(path) => write!(f, "{}", path.display()),
             Self::Tcp { host, port } if host.contains(':') => write!(f, "tcp://[{host}]:{port}"),
             Self::Tcp { host, port } => write!(f, "tcp://{host}:{port}"),
+            Self::Ros2 { topic } => write!(f, "ros2://{topic}"),
             Self::Stdin => write!(f, "standard input"),
         }
     }
@@ -151,5 +179,32 @@ mod tests {
             Err(Error::TcpForm { .. })
         ));
         assert!(matches!("".parse::<SourceSpec>(), Err(Error::Empty)));
+    }
+
+    #[test]
+    fn ros2_topics_are_absolute_and_checked() {
+        for input in ["ros2:///event_camera/events", "ros2://event_camera/events"] {
+            let spec = input.parse::<SourceSpec>().unwrap();
+            assert_eq!(
+                spec,
+                SourceSpec::Ros2 {
+                    topic: "/event_camera/events".into()
+                },
+                "{input}"
+            );
+            assert_eq!(spec.to_string(), "ros2:///event_camera/events");
+        }
+        for bad in [
+            "ros2://",
+            "ros2:///",
+            "ros2:///cam/",
+            "ros2:///cam-0/events",
+        ] {
+            let e = bad.parse::<SourceSpec>().unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("input `{bad}`")) && e.contains("invalid ROS 2 topic name"),
+                "{bad}: {e}"
+            );
+        }
     }
 }

@@ -55,18 +55,21 @@ pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<Mask
 /// The estimates of `events` replayed from memory in chunks of `chunk_len` events: what a live,
 /// interrupted or reconnected run over the same events must give.
 pub fn replayed(model: &Model, events: &[Event], chunk_len: usize) -> Vec<Estimate> {
-    let mut estimates = Vec::new();
-    pipeline::run(
+    estimates_of(
         MemorySource::new(events.to_vec(), chunk_len),
         Estimator::for_model(model, SENSOR, 1000).unwrap(),
-        &PipelineConfig::default(),
-        |out| {
-            if let Output::Estimate(e) = out {
-                estimates.push(e);
-            }
-            ControlFlow::Continue(())
-        },
     )
+}
+
+/// Every estimate `estimator` makes from `source` through the pipeline.
+pub fn estimates_of<S: EventSource + 'static>(source: S, estimator: Estimator) -> Vec<Estimate> {
+    let mut estimates = Vec::new();
+    pipeline::run(source, estimator, &PipelineConfig::default(), |out| {
+        if let Output::Estimate(e) = out {
+            estimates.push(e);
+        }
+        ControlFlow::Continue(())
+    })
     .unwrap();
     estimates
 }

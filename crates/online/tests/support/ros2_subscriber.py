@@ -19,35 +19,13 @@ Prints `ready` once the reader exists, then, when it stops, one line per sample 
 taken; floats as repr, which round-trips exactly), then `end`.
 """
 import sys, time
-from dataclasses import dataclass
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.topic import Topic
 from cyclonedds.sub import DataReader
 from cyclonedds.core import Qos, Policy, WaitSet, ReadCondition, ViewState, InstanceState, SampleState
 from cyclonedds.util import duration
-from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.types import int32, uint32, float64
-
-@dataclass
-class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-    sec: int32
-    nanosec: uint32
-
-@dataclass
-class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-    stamp: Time_
-    frame_id: str
-
-@dataclass
-class Vector3_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
-    x: float64
-    y: float64
-    z: float64
-
-@dataclass
-class Vector3Stamped_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3Stamped_"):
-    header: Header_
-    vector: Vector3_
+# Beside this script (Python puts the script's folder first on the path).
+from ros2_types import Vector3Stamped_
 
 domain, topic, idle_s, deadline_s = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
 mode = sys.argv[5] if len(sys.argv) > 5 else ""
