@@ -511,23 +511,23 @@ fn noise_verdict(gaps: &[Gap]) -> String {
         let grows = pairs(1.0);
         if low.abs() < 0.5 * reference.abs() {
             format!(
-                "The gap grows with the noise beyond the seeds' spread ({grows}; no pair of \
-                 levels shows it shrink) and mostly vanishes without noise (x{lo}), so in \
+                "Where the gap changes beyond the seeds' spread ({grows}), it grows with the \
+                 noise, and it mostly vanishes without noise (x{lo}), so in \
                  evtac's data the simulator's background noise drives it (the dynamic window at \
                  threshold 0 keeps every noise event; the static threshold and mask remove \
                  most), not the representations themselves."
             )
         } else {
             format!(
-                "The gap grows with the noise beyond the seeds' spread ({grows}; no pair of \
-                 levels shows it shrink) but stays at x{lo}, so background noise widens it while \
+                "Where the gap changes beyond the seeds' spread ({grows}), it grows with the \
+                 noise, but it stays at x{lo}, so background noise widens it while \
                  most of it is the representations' own in evtac's data."
             )
         }
     } else if changes.iter().all(|c| c.2 < 0.0) {
         format!(
-            "The gap shrinks as the noise grows, beyond the seeds' spread ({}), so background \
-             noise does not drive it in evtac's data.",
+            "Where the gap changes beyond the seeds' spread ({}), it shrinks as the noise grows, \
+             so background noise does not drive it in evtac's data.",
             pairs(-1.0)
         )
     } else {
