@@ -212,20 +212,23 @@ fn real_data_setup(dir: &Path) -> Option<()> {
     Some(())
 }
 
-/// docs/online.md's setup: a trained model, a trial, and its events as CSV.
+/// docs/online.md's setup: a static and a combined model (the frames example), a trial, and
+/// its events as CSV.
 fn online_setup(dir: &Path) -> Option<()> {
     let data = dir.join("sim");
     crate::common::simulate_tiny("exp1", 31, &data, 4);
-    run_ok(&[
-        "train",
-        s(&data),
-        "--repr",
-        "static",
-        "--epochs",
-        "2",
-        "--out",
-        s(&dir.join("runs/static")),
-    ]);
+    for repr in ["static", "combined"] {
+        run_ok(&[
+            "train",
+            s(&data),
+            "--repr",
+            repr,
+            "--epochs",
+            "2",
+            "--out",
+            s(&dir.join("runs").join(repr)),
+        ]);
+    }
     let trial = dir.join("trial.aedat4");
     std::fs::copy(data.join("t0000.aedat4"), &trial).ok()?;
     run_ok(&["convert", s(&trial), s(&dir.join("events.csv"))]);
