@@ -261,6 +261,15 @@ impl Column {
         Ok(raw)
     }
 
+    /// The error refusing element `index`, for `reason`.
+    fn value_error(&self, index: usize, reason: String) -> Hdf5Error {
+        Hdf5Error::Value {
+            dataset: self.path.clone(),
+            index,
+            reason,
+        }
+    }
+
     /// Decodes the integers stored in `raw`, elements `start..start + out.len()`, into `out`,
     /// through `set(item, value)`, whose error is the reason element `start + i` is refused.
     pub(super) fn ints<T>(
@@ -276,11 +285,7 @@ impl Column {
                 reason: "float seconds read as integers".into(),
             });
         };
-        let fail = |i: usize, reason: String| Hdf5Error::Value {
-            dataset: self.path.clone(),
-            index: start + i,
-            reason,
-        };
+        let fail = |i: usize, reason: String| self.value_error(start + i, reason);
         // One loop per stored type, so each is a plain widening loop.
         macro_rules! each {
             ($t:ty, $n:literal) => {
@@ -317,11 +322,7 @@ impl Column {
         let Kind::Seconds { width } = self.kind else {
             return self.ints(raw, start, out, set);
         };
-        let fail = |i: usize, reason: String| Hdf5Error::Value {
-            dataset: self.path.clone(),
-            index: start + i,
-            reason,
-        };
+        let fail = |i: usize, reason: String| self.value_error(start + i, reason);
         let mut each = |i: usize, item: &mut T, s: f64| {
             let (us, fits) = microseconds(s);
             if !fits {
