@@ -361,7 +361,16 @@ fn ros2_publishes_what_the_csv_holds() {
         samples.push(line);
     }
     assert!(subscriber.wait().unwrap().success());
-    assert_eq!(samples.len(), rows.len(), "messages received vs CSV rows");
+    assert_eq!(
+        samples.len(),
+        rows.len(),
+        "messages received vs CSV rows; first received {:?}, first row {:?}; last received \
+         {:?}, last row {:?}",
+        samples.first(),
+        rows.first(),
+        samples.last(),
+        rows.last()
+    );
     for (row, sample) in rows.iter().zip(&samples) {
         let f: Vec<&str> = sample.split(' ').collect();
         let t_us: i64 = row[0].parse().unwrap();

@@ -42,6 +42,13 @@
 //! (volatile durability, as ROS 2's default). A run that must not miss its first estimates
 //! (a replay recorded with `ros2 bag record`, the interop test) waits for its subscribers first:
 //! [`Ros2Publisher::wait_for_subscribers`] (`evtac online --ros2-wait-subscribers N`).
+//!
+//! Discovery is two announcements crossing: the writer matches the reader when the reader's
+//! announcement arrives, the reader matches the writer when ours does, and the two need not
+//! happen together. A reliable, volatile reader (Cyclone's, as rclpy's) that matches the writer
+//! late starts at the writer's next sequence number, so what was written in between is lost to
+//! it (the likeliest cause of a CI run whose subscriber missed 7 of 401 estimates). RustDDS says when *it* matched, not
+//! when the reader did, so the wait adds [`DISCOVERY_SETTLE`] after the match.
 
 use crate::estimator::Estimate;
 use crate::latency::LatencyStats;
@@ -544,12 +551,14 @@ impl Ros2Publisher {
         self.shared.subscribers.load(Ordering::Relaxed)
     }
 
-    /// Waits until at least `count` subscribers are matched, or `timeout` passed; returns
-    /// whether they are.
+    /// Waits until at least `count` subscribers are matched, or `timeout` passed, then
+    /// [`DISCOVERY_SETTLE`] more for them to match the writer in turn; returns whether they are
+    /// matched.
     pub fn wait_for_subscribers(&self, count: usize, timeout: Duration) -> bool {
         let deadline = Instant::now() + timeout;
         loop {
             if self.subscribers() >= count {
+                std::thread::sleep(DISCOVERY_SETTLE);
                 return true;
             }
             if Instant::now() >= deadline {
@@ -616,6 +625,13 @@ impl Drop for Ros2Publisher {
         }
     }
 }
+
+/// How long [`Ros2Publisher::wait_for_subscribers`] waits, once the writer has matched its
+/// subscribers, for them to have matched the writer too. Both sides send their announcement
+/// as soon as they discover each other's participant, so the gap is the other process's
+/// handling of one message: well under a millisecond idle, a few milliseconds on a loaded
+/// 2-core machine; 250 ms leaves room for a starved process and is paid once per run.
+pub const DISCOVERY_SETTLE: Duration = Duration::from_millis(250);
 
 /// How often the idle publishing thread refreshes the subscriber count.
 const IDLE_POLL: Duration = Duration::from_millis(5);
