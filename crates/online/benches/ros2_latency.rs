@@ -11,6 +11,12 @@
 //! `cargo bench -p evtac-online --bench ros2_latency` (with `EVTAC_PYTHON` naming a Python
 //! that has `cyclonedds`); `EVTAC_ROS2_BENCH_RUNS` runs (5) of 3,000 estimates each. Prints each
 //! run's median, P99 and maximum, then all runs pooled.
+//!
+//! Where the time goes: with `EVTAC_ROS2_BENCH_DUMP=FILE` every estimate is appended to FILE as
+//! `t_us handed_ns received_ns`; `benches/ros2_hops.py` captures the datagrams on `lo` meanwhile
+//! (as root) and splits each estimate's time at the moment its DATA crossed loopback: evtac's
+//! side (the write, RustDDS's event loop waking and sending) and the subscriber's (Cyclone's
+//! receive thread waking and storing the sample, the polling loop finding it).
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -20,7 +26,7 @@ use evtac_online::Estimator;
 use evtac_online::input::{MemorySource, Paced};
 use evtac_online::pipeline::{self, Output, PipelineConfig};
 use evtac_online::ros2::Ros2Publisher;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
@@ -70,7 +76,15 @@ fn run(python: &PathBuf, model: &Model, run: u32) -> Vec<i128> {
     .expect("the run");
     let stats = publisher.finish();
     assert_eq!(stats.dropped(), 0, "{stats}");
+    eprintln!("{stats}");
     let mut added = Vec::with_capacity(handed.len());
+    let mut dump = std::env::var_os("EVTAC_ROS2_BENCH_DUMP").map(|path| {
+        std::fs::OpenOptions::new()
+            .append(true)
+            .create(true)
+            .open(path)
+            .expect("the dump opens")
+    });
     for line in lines.map_while(Result::ok) {
         if line == "end" {
             break;
@@ -81,6 +95,9 @@ fn run(python: &PathBuf, model: &Model, run: u32) -> Vec<i128> {
         let t_us = sec * 1_000_000 + nanosec / 1000;
         if let Ok(k) = handed.binary_search_by_key(&t_us, |&(t, _)| t) {
             added.push(recv - handed[k].1);
+            if let Some(dump) = &mut dump {
+                writeln!(dump, "{t_us} {} {recv}", handed[k].1).expect("the dump is written");
+            }
         }
     }
     let _ = child.wait();

@@ -29,14 +29,21 @@
 //! `ros2 node list` shows no evtac node (`ros2 topic list/echo/info` work as usual).
 //!
 //! # Nothing blocks estimation
-//! [`Ros2Publisher::publish`] never waits: it stamps the hand-over time and puts the estimate
-//! into a bounded queue ([`QUEUE`] messages) for a publishing thread, which serializes it and
-//! hands it to the DDS writer. RustDDS's reliable writer keeps up to 8192 samples that a
-//! subscriber has not acknowledged; when that window is full (a subscriber that stopped reading
-//! but did not leave), a write waits at most [`WRITE_BLOCKING`] and then gives up. A full queue
-//! or a write that gave up drops that estimate for ROS and counts it ([`PublishStats`]); the
-//! estimation and the CSV output go on untouched. No subscriber at all is not a drop: with
-//! volatile durability nobody is owed the message, and DDS discards it at once.
+//! [`Ros2Publisher::publish`] never waits: on the caller's thread it serializes the estimate
+//! and hands it to the DDS writer, whose own thread (RustDDS's event loop) puts it on the wire.
+//! RustDDS's reliable writer keeps up to 8192 samples that a subscriber has not acknowledged;
+//! the writer's QoS gives a write no time to wait for room ([`WRITE_BLOCKING`] is zero), so when
+//! that window is full (a subscriber that stopped reading but did not leave) the estimate is
+//! dropped for ROS at once and counted ([`PublishStats`]); the estimation and the CSV output go
+//! on untouched. No subscriber at all is not a drop: with volatile durability nobody is owed
+//! the message, and DDS discards it at once.
+//!
+//! An earlier version handed each estimate to a publishing thread of evtac's own through a
+//! queue. That thread was one more wake-up between the estimate and the wire, and on a shared
+//! core each wake-up is a scheduler's decision: it put the added latency's P99 at 176 us.
+//! What it protected against, a write that waits, the zero blocking time rules out. What a
+//! write still shares with RustDDS's event loop is the send buffer's lock, held for the
+//! moment of an insert or a send; the publish time in the summary is that write's duration.
 //!
 //! Messages published before a subscriber's discovery completes are not delivered to it
 //! (volatile durability, as ROS 2's default). A run that must not miss its first estimates
@@ -52,7 +59,6 @@
 
 use crate::estimator::Estimate;
 use crate::latency::LatencyStats;
-use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError, bounded};
 use rustdds::no_key::DataWriter;
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{
@@ -60,10 +66,8 @@ use rustdds::{
     RepresentationIdentifier, StatusEvented, TopicKind,
 };
 use serde::{Deserialize, Serialize};
+use std::cell::{Cell, RefCell};
 use std::net::IpAddr;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// The DDS type name of `geometry_msgs/msg/Vector3Stamped`.
@@ -76,13 +80,9 @@ pub const TYPE_NAME: &str = "geometry_msgs::msg::dds_::Vector3Stamped_";
 /// Keep-last with any depth matches a default subscription.
 pub const HISTORY_DEPTH: i32 = 1000;
 
-/// Estimates the queue to the publishing thread holds before further ones are dropped: a
-/// quarter of a second at one estimate per millisecond.
-pub const QUEUE: usize = 256;
-
 /// Longest a write waits for room in the reliable writer's window before the estimate is
-/// dropped (see the module docs).
-pub const WRITE_BLOCKING: Duration = Duration::from_millis(5);
+/// dropped: not at all, since the write runs on the caller's thread (see the module docs).
+pub const WRITE_BLOCKING: Duration = Duration::ZERO;
 
 /// How long [`Ros2Publisher::finish`] waits for subscribers to acknowledge what was published,
 /// so that a run's last estimates are not lost by the participant leaving.
@@ -328,9 +328,6 @@ pub enum Error {
         #[source]
         source: rustdds::dds::CreateError,
     },
-    /// The publishing thread could not be started.
-    #[error("cannot start the ROS 2 publishing thread: {0}")]
-    Thread(#[source] std::io::Error),
 }
 
 /// Where and how to publish.
@@ -370,29 +367,28 @@ pub struct PublishStats {
     pub domain: u16,
     /// Estimates handed to the DDS writer.
     pub published: u64,
-    /// Estimates dropped because the queue to the publishing thread was full.
-    pub dropped_queue_full: u64,
-    /// Estimates dropped because the writer gave up (its reliable window stayed full for
-    /// [`WRITE_BLOCKING`], or it failed).
+    /// Estimates dropped because the writer refused them: its reliable window was full (a
+    /// subscriber that stopped acknowledging), or it failed.
     pub dropped_write: u64,
     /// Subscribers matched when the run ended.
     pub subscribers: usize,
     /// Whether every subscriber acknowledged every published estimate before the publisher
     /// left (waited for up to [`LINGER`]).
     pub acknowledged: bool,
-    /// From [`Ros2Publisher::publish`] to the DDS writer having taken the message (serialized
-    /// and in its send buffer; RustDDS's own thread puts it on the wire): median, P99, max.
+    /// How long [`Ros2Publisher::publish`] took on the caller's thread (serializing, and the
+    /// DDS writer taking the message into its send buffer; RustDDS's own thread puts it on the
+    /// wire): median, P99, max.
     pub latency_median: Duration,
-    /// P99 of the publish latency.
+    /// P99 of the publish time.
     pub latency_p99: Duration,
-    /// Largest publish latency.
+    /// Longest publish time.
     pub latency_max: Duration,
 }
 
 impl PublishStats {
     /// Estimates not published, for any reason.
     pub fn dropped(&self) -> u64 {
-        self.dropped_queue_full + self.dropped_write
+        self.dropped_write
     }
 }
 
@@ -401,15 +397,13 @@ impl std::fmt::Display for PublishStats {
         let us = |d: Duration| d.as_secs_f64() * 1e6;
         writeln!(
             f,
-            "ROS 2 {} (DDS {}, domain {}): {} published, {} dropped ({} queue full, {} write \
-             gave up), {} subscriber(s) at the end{}",
+            "ROS 2 {} (DDS {}, domain {}): {} published, {} dropped (writer's window full), \
+             {} subscriber(s) at the end{}",
             self.topic,
             self.dds_topic,
             self.domain,
             self.published,
             self.dropped(),
-            self.dropped_queue_full,
-            self.dropped_write,
             self.subscribers,
             if self.acknowledged {
                 ""
@@ -419,7 +413,7 @@ impl std::fmt::Display for PublishStats {
         )?;
         write!(
             f,
-            "ROS 2 publish latency (estimate handed over to DDS writer done): median {:.1} us, \
+            "ROS 2 publish time (the DDS write, on the thread that delivers estimates): median {:.1} us, \
              P99 {:.1} us, max {:.1} us",
             us(self.latency_median),
             us(self.latency_p99),
@@ -428,32 +422,22 @@ impl std::fmt::Display for PublishStats {
     }
 }
 
-/// Counters shared between the caller and the publishing thread.
-#[derive(Debug, Default)]
-struct Shared {
-    dropped_queue_full: AtomicU64,
-    subscribers: AtomicUsize,
-}
-
 type Writer = DataWriter<Vector3Stamped>;
 
-/// What the publishing thread returns.
-struct Done {
-    published: u64,
-    dropped_write: u64,
-    latency: LatencyStats,
-    acknowledged: bool,
-    subscribers: usize,
-}
-
-/// Publishes estimates on a ROS 2 topic from a thread of its own (see the module docs).
+/// Publishes estimates on a ROS 2 topic, writing on the caller's thread (see the module docs).
+///
+/// Not `Sync`: one thread publishes.
 pub struct Ros2Publisher {
     options: Ros2Options,
     dds_topic: String,
-    tx: Option<Sender<(Estimate, Instant)>>,
-    shared: Arc<Shared>,
-    thread: Option<JoinHandle<Done>>,
-    // Dropped last (fields drop in order): the writer lives in the thread.
+    writer: Writer,
+    /// Subscribers matched, as of the latest status RustDDS reported.
+    subscribers: Cell<usize>,
+    published: Cell<u64>,
+    dropped_write: Cell<u64>,
+    /// How long each write took.
+    latency: RefCell<LatencyStats>,
+    // Dropped last (fields drop in order): the writer belongs to it.
     _participant: rustdds::DomainParticipant,
 }
 
@@ -520,22 +504,15 @@ impl Ros2Publisher {
         let writer: Writer = publisher
             .create_datawriter_no_key_cdr::<Vector3Stamped>(&topic, None)
             .map_err(create("data writer"))?;
-        let (tx, rx) = bounded(QUEUE);
-        let shared = Arc::new(Shared::default());
-        let thread = std::thread::Builder::new()
-            .name("evtac-ros2".into())
-            .spawn({
-                let shared = Arc::clone(&shared);
-                let frame_id = options.frame_id.clone();
-                move || publish_loop(&writer, &rx, &frame_id, &shared)
-            })
-            .map_err(Error::Thread)?;
         Ok(Self {
             options,
             dds_topic,
-            tx: Some(tx),
-            shared,
-            thread: Some(thread),
+            writer,
+            subscribers: Cell::new(0),
+            published: Cell::new(0),
+            dropped_write: Cell::new(0),
+            // The threshold of "late" is irrelevant here; only the quantiles are reported.
+            latency: RefCell::new(LatencyStats::new(Duration::from_millis(1))),
             _participant: participant,
         })
     }
@@ -545,10 +522,16 @@ impl Ros2Publisher {
         &self.dds_topic
     }
 
-    /// Subscribers matched to the writer, as of the publishing thread's latest look (it looks
-    /// every few milliseconds while idle, and after every message).
+    /// Subscribers matched to the writer now.
     pub fn subscribers(&self) -> usize {
-        self.shared.subscribers.load(Ordering::Relaxed)
+        // RustDDS reports matches as status events; the latest says how many are matched.
+        while let Some(status) = self.writer.try_recv_status() {
+            if let DataWriterStatus::PublicationMatched { current, .. } = status {
+                self.subscribers
+                    .set(usize::try_from(current.count()).unwrap_or(0));
+            }
+        }
+        self.subscribers.get()
     }
 
     /// Waits until at least `count` subscribers are matched, or `timeout` passed, then
@@ -568,60 +551,39 @@ impl Ros2Publisher {
         }
     }
 
-    /// Hands `estimate` to the publishing thread, never waiting: when its queue is full the
-    /// estimate is dropped and counted.
+    /// Writes `estimate` on the topic, never waiting: when the reliable writer's window is full
+    /// the estimate is dropped for ROS and counted.
     pub fn publish(&self, estimate: &Estimate) {
-        let Some(tx) = &self.tx else { return };
-        match tx.try_send((*estimate, Instant::now())) {
-            Ok(()) => {}
-            // Disconnected only if the thread died (a panic, reported by `finish`).
-            Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => {
-                self.shared
-                    .dropped_queue_full
-                    .fetch_add(1, Ordering::Relaxed);
+        let started = Instant::now();
+        let message = Vector3Stamped::from_estimate(estimate, &self.options.frame_id);
+        match self.writer.write(message, None) {
+            Ok(()) => {
+                self.latency.borrow_mut().record(started.elapsed());
+                self.published.set(self.published.get() + 1);
             }
+            Err(_) => self.dropped_write.set(self.dropped_write.get() + 1),
         }
     }
 
-    /// Publishes what is still queued, waits up to [`LINGER`] for the subscribers to
-    /// acknowledge everything, leaves the domain and returns the run's figures.
-    pub fn finish(mut self) -> PublishStats {
-        self.tx = None;
-        let done = self.thread.take().and_then(|t| t.join().ok());
-        let shared = &self.shared;
-        let dropped_queue_full = shared.dropped_queue_full.load(Ordering::Relaxed);
-        let mut stats = PublishStats {
+    /// Waits up to [`LINGER`] for the subscribers to acknowledge everything published, leaves
+    /// the domain and returns the run's figures.
+    pub fn finish(self) -> PublishStats {
+        let acknowledged = self
+            .writer
+            .wait_for_acknowledgments(LINGER)
+            .unwrap_or(false);
+        let latency = self.latency.borrow();
+        PublishStats {
             topic: self.options.topic.clone(),
             dds_topic: self.dds_topic.clone(),
             domain: self.options.domain,
-            published: 0,
-            dropped_queue_full,
-            dropped_write: 0,
-            subscribers: shared.subscribers.load(Ordering::Relaxed),
-            acknowledged: false,
-            latency_median: Duration::ZERO,
-            latency_p99: Duration::ZERO,
-            latency_max: Duration::ZERO,
-        };
-        if let Some(done) = done {
-            stats.published = done.published;
-            stats.dropped_write = done.dropped_write;
-            stats.subscribers = done.subscribers;
-            stats.acknowledged = done.acknowledged;
-            stats.latency_median = done.latency.quantile(0.5);
-            stats.latency_p99 = done.latency.quantile(0.99);
-            stats.latency_max = done.latency.max();
-        }
-        stats
-    }
-}
-
-impl Drop for Ros2Publisher {
-    fn drop(&mut self) {
-        // Not finished: still let the thread end before the participant goes.
-        self.tx = None;
-        if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+            published: self.published.get(),
+            dropped_write: self.dropped_write.get(),
+            subscribers: self.subscribers(),
+            acknowledged,
+            latency_median: latency.quantile(0.5),
+            latency_p99: latency.quantile(0.99),
+            latency_max: latency.max(),
         }
     }
 }
@@ -632,56 +594,6 @@ impl Drop for Ros2Publisher {
 /// handling of one message: well under a millisecond idle, a few milliseconds on a loaded
 /// 2-core machine; 250 ms leaves room for a starved process and is paid once per run.
 pub const DISCOVERY_SETTLE: Duration = Duration::from_millis(250);
-
-/// How often the idle publishing thread refreshes the subscriber count.
-const IDLE_POLL: Duration = Duration::from_millis(5);
-
-/// The publishing thread: messages from the queue to the writer until the queue closes.
-fn publish_loop(
-    writer: &Writer,
-    rx: &Receiver<(Estimate, Instant)>,
-    frame_id: &str,
-    shared: &Shared,
-) -> Done {
-    // RustDDS reports matches as status events; the latest says how many are matched now.
-    let mut subscribers = 0usize;
-    let mut count = |w: &Writer| {
-        while let Some(status) = w.try_recv_status() {
-            if let DataWriterStatus::PublicationMatched { current, .. } = status {
-                subscribers = usize::try_from(current.count()).unwrap_or(0);
-            }
-        }
-        subscribers
-    };
-    // The threshold of "late" is irrelevant here; only the quantiles are reported.
-    let mut latency = LatencyStats::new(WRITE_BLOCKING);
-    let (mut published, mut dropped_write) = (0u64, 0u64);
-    loop {
-        match rx.recv_timeout(IDLE_POLL) {
-            Ok((estimate, handed)) => {
-                let message = Vector3Stamped::from_estimate(&estimate, frame_id);
-                match writer.write(message, None) {
-                    Ok(()) => {
-                        latency.record(handed.elapsed());
-                        published += 1;
-                    }
-                    Err(_) => dropped_write += 1,
-                }
-            }
-            Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => break,
-        }
-        shared.subscribers.store(count(writer), Ordering::Relaxed);
-    }
-    let acknowledged = writer.wait_for_acknowledgments(LINGER).unwrap_or(false);
-    Done {
-        published,
-        dropped_write,
-        latency,
-        acknowledged,
-        subscribers: count(writer),
-    }
-}
 
 #[cfg(test)]
 mod tests {

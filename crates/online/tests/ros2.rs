@@ -166,7 +166,7 @@ fn a_cyclone_dds_subscriber_receives_every_estimate_with_its_values_and_stamp() 
         )),
         "{text}"
     );
-    assert!(text.contains("ROS 2 publish latency"), "{text}");
+    assert!(text.contains("ROS 2 publish time (the DDS write"), "{text}");
 
     let received = subscriber.received();
     assert_eq!(
@@ -250,16 +250,21 @@ fn publishing_never_waits_without_subscribers_or_with_a_flood() {
     support::assert_same_estimates(&got, &expected);
     assert_eq!(summary.estimates, got.len() as u64);
 
-    // A flood far beyond the queue: every call returns at once, and every estimate is either
-    // published or counted as dropped.
+    // A flood of 200 s of estimates in a loop: every call returns (no wait on anyone), and
+    // every estimate is either published or counted as dropped.
     let e = got[0];
     let started = Instant::now();
     let flood = 200_000u64;
     for _ in 0..flood {
         publisher.publish(&e);
     }
+    // Not a speed goal (0.34 s idle): a write that waited even a millisecond per call would
+    // take 200 s.
     let took = started.elapsed();
-    assert!(took < Duration::from_secs(2), "{flood} calls took {took:?}");
+    assert!(
+        took < Duration::from_secs(30),
+        "{flood} calls took {took:?}"
+    );
     let stats = publisher.finish();
     assert_eq!(
         stats.published + stats.dropped(),

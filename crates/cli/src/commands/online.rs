@@ -362,7 +362,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         |output| {
             match output {
                 Output::Estimate(e) => {
-                    // First: it only hands the estimate to the publishing thread.
+                    // First: the write only hands the message to the DDS writer, never waiting.
                     if let Some(publisher) = &publisher {
                         publisher.publish(&e);
                     }

@@ -51,8 +51,13 @@ while True:
         break
     if not poll:
         ws.wait(duration(milliseconds=50))
+    before = time.time_ns()
     samples = reader.take(N=1000)
-    t = time.time_ns()
+    # Polling, an empty take lasts about a microsecond, so a sample that this take returns
+    # reached the reader within about a microsecond of `before`; stamping after the take would
+    # add Python's decoding of the sample (tens of microseconds). Waking, the sample is
+    # stamped as the subscriber has it, decoded.
+    t = before if poll else time.time_ns()
     for s in samples:
         # The writer leaving comes as an invalid sample (instance state, no data).
         if not isinstance(s, Vector3Stamped_):
