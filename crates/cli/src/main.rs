@@ -68,6 +68,9 @@ enum Command {
     Tune(commands::tune::Args),
     /// Reproduce the paper end to end: simulate, label, tune, Experiments 1-3, latency, report.
     Reproduce(commands::reproduce::Args),
+    /// Which of the paper's conclusions survive the simulator: Experiment 1 with each unmeasured
+    /// simulator parameter at x0.5 and x1.5.
+    Sensitivity(commands::sensitivity::Args),
     /// Run one job of a jobs file (a Slurm array task's work).
     Jobs(commands::jobs::Args),
     /// Estimate contact angles online from a live or replayed event stream.
@@ -91,6 +94,7 @@ fn main() {
         Command::Predict(args) => commands::predict::run(args),
         Command::Tune(args) => commands::tune::run(args),
         Command::Reproduce(args) => commands::reproduce::run(args),
+        Command::Sensitivity(args) => commands::sensitivity::run(args),
         Command::Jobs(args) => commands::jobs::run(args),
         Command::Online(args) => commands::online::run(args),
     };

@@ -18,6 +18,7 @@ mod render_model;
 mod render_mp4;
 mod represent;
 mod reproduce;
+mod sensitivity;
 mod simulate;
 mod slurm;
 mod stats;

@@ -33,6 +33,15 @@ pub enum Error {
     /// The `done` marker of a simulated dataset could not be written.
     #[error(transparent)]
     Jobs(#[from] crate::jobs::Error),
+    /// A simulator parameter of the sensitivity study could not be scaled.
+    #[error(transparent)]
+    Perturb(#[from] crate::sensitivity::PerturbError),
+    /// Something a stage needs from an earlier one is not in its results.
+    #[error("missing {what}")]
+    Missing {
+        /// What is missing.
+        what: &'static str,
+    },
     /// The log of stage times (`stage-times.csv`) could not be read or appended to.
     #[error(transparent)]
     StageLog(#[from] crate::stage_log::Error),

@@ -40,8 +40,25 @@ pub fn run(
     training_values: &[f64],
     progress: &dyn Progress,
 ) -> Result<Vec<Exp3Point>, Error> {
-    let ds = cache.dataset();
-    let trials: Vec<&TrialMeta> = ds.manifest.trials.iter().collect();
+    let trials: Vec<&TrialMeta> = cache.dataset().manifest.trials.iter().collect();
+    let set = match axis {
+        Axis::Speed => FeatureSet::Exp3Speed,
+        Axis::Depth => FeatureSet::Exp3Depth,
+    };
+    by_level(cache, &trials, axis, models, training_values, set, progress)
+}
+
+/// [`run`] on `trials` of `cache`'s dataset only (the sensitivity study's Experiment 1 test
+/// trials), their features reported to `progress` as `set`.
+pub(crate) fn by_level(
+    cache: &FeatureCache<'_>,
+    trials: &[&TrialMeta],
+    axis: Axis,
+    models: &[(ReprKind, Vec<Model>)],
+    training_values: &[f64],
+    set: FeatureSet,
+    progress: &dyn Progress,
+) -> Result<Vec<Exp3Point>, Error> {
     let mut by_value: BTreeMap<i64, Vec<usize>> = BTreeMap::new();
     for (i, t) in trials.iter().enumerate() {
         // Keyed in thousandths so float values group exactly.
@@ -54,19 +71,15 @@ pub fn run(
         .iter()
         .filter_map(|(_, m)| m.first().map(|m| m.repr_config()))
         .collect();
-    let set = match axis {
-        Axis::Speed => FeatureSet::Exp3Speed,
-        Axis::Depth => FeatureSet::Exp3Depth,
-    };
     progress.stage(Stage::Features(set), trials.len() as u64);
-    cache.ensure(&trials, &configs, Sampling::MOTION, &|reused| {
+    cache.ensure(trials, &configs, Sampling::MOTION, &|reused| {
         progress.finished(reused)
     })?;
     let mut out = Vec::new();
     for (name, ms) in models {
         let Some(first) = ms.first() else { continue };
         let set = cache.load(
-            &trials,
+            trials,
             &first.repr_config(),
             Sampling::MOTION,
             &[Phase::Motion],

@@ -24,9 +24,12 @@
 //!   [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm cluster);
 //!   [`results`] is what they measured, as plain typed data (it imports nothing from the
 //!   experiments); [`choices`] lists the values evtac chose where the paper states none.
+//! - [`sensitivity`]: Experiment 1, tuning included, with each unmeasured simulator parameter
+//!   scaled, one at a time: which of the paper's conclusions hold on which simulator.
 //!
-//! Modules that only the pipeline calls (`noise`, `exp2`, `exp3`, `examples`, `label_check`)
-//! are private: their results are in [`results`], their errors in [`pipeline::Error`].
+//! Modules that only the pipeline calls (`noise`, `variant`, `exp2`, `exp3`, `examples`,
+//! `label_check`) are private: their results are in [`results`], their errors in
+//! [`pipeline::Error`].
 //!
 //! ```no_run
 //! use evtac_experiments::progress::Quiet;
@@ -66,6 +69,7 @@ pub mod progress;
 pub mod repr_example;
 pub mod results;
 pub mod sampling;
+pub mod sensitivity;
 pub mod sensor_view;
 pub mod slurm;
 pub mod splits;
@@ -73,5 +77,6 @@ pub mod stage;
 pub mod stage_log;
 pub mod training;
 pub mod tuning;
+mod variant;
 
 pub use label_check::LabelCheck;

@@ -12,42 +12,18 @@
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
-use crate::dataset::{Dataset, Simulated};
+use crate::dataset::Dataset;
 use crate::error::Error;
 use crate::exp1;
-use crate::jobs;
 use crate::results::{Exp1Repr, NoisePoint};
 use crate::stage::{FeatureSet, Stage};
+use crate::variant;
 use evtac_repr::ReprConfig;
 use std::path::{Path, PathBuf};
 
 /// The dataset folder of factor `level` under the run's output folder.
 pub fn dataset_dir(out: &Path, level: f64) -> PathBuf {
     out.join("noise").join(format!("x{level}"))
-}
-
-/// Simulates (or resumes) the dataset of factor `level` from Experiment 1's simulation `sim`.
-fn simulate(sim: &Simulated, level: f64, dir: &Path, run: &RunContext<'_>) -> Result<(), Error> {
-    if jobs::is_done(dir) {
-        return Ok(());
-    }
-    let mut params = sim.params.clone();
-    params.dvs = params.dvs.with_noise_scaled(level);
-    let config = evtac_sim::DatasetConfig {
-        params,
-        ..evtac_sim::DatasetConfig::new(sim.protocol, sim.scale, sim.seed)
-    };
-    let n = evtac_sim::plan(sim.protocol, sim.scale, sim.seed, &config.params.timeline).len();
-    run.progress.stage(Stage::NoiseSimulating, n as u64);
-    evtac_sim::simulate_dataset(&config, dir, |_| run.progress.advance(1)).map_err(|source| {
-        Error::Simulation {
-            protocol: sim.protocol,
-            dir: dir.to_path_buf(),
-            source: Box::new(source),
-        }
-    })?;
-    jobs::mark_done(dir)?;
-    Ok(())
 }
 
 /// Events per second in the crop of `ds`'s no-contact recording, which lasts `seconds`.
@@ -94,7 +70,16 @@ pub fn run(
             continue;
         }
         let dir = dataset_dir(out, level);
-        simulate(&sim, level, &dir, run)?;
+        // Same protocol, scale and seed as Experiment 1's dataset: only the noise differs.
+        let mut params = sim.params.clone();
+        params.dvs = params.dvs.with_noise_scaled(level);
+        variant::simulate(
+            &params,
+            (sim.scale, sim.seed),
+            &dir,
+            Stage::NoiseSimulating,
+            run.progress,
+        )?;
         let ds = Dataset::open(&dir, ds1.inputs)?;
         let splits = ds.splits(run.seed)?;
         let cache = FeatureCache::new(&ds)?;

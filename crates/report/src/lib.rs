@@ -8,6 +8,7 @@
 //!   learned-fusion verdicts in `markdown/fusion.rs`, the label check in `markdown/labels.rs`).
 //! - [`plots`]: one figure family per submodule.
 //! - [`render`]: frames of a recording as GIF, MP4 or PNG sheet.
+//! - [`sensitivity`]: the sensitivity study's summary, table and tornado figure.
 //!
 //! The crate reads results; it runs nothing. `evtac reproduce` runs the pipeline
 //! (`evtac-experiments`), then calls [`write()`].
@@ -26,6 +27,7 @@
 mod markdown;
 pub mod plots;
 pub mod render;
+pub mod sensitivity;
 
 pub use markdown::{
     CHOICES_TITLE, Error, FIGURES, PAPER_EXP2_STATIC, PAPER_TABLE, exp1_stats, markdown, write,

@@ -17,6 +17,7 @@ pub(crate) mod images;
 mod latency;
 mod phases;
 mod representations;
+mod sensitivity;
 mod sensor;
 mod tuning;
 
@@ -25,6 +26,7 @@ pub use examples::{example_curves, overlays};
 pub use latency::latency;
 pub use phases::phase_bars;
 pub use representations::representations;
+pub use sensitivity::gap_tornado;
 pub use sensor::sensor;
 pub use tuning::tuning_curves;
 

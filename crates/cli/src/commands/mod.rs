@@ -12,6 +12,7 @@ pub mod predict;
 pub mod render;
 pub mod represent;
 pub mod reproduce;
+pub mod sensitivity;
 pub mod simulate;
 pub mod stats;
 pub mod train;

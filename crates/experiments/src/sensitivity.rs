@@ -1,0 +1,606 @@
+//! Which of the paper's conclusions survive the simulator's unmeasured parameters: Experiment 1,
+//! tuning included, on a dataset simulated with one parameter at [`FACTORS`] times its default,
+//! one parameter at a time, beside the same on the defaults (the baseline).
+//!
+//! Nothing in the simulator is fitted to a NeuroTac (`docs/simulator.md`): contact mechanics,
+//! pin layout, the DVS pixel model and the IMU's noise are assumed or v2e's generic defaults. A
+//! result on simulated data is a result about the method on this simulator, so each point asks
+//! whether the paper's conclusions still hold on a simulator that differs in one of them
+//! ([`Conclusions`]):
+//!
+//! - **static best**: static's test MAE (mean over seeds) is below dynamic's and combined's;
+//! - **OR not better than static**: combined's is not below static's;
+//! - **dynamic worse at 2 deg/s**: on the test trials, dynamic's error at the slowest speed
+//!   rises above its mean over the other speeds by more than static's does (the paper: "larger
+//!   errors at 2 deg/s, the increase more pronounced for the dynamic representation");
+//! - **dynamic worse at shallow depth**: the same at the shallowest depth.
+//!
+//! The last two read Experiment 1's own test trials by level (a few per level at small scale,
+//! so they are the noisiest), not Experiment 3's datasets, which would mean simulating three
+//! datasets per point instead of one.
+//!
+//! Each point lives in its own folder, `OUT/points/<parameter>/x<factor>/` (`data/`, the
+//! dataset, marked done when simulated; `models/`, tuning and Experiment 1 runs, each marked
+//! done), so an interrupted study resumes where it stopped. The same plan, master seed and
+//! dataset seed serve every point: the trials, splits, camera and training seeds are the
+//! baseline's, and only the parameter differs.
+
+use crate::cache::FeatureCache;
+use crate::context::RunContext;
+use crate::dataset::Dataset;
+use crate::error::Error;
+use crate::exp1;
+use crate::exp3::{self, Axis};
+use crate::results::{Exp1Repr, Exp3Point, MaeStats};
+use crate::splits::Split;
+use crate::stage::{FeatureSet, Stage};
+use crate::tuning::{self, Kind};
+use crate::variant;
+use evtac_import::inputs::Inputs;
+use evtac_learn::Model;
+use evtac_repr::ReprKind;
+use evtac_sim::{Protocol, SimParams};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The factors every parameter is scaled by.
+pub const FACTORS: [f64; 2] = [0.5, 1.5];
+
+/// One simulator parameter the study varies: one or more fields of [`SimParams`] scaled
+/// together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Parameter {
+    /// Short name, also the point's folder (`points/<name>/`).
+    pub name: &'static str,
+    /// What it is, for the table.
+    pub what: &'static str,
+    /// The fields, as `section.field` of `simulator.json`.
+    pub fields: &'static [&'static str],
+}
+
+/// Every parameter of the simulator that no measurement of a NeuroTac sets, in the order of
+/// `simulator.json`. The rest are either the paper's (tip radius, the protocol's speeds, depths
+/// and timeline, the camera's resolution), the rig's specification (the IRB 120's
+/// repeatability), or only shape the image without a physical meaning of their own
+/// (brightness, vignetting; the pins' count and size are varied instead).
+pub const PARAMETERS: [Parameter; 17] = [
+    Parameter {
+        name: "pin_rings",
+        what: "rings of pins (pin spacing: more rings, closer pins)",
+        fields: &["sensor.rings"],
+    },
+    Parameter {
+        name: "pin_size",
+        what: "radius of a pin's bright tip",
+        fields: &["sensor.pin_sigma_mm"],
+    },
+    Parameter {
+        name: "normal_gain",
+        what: "contact: pin motion along the normal per mm of penetration",
+        fields: &["contact.normal_gain"],
+    },
+    Parameter {
+        name: "spread_gain",
+        what: "contact: lateral spread of pins per mm of penetration",
+        fields: &["contact.spread_gain"],
+    },
+    Parameter {
+        name: "skin_tau",
+        what: "skin's time constant (viscoelastic lag)",
+        fields: &["contact.skin_tau_s"],
+    },
+    Parameter {
+        name: "shear",
+        what: "shear of the stuck patch per degree of lag",
+        fields: &["contact.shear_mm_per_deg"],
+    },
+    Parameter {
+        name: "trial_variation",
+        what: "per-trial spread of the skin's gains",
+        fields: &["contact.trial_variation"],
+    },
+    Parameter {
+        name: "creep",
+        what: "share of the skin's slow (creep) response",
+        fields: &["contact.creep_fraction"],
+    },
+    Parameter {
+        name: "on_threshold",
+        what: "DVS ON threshold (log intensity)",
+        fields: &["dvs.pos_thres"],
+    },
+    Parameter {
+        name: "off_threshold",
+        what: "DVS OFF threshold (log intensity)",
+        fields: &["dvs.neg_thres"],
+    },
+    Parameter {
+        name: "threshold_mismatch",
+        what: "DVS thresholds' pixel-to-pixel spread",
+        fields: &["dvs.sigma_thres"],
+    },
+    Parameter {
+        name: "cutoff",
+        what: "DVS photoreceptor cutoff frequency",
+        fields: &["dvs.cutoff_hz"],
+    },
+    Parameter {
+        name: "refractory",
+        what: "DVS refractory period",
+        fields: &["dvs.refractory_period_s"],
+    },
+    Parameter {
+        name: "leak_rate",
+        what: "DVS leak event rate",
+        fields: &["dvs.leak_rate_hz"],
+    },
+    Parameter {
+        name: "shot_noise",
+        what: "DVS shot-noise event rate",
+        fields: &["dvs.shot_noise_rate_hz"],
+    },
+    Parameter {
+        name: "hot_pixels",
+        what: "number of hot pixels",
+        fields: &["dvs.hot_pixels"],
+    },
+    Parameter {
+        name: "imu_noise",
+        what: "IMU's gyroscope and accelerometer white noise",
+        fields: &["imu.gyro_noise_deg_s", "imu.accel_noise_g"],
+    },
+];
+
+/// The parameter named `name`.
+pub fn parameter(name: &str) -> Option<Parameter> {
+    PARAMETERS.iter().copied().find(|p| p.name == name)
+}
+
+/// Why a parameter could not be scaled.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PerturbError {
+    /// A field is not a number of `simulator.json`.
+    #[error("simulator parameter {field} is not a number in simulator.json")]
+    NotANumber {
+        /// The field, `section.field`.
+        field: String,
+    },
+    /// The scaled parameters are not valid simulator parameters.
+    #[error("simulator parameters with {field} scaled: {message}")]
+    Invalid {
+        /// The field.
+        field: String,
+        /// What serde said.
+        message: String,
+    },
+}
+
+/// `params` with `parameter`'s fields multiplied by `factor`; integers (pin rings, hot pixels)
+/// are rounded to the nearest.
+///
+/// Through `simulator.json`'s own form (serde), so that a field is named once, as a user reads
+/// it in a dataset's `simulator.json`, rather than by a hand-written accessor per field.
+pub fn perturbed(
+    params: &SimParams,
+    parameter: &Parameter,
+    factor: f64,
+) -> Result<SimParams, PerturbError> {
+    let mut value = serde_json::to_value(params).map_err(|e| PerturbError::Invalid {
+        field: parameter.name.to_string(),
+        message: e.to_string(),
+    })?;
+    for field in parameter.fields {
+        let not_a_number = || PerturbError::NotANumber {
+            field: (*field).to_string(),
+        };
+        let slot = field
+            .split('.')
+            .try_fold(&mut value, |v, key| v.get_mut(key))
+            .ok_or_else(not_a_number)?;
+        *slot = if let Some(n) = slot.as_u64() {
+            serde_json::Value::from((n as f64 * factor).round() as u64)
+        } else {
+            let x = slot.as_f64().ok_or_else(not_a_number)?;
+            serde_json::Value::from(x * factor)
+        };
+    }
+    serde_json::from_value(value).map_err(|e| PerturbError::Invalid {
+        field: parameter.fields.join(", "),
+        message: e.to_string(),
+    })
+}
+
+/// Whether each of the paper's conclusions holds at one point (see the module docs); `None`
+/// where the test trials have fewer than two levels to compare.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Conclusions {
+    /// Static's test MAE is the lowest of the three.
+    pub static_best: bool,
+    /// Combined (OR) is not better than static.
+    pub or_not_better: bool,
+    /// Dynamic's rise at the slowest speed exceeds static's.
+    pub dynamic_worse_slow: Option<bool>,
+    /// Dynamic's rise at the shallowest depth exceeds static's.
+    pub dynamic_worse_shallow: Option<bool>,
+}
+
+impl Conclusions {
+    /// The conclusions' names, in the order of [`Conclusions::each`].
+    pub const NAMES: [&'static str; 4] = [
+        "static best",
+        "OR not better than static",
+        "dynamic worse at the slowest speed",
+        "dynamic worse at the shallowest depth",
+    ];
+
+    /// The four, in [`Conclusions::NAMES`]' order (`None`: not measurable at this point).
+    pub fn each(&self) -> [Option<bool>; 4] {
+        [
+            Some(self.static_best),
+            Some(self.or_not_better),
+            self.dynamic_worse_slow,
+            self.dynamic_worse_shallow,
+        ]
+    }
+}
+
+/// How much a representation's error rises at one extreme level of the test trials: its MAE
+/// there minus its mean over the other levels (both means over seeds).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rise {
+    /// The extreme level (deg/s or mm).
+    pub level: f64,
+    /// How many levels the test trials have (fewer than 2: nothing to compare, rises 0).
+    pub levels: usize,
+    /// Static's rise, deg.
+    pub static_deg: f64,
+    /// Dynamic's rise, deg.
+    pub dynamic_deg: f64,
+}
+
+/// What tuning chose for one representation at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Tuned {
+    /// Static's decay tau or dynamic's window, ms.
+    pub time_ms: f64,
+    /// The binarization threshold.
+    pub threshold: f64,
+}
+
+impl Tuned {
+    fn of(t: &crate::results::Tuning) -> Tuned {
+        Tuned {
+            time_ms: t.chosen_time_ms,
+            threshold: t.chosen_threshold,
+        }
+    }
+}
+
+/// One point of the study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// The parameter (`baseline` for the defaults).
+    pub parameter: String,
+    /// The factor on it (1 for the baseline).
+    pub factor: f64,
+    /// The settings tuning chose, static then dynamic.
+    pub tuned: [Tuned; 2],
+    /// Test MAE statistics over seeds: static, dynamic, combined.
+    pub test: [MaeStats; 3],
+    /// Dynamic minus static test MAE (means over seeds), deg.
+    pub gap_deg: f64,
+    /// The rise at the slowest speed.
+    pub slow: Rise,
+    /// The rise at the shallowest depth.
+    pub shallow: Rise,
+    /// What holds.
+    pub conclusions: Conclusions,
+}
+
+/// The whole study: what `evtac sensitivity` writes as `sensitivity.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Study {
+    /// The scale.
+    pub scale: String,
+    /// The master seed.
+    pub seed: u64,
+    /// The factors.
+    pub factors: Vec<f64>,
+    /// The defaults' point first, then each parameter at each factor.
+    pub points: Vec<Point>,
+}
+
+impl Study {
+    /// The baseline (the defaults), when the study has it.
+    pub fn baseline(&self) -> Option<&Point> {
+        self.points.iter().find(|p| p.parameter == BASELINE)
+    }
+
+    /// For each conclusion, in [`Conclusions::NAMES`]' order, how many of the perturbed points
+    /// (the baseline excluded) it holds at, and at how many it could be decided.
+    pub fn shares(&self) -> [(usize, usize); 4] {
+        let mut out = [(0, 0); 4];
+        for p in self.points.iter().filter(|p| p.parameter != BASELINE) {
+            for (o, holds) in out.iter_mut().zip(p.conclusions.each()) {
+                if let Some(holds) = holds {
+                    o.0 += usize::from(holds);
+                    o.1 += 1;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The baseline point's name.
+pub const BASELINE: &str = "baseline";
+
+/// The folder of one point under the study's output folder.
+pub fn point_dir(out: &Path, parameter: &str, factor: f64) -> PathBuf {
+    out.join("points")
+        .join(parameter)
+        .join(format!("x{factor}"))
+}
+
+/// Static's and dynamic's rise at the lowest level of `points`.
+fn rise(points: &[Exp3Point]) -> Rise {
+    let level = points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min);
+    let mut values: Vec<f64> = points.iter().map(|p| p.value).collect();
+    values.sort_by(f64::total_cmp);
+    values.dedup();
+    let of = |kind: ReprKind| {
+        let at: Vec<&Exp3Point> = points.iter().filter(|p| p.name == kind).collect();
+        let extreme = at
+            .iter()
+            .filter(|p| p.value == level)
+            .map(|p| p.stats.overall.mean)
+            .sum::<f64>();
+        let others: Vec<f64> = at
+            .iter()
+            .filter(|p| p.value != level)
+            .map(|p| p.stats.overall.mean)
+            .collect();
+        if others.is_empty() {
+            0.0
+        } else {
+            extreme - others.iter().sum::<f64>() / others.len() as f64
+        }
+    };
+    Rise {
+        level,
+        levels: values.len(),
+        static_deg: of(ReprKind::Static),
+        dynamic_deg: of(ReprKind::Dynamic),
+    }
+}
+
+/// One point: simulate, tune, Experiment 1 with the paper's three representations, the test
+/// trials by speed and by depth, the conclusions. `dir` is the point's folder.
+pub fn point(
+    parameter: &str,
+    factor: f64,
+    params: &SimParams,
+    dir: &Path,
+    run: &RunContext<'_>,
+) -> Result<Point, Error> {
+    let data = dir.join("data");
+    variant::simulate(
+        params,
+        (run.plan.scale, run.seed),
+        &data,
+        Stage::Simulating(Protocol::Exp1),
+        run.progress,
+    )?;
+    let ds = Dataset::open(&data, Inputs::FROM_FILES)?;
+    let splits = ds.splits(run.seed)?;
+    let cache = FeatureCache::new(&ds)?;
+    let models = dir.join("models");
+    let at = RunContext {
+        models: &models,
+        ..*run
+    };
+    let st = tuning::tune(&cache, &splits, Kind::Static, &at)?;
+    let dt = tuning::tune(&cache, &splits, Kind::Dynamic, &at)?;
+    let reprs = exp1::paper_representations(st.chosen_config, dt.chosen_config);
+    let e1 = exp1::run(&cache, &splits, &reprs, &at)?;
+    let stats = |kind: ReprKind| -> Result<MaeStats, Error> {
+        e1.iter()
+            .find(|r| r.name == kind)
+            .map(|r: &Exp1Repr| r.test)
+            .ok_or(Error::Missing {
+                what: "a representation in Experiment 1's results",
+            })
+    };
+    let test = [
+        stats(ReprKind::Static)?,
+        stats(ReprKind::Dynamic)?,
+        stats(ReprKind::Combined)?,
+    ];
+    // Static and dynamic by level on the test trials.
+    let loaded: Vec<(ReprKind, Vec<Model>)> = [ReprKind::Static, ReprKind::Dynamic]
+        .into_iter()
+        .map(|kind| exp1::models(&models, kind, run.seed, run.plan.seeds).map(|m| (kind, m)))
+        .collect::<Result<_, _>>()?;
+    let trials = ds.trials(splits.get(Split::Test))?;
+    let mut rises = Vec::new();
+    for axis in [Axis::Speed, Axis::Depth] {
+        let levels = exp3::by_level(
+            &cache,
+            &trials,
+            axis,
+            &loaded,
+            &[],
+            FeatureSet::Exp1,
+            run.progress,
+        )?;
+        rises.push(rise(&levels));
+    }
+    let (slow, shallow) = (rises[0], rises[1]);
+    let mean = |s: &MaeStats| s.overall.mean;
+    let [st_mae, dy_mae, co_mae] = [mean(&test[0]), mean(&test[1]), mean(&test[2])];
+    Ok(Point {
+        parameter: parameter.to_string(),
+        factor,
+        tuned: [Tuned::of(&st), Tuned::of(&dt)],
+        test,
+        gap_deg: dy_mae - st_mae,
+        slow,
+        shallow,
+        conclusions: Conclusions {
+            static_best: st_mae < dy_mae && st_mae < co_mae,
+            or_not_better: co_mae >= st_mae,
+            dynamic_worse_slow: (slow.levels > 1).then_some(slow.dynamic_deg > slow.static_deg),
+            dynamic_worse_shallow: (shallow.levels > 1)
+                .then_some(shallow.dynamic_deg > shallow.static_deg),
+        },
+    })
+}
+
+/// The study: the baseline, then every parameter of `parameters` at every factor of `factors`,
+/// under `out`. `run.models` is unused (each point has its own); `run.plan`'s scale sizes the
+/// datasets, `run.seed` seeds the datasets, splits and training.
+pub fn run(
+    parameters: &[Parameter],
+    factors: &[f64],
+    out: &Path,
+    run: &RunContext<'_>,
+) -> Result<Study, Error> {
+    evtac_learn::flush_denormals();
+    let defaults = SimParams::default();
+    let mut todo: Vec<(&str, f64, SimParams)> = vec![(BASELINE, 1.0, defaults.clone())];
+    for parameter in parameters {
+        for &factor in factors {
+            todo.push((
+                parameter.name,
+                factor,
+                perturbed(&defaults, parameter, factor)?,
+            ));
+        }
+    }
+    let started = std::time::Instant::now();
+    let mut points = Vec::with_capacity(todo.len());
+    for (k, (name, factor, params)) in todo.iter().enumerate() {
+        // Resumed points take no time, so early in a resumed study this is pessimistic.
+        let eta = match k {
+            0 => String::new(),
+            _ => {
+                let per_point = started.elapsed().as_secs_f64() / k as f64;
+                format!(
+                    ", about {:.0} min left",
+                    per_point * (todo.len() - k) as f64 / 60.0
+                )
+            }
+        };
+        run.progress.message(&format!(
+            "point {} of {}: {name} x{factor}{eta}",
+            k + 1,
+            todo.len()
+        ));
+        points.push(point(
+            name,
+            *factor,
+            params,
+            &point_dir(out, name, *factor),
+            run,
+        )?);
+    }
+    Ok(Study {
+        scale: run.plan.scale.name().to_string(),
+        seed: run.seed,
+        factors: factors.to_vec(),
+        points,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_parameter_scales_its_fields_and_nothing_else() {
+        let defaults = SimParams::default();
+        let base = serde_json::to_value(&defaults).unwrap();
+        for p in PARAMETERS {
+            let scaled = serde_json::to_value(perturbed(&defaults, &p, 1.5).unwrap()).unwrap();
+            for section in [
+                "sensor", "contact", "camera", "dvs", "imu", "timeline", "rig",
+            ] {
+                let (b, s) = (&base[section], &scaled[section]);
+                for (key, bv) in b.as_object().unwrap() {
+                    let field = format!("{section}.{key}");
+                    let sv = &s[key];
+                    if p.fields.contains(&field.as_str()) {
+                        let (x, y) = (bv.as_f64().unwrap(), sv.as_f64().unwrap());
+                        assert!(
+                            x != 0.0,
+                            "{field} is 0 by default: scaling it varies nothing"
+                        );
+                        assert!((y - 1.5 * x).abs() <= 0.5, "{field}: {x} -> {y}");
+                    } else {
+                        assert_eq!(bv, sv, "{} changed {field}", p.name);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn integers_round_and_names_are_unique_folders() {
+        let rings = parameter("pin_rings").unwrap();
+        let half = perturbed(&SimParams::default(), &rings, 0.5).unwrap();
+        assert_eq!(half.sensor.rings, 5);
+        let mut names: Vec<&str> = PARAMETERS.iter().map(|p| p.name).collect();
+        names.push(BASELINE);
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), PARAMETERS.len() + 1);
+        assert_eq!(
+            point_dir(Path::new("out"), "cutoff", 0.5),
+            Path::new("out/points/cutoff/x0.5")
+        );
+    }
+
+    #[test]
+    fn a_field_that_is_not_a_number_is_named() {
+        let bad = Parameter {
+            name: "bad",
+            what: "",
+            fields: &["dvs.no_such_field"],
+        };
+        let e = perturbed(&SimParams::default(), &bad, 2.0).unwrap_err();
+        assert!(e.to_string().contains("dvs.no_such_field"), "{e}");
+    }
+
+    fn level(name: ReprKind, value: f64, mae: f64) -> Exp3Point {
+        let runs = vec![crate::results::Mae {
+            overall: mae,
+            pitch: mae,
+            roll: mae,
+        }];
+        Exp3Point {
+            name,
+            value,
+            seen: true,
+            trials: 1,
+            stats: MaeStats::of(&runs),
+            runs,
+        }
+    }
+
+    #[test]
+    fn the_rise_is_the_lowest_level_against_the_mean_of_the_others() {
+        let points = [
+            level(ReprKind::Static, 2.0, 0.30),
+            level(ReprKind::Static, 4.0, 0.20),
+            level(ReprKind::Static, 6.0, 0.10),
+            level(ReprKind::Dynamic, 4.0, 0.25),
+            level(ReprKind::Dynamic, 2.0, 0.55),
+            level(ReprKind::Dynamic, 6.0, 0.35),
+        ];
+        let r = rise(&points);
+        assert_eq!((r.level, r.levels), (2.0, 3));
+        assert!((r.static_deg - 0.15).abs() < 1e-12, "{r:?}");
+        assert!((r.dynamic_deg - 0.25).abs() < 1e-12, "{r:?}");
+    }
+}
