@@ -278,6 +278,7 @@ pub fn reproduce(
         labels,
         overlays,
         repr_example,
+        sensor_kind: sensor.as_ref().map(|v| v.kind),
         sensor,
     };
     results.run.stage_seconds = stages.list;

@@ -464,6 +464,10 @@ pub struct Results {
     /// The sensor at rest and in contact; not written to JSON.
     #[serde(skip)]
     pub sensor: Option<SensorView>,
+    /// What the sensor figure shows: its view is not in JSON but its kind is, so that the
+    /// report's caption can be rebuilt from `results.json` alone. Absent from older results.
+    #[serde(default)]
+    pub sensor_kind: Option<SensorKind>,
 }
 
 #[cfg(test)]

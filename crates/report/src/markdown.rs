@@ -181,12 +181,67 @@ fn exp3_design(values: &[(f64, bool)], axis: &str, unit: &str) -> String {
     )
 }
 
+/// The unseen levels of one Experiment 3 axis whose mean error exceeds both seen neighbours'
+/// (the nearest seen level below and above) by more than the seeds' spread (the largest SD of
+/// the three), per representation, as a sentence; the paper reports none ("did not cause
+/// abrupt mean error increases"), so any found is said in words, not left to the table.
+fn unseen_penalties(points: &[Exp3Point], (axis, unit): (&str, &str)) -> String {
+    let mut found = Vec::new();
+    for name in ReprKind::in_order(points.iter().map(|p| p.name)) {
+        let mut own: Vec<&Exp3Point> = points.iter().filter(|p| p.name == name).collect();
+        own.sort_by(|a, b| a.value.total_cmp(&b.value));
+        for (i, p) in own.iter().enumerate().filter(|(_, p)| !p.seen) {
+            let below = own[..i].iter().rev().find(|q| q.seen);
+            let above = own[i + 1..].iter().find(|q| q.seen);
+            let (Some(lo), Some(hi)) = (below, above) else {
+                continue;
+            };
+            let (m, a, b) = (
+                p.stats.overall.mean,
+                lo.stats.overall.mean,
+                hi.stats.overall.mean,
+            );
+            let spread = p
+                .stats
+                .overall
+                .std
+                .max(lo.stats.overall.std)
+                .max(hi.stats.overall.std);
+            if m - a.max(b) > spread {
+                found.push(format!(
+                    "{} at {} {unit} ({m:.3} against {a:.3} at {} and {b:.3} at {}; seeds' SD at \
+                     most {spread:.3})",
+                    name.title(),
+                    p.value,
+                    lo.value,
+                    hi.value
+                ));
+            }
+        }
+    }
+    if found.is_empty() {
+        format!(
+            "No unseen {axis} is worse than both its seen neighbours by more than the seeds' \
+             spread (the paper reports no such penalty either)."
+        )
+    } else {
+        format!(
+            "**Unseen {axis}s worse than both seen neighbours by more than the seeds' spread:** \
+             {}. The paper reports no such penalty (\"did not cause abrupt mean error \
+             increases\"): on this simulator, these models do not interpolate between the \
+             {axis}s they were trained on as the paper's did.",
+            found.join("; ")
+        )
+    }
+}
+
 /// An Experiment 3 table, after the sentence on its design.
 fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str)) {
     let mut values: Vec<(f64, bool)> = points.iter().map(|p| (p.value, p.seen)).collect();
     values.sort_by(|a, b| a.0.total_cmp(&b.0));
     values.dedup_by(|a, b| a.0 == b.0);
     let _ = writeln!(md, "{}\n", exp3_design(&values, axis, unit));
+    let unit_name = unit;
     let unit = format!("{axis} ({unit})");
     let names = ReprKind::in_order(points.iter().map(|p| p.name));
     let _ = writeln!(
@@ -211,6 +266,7 @@ fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str))
             cells.join(" | ")
         );
     }
+    let _ = writeln!(md, "\n{}", unseen_penalties(points, (axis, unit_name)));
 }
 
 /// The report's Markdown.
@@ -279,7 +335,12 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
 
     if figures.contains(&FIGURES[7].0) || figures.contains(&FIGURES[8].0) {
         let _ = writeln!(md, "## The sensor and the representations\n");
-        figure(&mut md, figures, 8, r.sensor.as_ref().map(|v| v.kind));
+        figure(
+            &mut md,
+            figures,
+            8,
+            r.sensor.as_ref().map(|v| v.kind).or(r.sensor_kind),
+        );
         figure(&mut md, figures, 7, None);
     }
 
@@ -772,6 +833,44 @@ mod tests {
         assert!(shrinks.contains("shrinks"), "{shrinks}");
         assert!(shrinks.contains("x0 to x1, x0 to x3"), "{shrinks}");
         assert!(!noise_verdict(&[(1.0, 0.3, 0.0)]).contains("gap"));
+    }
+
+    #[test]
+    fn an_unseen_level_worse_than_both_seen_neighbours_beyond_the_spread_is_named() {
+        let point = |name, value: f64, seen, mean: f64, sd: f64| {
+            let runs = [mean - sd, mean + sd].map(|m| evtac_experiments::results::Mae {
+                overall: m,
+                pitch: m,
+                roll: m,
+            });
+            Exp3Point {
+                name,
+                value,
+                seen,
+                trials: 6,
+                stats: evtac_experiments::results::MaeStats::of(&runs),
+                runs: runs.to_vec(),
+            }
+        };
+        let s = ReprKind::Static;
+        let d = ReprKind::Dynamic;
+        let points = [
+            point(s, 1.0, true, 0.17, 0.005),
+            point(s, 1.5, false, 0.24, 0.005),
+            point(s, 2.0, true, 0.18, 0.005),
+            // Worse than both, but within the spread: not named.
+            point(d, 1.0, true, 0.30, 0.04),
+            point(d, 1.5, false, 0.33, 0.04),
+            point(d, 2.0, true, 0.31, 0.04),
+        ];
+        let text = unseen_penalties(&points, ("depth", "mm"));
+        assert!(
+            text.contains("Static at 1.5 mm (0.240 against 0.170 at 1 and 0.180 at 2"),
+            "{text}"
+        );
+        assert!(!text.contains("Dynamic"), "{text}");
+        let calm = unseen_penalties(&points[3..], ("depth", "mm"));
+        assert!(calm.starts_with("No unseen depth is worse"), "{calm}");
     }
 
     #[test]
