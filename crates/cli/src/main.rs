@@ -4,6 +4,7 @@
 //! (`evtac-events`, `evtac-repr`, `evtac-sim`, `evtac-labels`, `evtac-learn`,
 //! `evtac-experiments`, `evtac-online`). Run `evtac --help` for the subcommands.
 
+mod cluster;
 mod commands;
 mod inputs;
 mod kinds;

@@ -417,6 +417,18 @@ fn no_fusions_trains_the_papers_three_representations_only() {
     );
     assert_eq!(paper[..3], all[..3], "the paper's three keep their jobs");
     assert_eq!(paper[3..], [0, 0], "no fusion is trained: {paper:?}");
+    // The paper's plan as a shell gives it: `--noise-levels ''` is no levels, not an error.
+    assert_eq!(export(&["--no-fusions", "--noise-levels", ""]), paper);
+    let bad = crate::common::evtac()
+        .args(["reproduce", "--scale", "tiny", "--out", &out_s])
+        .args(["--noise-levels", "0,x3"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && stderr.contains("\"x3\" is not a factor"),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -1,6 +1,38 @@
-//! Tests of `evtac sensitivity`.
+//! Tests of `evtac sensitivity` (its Slurm executor's in `slurm.rs`).
 
 use crate::common::{evtac, run_ok};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The arguments of the tiny study the tests share: one parameter at the default factors.
+pub fn tiny_study_args(out: &Path) -> Vec<String> {
+    let out = out.to_str().expect("utf-8 path");
+    [
+        "sensitivity",
+        "--scale",
+        "tiny",
+        "--parameters",
+        "on_threshold",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// One tiny study, run once per test binary, and what it printed: its output folder and stdout.
+pub fn tiny_study() -> &'static (PathBuf, String) {
+    static STUDY: OnceLock<(tempfile::TempDir, (PathBuf, String))> = OnceLock::new();
+    let (_, study) = STUDY.get_or_init(|| {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let out = dir.path().join("study");
+        let args = tiny_study_args(&out);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let stdout = String::from_utf8_lossy(&run_ok(&args).stdout).into_owned();
+        (dir, (out, stdout))
+    });
+    study
+}
 
 /// `dvs.pos_thres` of the dataset of one point.
 fn on_threshold(point: &std::path::Path) -> f64 {
@@ -13,19 +45,7 @@ fn on_threshold(point: &std::path::Path) -> f64 {
 
 #[test]
 fn a_tiny_study_varies_the_simulator_writes_its_summary_and_resumes_to_the_same_bytes() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("study");
-    let args = [
-        "sensitivity",
-        "--scale",
-        "tiny",
-        "--parameters",
-        "on_threshold",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    let first = run_ok(&args);
-    let stdout = String::from_utf8_lossy(&first.stdout);
+    let (out, stdout) = tiny_study();
     assert!(
         stdout.contains("static best: holds at ") && stdout.contains(" of 2 perturbed points"),
         "{stdout}"
@@ -83,7 +103,7 @@ fn a_tiny_study_varies_the_simulator_writes_its_summary_and_resumes_to_the_same_
     let png = std::fs::read(out.join("gap-tornado.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 1000);
     // No partial file is left beside the outputs.
-    let leftovers: Vec<_> = std::fs::read_dir(&out)
+    let leftovers: Vec<_> = std::fs::read_dir(out)
         .unwrap()
         .filter_map(Result::ok)
         .filter(|e| e.file_name().to_string_lossy().contains("partial"))
@@ -91,7 +111,8 @@ fn a_tiny_study_varies_the_simulator_writes_its_summary_and_resumes_to_the_same_
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
     // Run again: every point resumes from its finished runs, and the study is the same bytes.
-    run_ok(&args);
+    let args = tiny_study_args(out);
+    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(std::fs::read(out.join("sensitivity.json")).unwrap(), json);
 }
 

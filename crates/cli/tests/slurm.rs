@@ -1,7 +1,9 @@
 //! `evtac reproduce --executor slurm` against a real Slurm (slurmctld + slurmd on localhost,
 //! started by `.ci/slurm-up`): the tiny reproduction submitted as job arrays, one array task
 //! cancelled mid-run (`scancel`), the run resumed, and the results compared with the local run
-//! of the same seed ([`crate::reproduce::tiny_run`]).
+//! of the same seed ([`crate::reproduce::tiny_run`]). And `evtac sensitivity --executor slurm`:
+//! the tiny study's points as one array, the study the same bytes as the local one
+//! ([`crate::sensitivity::tiny_study`]).
 //!
 //! Every array is submitted held (`--slurm-args=--hold`) and released by the test, so the task
 //! is cancelled at a known point (before it ran) rather than by a race with the scheduler.
@@ -153,4 +155,47 @@ fn slurm_reproduction_resumes_after_a_cancelled_task_and_matches_the_local_run()
         assert!(a == b, "{name} differs from the local run's");
     }
     assert!(out.join("report.md").is_file());
+}
+
+#[test]
+fn slurm_sensitivity_runs_a_task_per_point_and_matches_the_local_study() {
+    if !evtac_testkit::slurm_cluster() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    let run = evtac()
+        .args(crate::sensitivity::tiny_study_args(&out))
+        .args(["--executor", "slurm"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    // One task per point: the baseline and the parameter at its two factors.
+    let jobs = evtac_experiments::job::read(&out.join("slurm/sensitivity.jobs")).unwrap();
+    assert_eq!(jobs.len(), 3, "{jobs:?}");
+    let logs = std::fs::read_dir(out.join("slurm"))
+        .unwrap()
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".out"))
+        .count();
+    assert_eq!(logs, 3, "one log per task");
+    let (local, _) = crate::sensitivity::tiny_study();
+    assert!(
+        std::fs::read(out.join("sensitivity.json")).unwrap()
+            == std::fs::read(local.join("sensitivity.json")).unwrap(),
+        "the Slurm study differs from the local one"
+    );
+    // Run again: nothing is left to submit, and the summary is the same.
+    let again = evtac()
+        .args(crate::sensitivity::tiny_study_args(&out))
+        .args(["--executor", "slurm"])
+        .output()
+        .unwrap();
+    assert!(again.status.success());
+    assert!(
+        !String::from_utf8_lossy(&again.stderr).contains("submitted as Slurm job"),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
 }

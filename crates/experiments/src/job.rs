@@ -43,6 +43,8 @@ pub enum Job {
     /// A whole reproduction on one machine, resuming from every finished job (the Slurm
     /// executor's last task: evaluation, Experiment 3, latency and the report).
     Reproduce(ReproduceJob),
+    /// One point of a sensitivity study (a Slurm task of `evtac sensitivity`).
+    SensitivityPoint(SensitivityPointJob),
 }
 
 impl Job {
@@ -52,6 +54,7 @@ impl Job {
             Job::Simulate(j) => &j.out,
             Job::Train(j) => &j.out,
             Job::Reproduce(j) => &j.out,
+            Job::SensitivityPoint(j) => &j.out,
         }
     }
 }
@@ -169,6 +172,40 @@ pub struct ReproduceJob {
     pub noise_levels: Option<Vec<f64>>,
     /// Whether the learned fusions are trained beside the paper's three.
     pub fusions: bool,
+}
+
+/// One point of a sensitivity study: Experiment 1, tuning included, on a dataset simulated with
+/// one parameter scaled ([`crate::sensitivity::point`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensitivityPointJob {
+    /// The study's scale.
+    pub scale: Scale,
+    /// The study's master seed.
+    pub seed: u64,
+    /// The parameter ([`crate::sensitivity::BASELINE`] for the defaults).
+    pub parameter: String,
+    /// The factor on it.
+    pub factor: f64,
+    /// The point's folder ([`crate::sensitivity::point_dir`]).
+    pub out: PathBuf,
+}
+
+impl SensitivityPointJob {
+    /// Runs the point (resuming what is finished), reporting to `progress`.
+    pub fn run(&self, progress: &dyn crate::progress::Progress) -> Result<(), Error> {
+        evtac_learn::flush_denormals();
+        let plan = crate::sensitivity::plan(self.scale);
+        let params = crate::sensitivity::params_of(&self.parameter, self.factor)?;
+        let models = self.out.join("models");
+        let run = crate::context::RunContext {
+            plan: &plan,
+            seed: self.seed,
+            models: &models,
+            progress,
+        };
+        crate::sensitivity::point(&self.parameter, self.factor, &params, &self.out, &run)?;
+        Ok(())
+    }
 }
 
 /// Errors reading or writing a jobs file.
@@ -326,6 +363,13 @@ mod tests {
                 inputs: Inputs::FROM_FILES,
                 noise_levels: Some(vec![0.0, 2.5]),
                 fusions: false,
+            }),
+            Job::SensitivityPoint(SensitivityPointJob {
+                scale: Scale::Small,
+                seed: 2,
+                parameter: "cutoff".into(),
+                factor: 0.5,
+                out: "study/points/cutoff/x0.5".into(),
             }),
         ]
     }

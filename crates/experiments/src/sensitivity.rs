@@ -156,10 +156,56 @@ pub fn parameter(name: &str) -> Option<Parameter> {
     PARAMETERS.iter().copied().find(|p| p.name == name)
 }
 
+/// Every parameter's name, comma-separated (for messages).
+pub fn names() -> String {
+    PARAMETERS.map(|p| p.name).join(", ")
+}
+
+/// The simulator parameters of the point (`parameter`, `factor`): the defaults for
+/// [`BASELINE`], else the defaults with that parameter scaled.
+pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError> {
+    let defaults = SimParams::default();
+    if parameter == BASELINE {
+        return Ok(defaults);
+    }
+    let p = self::parameter(parameter).ok_or_else(|| PerturbError::Unknown {
+        name: parameter.to_string(),
+    })?;
+    perturbed(&defaults, &p, factor)
+}
+
+/// The plan every point runs: the scale's, with the paper's three representations only and no
+/// noise study (each point is one Experiment 1).
+pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
+    crate::plan::Plan {
+        fusions: false,
+        noise_levels: Vec::new(),
+        ..crate::plan::Plan::for_scale(scale)
+    }
+}
+
+/// The study's points in order: the baseline, then every parameter at every factor.
+pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(&'static str, f64)> {
+    let mut out = vec![(BASELINE, 1.0)];
+    for p in parameters {
+        out.extend(factors.iter().map(|&f| (p.name, f)));
+    }
+    out
+}
+
 /// Why a parameter could not be scaled.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum PerturbError {
+    /// No parameter has this name.
+    #[error(
+        "no simulator parameter {name:?} in the sensitivity study; the parameters are {}",
+        names()
+    )]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
     /// A field is not a number of `simulator.json`.
     #[error("simulator parameter {field} is not a number in simulator.json")]
     NotANumber {
@@ -437,6 +483,9 @@ pub fn point(
         rises.push(rise(&levels));
     }
     let (slow, shallow) = (rises[0], rises[1]);
+    // Every part resumes on its own; the marker says the point as a whole is finished (what a
+    // Slurm run submits again is what has none).
+    crate::jobs::mark_done(dir)?;
     let mean = |s: &MaeStats| s.overall.mean;
     let [st_mae, dy_mae, co_mae] = [mean(&test[0]), mean(&test[1]), mean(&test[2])];
     Ok(Point {
@@ -457,9 +506,10 @@ pub fn point(
     })
 }
 
-/// The study: the baseline, then every parameter of `parameters` at every factor of `factors`,
-/// under `out`. `run.models` is unused (each point has its own); `run.plan`'s scale sizes the
-/// datasets, `run.seed` seeds the datasets, splits and training.
+/// The study: the baseline, then every parameter of `parameters` at every factor of `factors`
+/// ([`points`]), under `out`. `run.models` is unused (each point has its own); `run.plan`
+/// ([`plan`]) sizes the datasets, `run.seed` seeds the datasets, splits and training. Points
+/// already finished (by an earlier run, or by Slurm tasks) are read back from their runs.
 pub fn run(
     parameters: &[Parameter],
     factors: &[f64],
@@ -467,17 +517,10 @@ pub fn run(
     run: &RunContext<'_>,
 ) -> Result<Study, Error> {
     evtac_learn::flush_denormals();
-    let defaults = SimParams::default();
-    let mut todo: Vec<(&str, f64, SimParams)> = vec![(BASELINE, 1.0, defaults.clone())];
-    for parameter in parameters {
-        for &factor in factors {
-            todo.push((
-                parameter.name,
-                factor,
-                perturbed(&defaults, parameter, factor)?,
-            ));
-        }
-    }
+    let todo = points(parameters, factors)
+        .into_iter()
+        .map(|(name, factor)| Ok((name, factor, params_of(name, factor)?)))
+        .collect::<Result<Vec<_>, PerturbError>>()?;
     let started = std::time::Instant::now();
     let mut points = Vec::with_capacity(todo.len());
     for (k, (name, factor, params)) in todo.iter().enumerate() {
@@ -543,6 +586,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn points_start_with_the_baseline_and_unknown_names_are_refused() {
+        let p = [parameter("cutoff").unwrap(), parameter("creep").unwrap()];
+        assert_eq!(
+            points(&p, &[0.5, 2.0]),
+            [
+                (BASELINE, 1.0),
+                ("cutoff", 0.5),
+                ("cutoff", 2.0),
+                ("creep", 0.5),
+                ("creep", 2.0)
+            ]
+        );
+        assert_eq!(params_of(BASELINE, 1.0).unwrap(), SimParams::default());
+        let e = params_of("grip", 2.0).unwrap_err().to_string();
+        assert!(e.contains("\"grip\"") && e.contains("cutoff"), "{e}");
     }
 
     #[test]

@@ -20,6 +20,10 @@
 //! 3. `report`: one task running the reproduction itself ([`Job::Reproduce`]), which finds every
 //!    training done and evaluates, runs Experiment 3 and the latency study, and writes the
 //!    report.
+//!
+//! A sensitivity study ([`Slurm::sensitivity`]) is one array, a task per point not yet finished
+//! ([`Job::SensitivityPoint`]: each simulates, tunes and trains its Experiment 1 on its CPU);
+//! the front end then writes the summary from the finished points.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -330,6 +334,35 @@ impl Slurm {
             if written { &[] } else { &[0] },
             &logs,
         )
+    }
+}
+
+impl Slurm {
+    /// Runs the unfinished points among `points` (sensitivity-point jobs) as one array,
+    /// `sensitivity`, logging under `logs`, and returns when every one has finished (or an
+    /// error naming those that did not). The study's summary is the caller's to write, from
+    /// the finished points.
+    pub fn sensitivity(
+        &self,
+        points: &[Job],
+        task: &dyn Fn(&Path) -> String,
+        logs: &Path,
+        progress: &dyn Progress,
+    ) -> Result<(), Error> {
+        let todo: Vec<Job> = points
+            .iter()
+            .filter(|j| !jobs::is_done(j.out()))
+            .cloned()
+            .collect();
+        if todo.is_empty() {
+            return Ok(());
+        }
+        let job = submit(self, "sensitivity", &todo, task, logs, None, progress)?;
+        self.wait(&job, progress)?;
+        let unfinished: Vec<usize> = (0..todo.len())
+            .filter(|&k| !jobs::is_done(todo[k].out()))
+            .collect();
+        check(self, "sensitivity", &job, &unfinished, logs)
     }
 }
 

@@ -88,6 +88,7 @@ fn run_job(job: &Job) -> anyhow::Result<()> {
                 }
             }
             Job::Reproduce(j) => super::reproduce::run(super::reproduce::Args::for_job(j))?,
+            Job::SensitivityPoint(j) => j.run(&evtac_experiments::progress::Quiet)?,
         }
         Ok(())
     })
@@ -141,6 +142,11 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if !j.fusions {
                 args.push("--no-fusions".into());
             }
+        }
+        Job::SensitivityPoint(j) => {
+            args.push("sensitivity".into());
+            args.extend(one_thread(j.scale, j.seed, &j.out));
+            args.extend(["--point".into(), format!("{}:{}", j.parameter, j.factor)]);
         }
     }
     args

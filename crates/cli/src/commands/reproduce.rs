@@ -7,11 +7,9 @@
 use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::job::{self, ReproduceJob};
-use evtac_experiments::jobs::shell_quote;
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::Plan;
 use evtac_experiments::progress::Progress;
-use evtac_experiments::slurm::Slurm;
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
 use evtac_sim::Scale;
@@ -42,8 +40,8 @@ pub struct Args {
     /// Background-noise factors to repeat Experiment 1 at (leak, shot and hot-pixel noise of
     /// the simulator scaled together; 1 is Experiment 1 itself), comma-separated; empty to skip.
     /// Default: the plan's (0,1,3 at every scale). Needs simulated Experiment 1 data.
-    #[arg(long, value_delimiter = ',', num_args = 0..)]
-    pub noise_levels: Option<Vec<f64>>,
+    #[arg(long, value_delimiter = ',', num_args = 0.., value_parser = noise_level)]
+    pub noise_levels: Option<Vec<NoiseLevel>>,
     /// Leave out evtac's learned fusions (stacked, late): train and report the paper's three
     /// representations only. With `--noise-levels` given empty, this is the paper's own plan
     /// (195 training runs at `--scale paper` instead of 375).
@@ -67,7 +65,29 @@ pub struct Args {
     pub slurm_args: Option<String>,
 }
 
+/// One value of `--noise-levels`: a factor, or none (`--noise-levels ''`, how a shell gives
+/// the flag an empty value, means no levels as `--noise-levels` alone does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoiseLevel(pub Option<f64>);
+
+fn noise_level(s: &str) -> Result<NoiseLevel, String> {
+    let s = s.trim();
+    if s.is_empty() {
+        return Ok(NoiseLevel(None));
+    }
+    s.parse::<f64>()
+        .map(|v| NoiseLevel(Some(v)))
+        .map_err(|e| format!("{s:?} is not a factor: {e}"))
+}
+
 impl Args {
+    /// The noise levels asked for (empty values dropped), or `None` for the plan's.
+    pub fn noise_levels(&self) -> Option<Vec<f64>> {
+        self.noise_levels
+            .as_ref()
+            .map(|levels| levels.iter().filter_map(|l| l.0).collect())
+    }
+
     /// The arguments that run `job` on this machine with one worker thread (the last task of a
     /// Slurm reproduction, whose task has one CPU).
     pub fn for_job(job: &ReproduceJob) -> Args {
@@ -77,7 +97,10 @@ impl Args {
             inputs: crate::inputs::InputArgs::of(job.inputs),
             seed: job.seed,
             out: job.out.clone(),
-            noise_levels: job.noise_levels.clone(),
+            noise_levels: job
+                .noise_levels
+                .as_ref()
+                .map(|levels| levels.iter().map(|&l| NoiseLevel(Some(l))).collect()),
             no_fusions: !job.fusions,
             workers: crate::workers::Workers { jobs: Some(1) },
             export_jobs: None,
@@ -87,7 +110,7 @@ impl Args {
     }
 }
 
-/// Where the jobs of a reproduction run.
+/// Where the jobs of a reproduction (or the points of a sensitivity study) run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Executor {
     /// This machine, `--jobs` threads.
@@ -280,7 +303,6 @@ impl Progress for Overall<'_> {
 /// Runs `evtac reproduce` on Slurm: submits, follows, and returns when the report is written.
 fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
     let started = Instant::now();
-    let exe = std::env::current_exe().context("finding the evtac binary the tasks run")?;
     let absolute = |p: &PathBuf| std::path::absolute(p).with_context(|| p.display().to_string());
     let run = ReproduceJob {
         scale: args.scale,
@@ -288,25 +310,13 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         out: absolute(&args.out)?,
         data: args.data.as_ref().map(absolute).transpose()?,
         inputs: args.inputs.inputs(),
-        noise_levels: args.noise_levels.clone(),
+        noise_levels: args.noise_levels(),
         fusions: !args.no_fusions,
     };
-    // Each task runs one job of its array's jobs file with this same binary.
-    let exe = shell_quote(&exe.display().to_string());
-    let task = |file: &std::path::Path| {
-        let file = shell_quote(&file.display().to_string());
-        format!("{exe} jobs run {file} --index \"$SLURM_ARRAY_TASK_ID\"")
-    };
-    let slurm = Slurm {
-        sbatch_args: args
-            .slurm_args
-            .as_deref()
-            .unwrap_or_default()
-            .split_whitespace()
-            .map(str::to_string)
-            .collect(),
-        ..Slurm::default()
-    };
+    let (slurm, task) = (
+        crate::cluster::slurm(args.slurm_args.as_deref()),
+        crate::cluster::task()?,
+    );
     let bars = Bars::default();
     slurm.reproduce(&run, plan, &task, &bars)?;
     bars.finish();
@@ -324,7 +334,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let mut plan = Plan::for_scale(args.scale);
-    if let Some(levels) = &args.noise_levels {
+    if let Some(levels) = &args.noise_levels() {
         if let Some(bad) = levels.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
             anyhow::bail!("--noise-levels: {bad} is not a factor (finite and at least 0)");
         }

@@ -3,11 +3,15 @@
 //! x0.5 and x1.5 of its default, one at a time, beside the defaults
 //! (`evtac_experiments::sensitivity`); writes `OUT/README.md`, `OUT/sensitivity.json` and
 //! `OUT/gap-tornado.png` (`evtac_report::sensitivity`). Every point resumes from its finished
-//! simulation and training runs.
+//! simulation and training runs. `--executor slurm` runs the unfinished points as one Slurm
+//! array (each task `evtac jobs run FILE --index K`, which is `evtac sensitivity --point`), then
+//! writes the summary here.
 
+use super::reproduce::Executor;
 use crate::progress::Bars;
+use anyhow::Context;
 use evtac_experiments::context::RunContext;
-use evtac_experiments::plan::Plan;
+use evtac_experiments::job::{Job, SensitivityPointJob};
 use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter};
 use evtac_sim::Scale;
 use std::path::PathBuf;
@@ -41,6 +45,64 @@ pub struct Args {
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
+    /// Where the points run: `local` (this machine's threads) or `slurm` (one Slurm array, a
+    /// task per unfinished point; OUT must be on storage every node sees). The summary is
+    /// written here once every point has finished; an interrupted study resumes when run again.
+    #[arg(long, value_enum, default_value_t = Executor::Local)]
+    pub executor: Executor,
+    /// Extra `sbatch` arguments, e.g. "--partition=cpu --time=1:00:00".
+    #[arg(long, allow_hyphen_values = true)]
+    pub slurm_args: Option<String>,
+    /// Run one point only, PARAMETER:FACTOR (`baseline:1` for the defaults), into OUT as the
+    /// point's folder, and write no summary: a Slurm task's work.
+    #[arg(long, value_name = "PARAMETER:FACTOR")]
+    pub point: Option<String>,
+}
+
+/// Runs the single point `spec` (`name:factor`) into `args.out`.
+fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
+    let (name, factor) = spec
+        .rsplit_once(':')
+        .and_then(|(n, f)| Some((n, f.parse::<f64>().ok()?)))
+        .with_context(|| format!("--point {spec}: give PARAMETER:FACTOR, e.g. cutoff:0.5"))?;
+    let job = SensitivityPointJob {
+        scale: args.scale,
+        seed: args.seed,
+        parameter: name.to_string(),
+        factor,
+        out: args.out.clone(),
+    };
+    let pool = args.workers.pool()?;
+    let bars = Bars::default();
+    pool.install(|| job.run(&bars))?;
+    bars.finish();
+    eprintln!("point {name} x{factor} finished in {}", args.out.display());
+    Ok(())
+}
+
+/// Runs every unfinished point of the study on Slurm, one array task each.
+fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> {
+    let out = std::path::absolute(&args.out).with_context(|| args.out.display().to_string())?;
+    let jobs: Vec<Job> = sensitivity::points(parameters, &args.factors)
+        .into_iter()
+        .map(|(name, factor)| {
+            Job::SensitivityPoint(SensitivityPointJob {
+                scale: args.scale,
+                seed: args.seed,
+                parameter: name.to_string(),
+                factor,
+                out: sensitivity::point_dir(&out, name, factor),
+            })
+        })
+        .collect();
+    let (slurm, task) = (
+        crate::cluster::slurm(args.slurm_args.as_deref()),
+        crate::cluster::task()?,
+    );
+    let bars = Bars::default();
+    slurm.sensitivity(&jobs, &task, &out.join("slurm"), &bars)?;
+    bars.finish();
+    Ok(())
 }
 
 /// The parameters `names` asks for, or every one.
@@ -52,10 +114,9 @@ fn chosen(names: Option<&[String]>) -> anyhow::Result<Vec<Parameter>> {
         .iter()
         .map(|n| {
             sensitivity::parameter(n).ok_or_else(|| {
-                let all: Vec<&str> = PARAMETERS.iter().map(|p| p.name).collect();
                 anyhow::anyhow!(
                     "--parameters: no simulator parameter {n:?}; the parameters are {}",
-                    all.join(", ")
+                    sensitivity::names()
                 )
             })
         })
@@ -76,11 +137,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
              baseline is always run)"
         );
     }
-    let plan = Plan {
-        fusions: false,
-        noise_levels: Vec::new(),
-        ..Plan::for_scale(args.scale)
-    };
+    anyhow::ensure!(
+        args.slurm_args.is_none() || args.executor == Executor::Slurm,
+        "--slurm-args is for --executor slurm"
+    );
+    if let Some(spec) = &args.point {
+        anyhow::ensure!(
+            args.executor == Executor::Local,
+            "--point runs one point here (a Slurm task's work): it takes no --executor slurm"
+        );
+        return one_point(&args, spec);
+    }
+    if args.executor == Executor::Slurm {
+        points_on_slurm(&args, &parameters)?;
+    }
+    // Locally: every point; after Slurm: every point is finished, and reading them back is
+    // quick.
+    let plan = sensitivity::plan(args.scale);
     let pool = args.workers.pool()?;
     let bars = Bars::default();
     let models = args.out.join("points");
