@@ -26,6 +26,7 @@ fn jobs_file(dir: &std::path::Path) -> std::path::PathBuf {
                 epochs: 3,
                 sampling: Sampling::MOTION,
                 phases: vec![Phase::Motion],
+                label_noise_deg: 0.0,
             },
             out: dir.join("model"),
         }),

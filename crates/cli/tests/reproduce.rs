@@ -224,6 +224,29 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         );
     }
     assert!(report.contains("Dynamic minus static test MAE: "));
+    // The label-noise ablation: the paper's three, trained on noisy labels, beside Experiment 1
+    // on the clean ones, its models apart from Experiment 1's.
+    let ablation = &results["label_noise"];
+    assert_eq!(ablation["sd_deg"].as_f64(), Some(0.04));
+    let e1 = results["exp1"].as_array().unwrap();
+    for (noisy, clean) in ablation["noisy"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(ablation["clean"].as_array().unwrap())
+    {
+        assert_eq!(noisy["name"], clean["name"]);
+        assert_eq!(
+            noisy["config"], clean["config"],
+            "the ablation keeps the tuned settings"
+        );
+        assert!(e1.contains(clean), "{clean} is not Experiment 1's");
+        assert_ne!(noisy["runs"], clean["runs"], "noisy labels changed nothing");
+    }
+    assert_eq!(ablation["noisy"].as_array().map(Vec::len), Some(3));
+    let noisy_model = out.join("models/label-noise/sd0.04/exp1/static/seed1/config.json");
+    assert!(noisy_model.is_file(), "{}", noisy_model.display());
+    assert!(report.contains("## Label-noise ablation"), "{report}");
     let settings = 3; // continuous-only, pause-motion, pause-motion-stop
     assert_eq!(
         results["exp2"].as_array().map(Vec::len),

@@ -108,6 +108,7 @@ pub(crate) fn seed_jobs(
                     epochs,
                     sampling,
                     phases: phases.to_vec(),
+                    label_noise_deg: 0.0,
                 },
                 out: dir(repr.kind(), seed),
             });
@@ -183,15 +184,29 @@ pub fn run_as(
     run: &RunContext<'_>,
     stages: (FeatureSet, Stage),
 ) -> Result<Vec<Exp1Repr>, Error> {
+    let jobs = jobs(cache.dataset(), reprs, run.plan, run.seed, run.models);
+    run_jobs(cache, splits, reprs, run, stages, &jobs)
+}
+
+/// [`run_as`] with Experiment 1's `jobs` given (the label-noise ablation's differ from
+/// [`jobs`] in their training labels only): features, training, then every model on the test
+/// split.
+pub(crate) fn run_jobs(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    reprs: &[ReprConfig],
+    run: &RunContext<'_>,
+    stages: (FeatureSet, Stage),
+    jobs: &[TrainJob],
+) -> Result<Vec<Exp1Repr>, Error> {
     let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
-    let jobs = jobs(cache.dataset(), reprs, plan, seed, out);
     features_then_training(
         cache,
         splits,
         reprs,
         Sampling::MOTION,
         stages,
-        &jobs,
+        jobs,
         progress,
     )?;
     let mut results = Vec::new();

@@ -172,6 +172,9 @@ pub struct ReproduceJob {
     pub noise_levels: Option<Vec<f64>>,
     /// Whether the learned fusions are trained beside the paper's three.
     pub fusions: bool,
+    /// The label-noise ablation's standard deviation (0: none), or `None` for the plan's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label_noise_deg: Option<f64>,
 }
 
 /// One point of a sensitivity study: Experiment 1, tuning included, on a dataset simulated with
@@ -340,6 +343,7 @@ mod tests {
             epochs: 7,
             sampling: Sampling::WITH_STOP,
             phases: vec![Phase::Motion, Phase::Stop],
+            label_noise_deg: 0.04,
         };
         vec![
             Job::Simulate(SimulateJob {
@@ -363,6 +367,7 @@ mod tests {
                 inputs: Inputs::FROM_FILES,
                 noise_levels: Some(vec![0.0, 2.5]),
                 fusions: false,
+                label_noise_deg: Some(0.0),
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

@@ -61,6 +61,7 @@ mod exp3;
 pub mod job;
 pub mod jobs;
 mod label_check;
+pub mod label_noise;
 pub mod latency;
 mod noise;
 pub mod pipeline;

@@ -17,7 +17,8 @@ use crate::stage_log::StageLog;
 use crate::training;
 use crate::tuning::{self, Kind};
 use crate::{
-    choices, examples, exp1, exp2, exp3, label_check, latency, noise, repr_example, sensor_view,
+    choices, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise, repr_example,
+    sensor_view,
 };
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
@@ -152,6 +153,10 @@ pub fn reproduce(
     if !noise.is_empty() {
         stages.done("experiment 1 at other noise")?;
     }
+    let label_noise = label_noise::run(&cache1, &splits1, &reprs, &e1, &run)?;
+    if label_noise.is_some() {
+        stages.done("label-noise ablation")?;
+    }
 
     let mut e2 = Vec::new();
     let mut example = None;
@@ -268,6 +273,7 @@ pub fn reproduce(
         exp3_depth: e3d,
         latency: lat,
         noise,
+        label_noise,
         example,
         choices: choices::of_run(
             plan,
@@ -297,7 +303,7 @@ pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
 }
 
 /// The training jobs that can run now and are not finished: the tuning runs, and once both
-/// tunings are finished, Experiments 1 and 2. Run them (in any order, in parallel, e.g. with
+/// tunings are finished, Experiments 1 and 2 and the label-noise ablation. Run them (in any order, in parallel, e.g. with
 /// `evtac jobs run`), then run the reproduction again: it resumes from the finished jobs.
 /// Makes the splits (and needs the Experiment 1 dataset).
 pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Result<Vec<Job>, Error> {
@@ -330,6 +336,7 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
     if let [s, d] = tuned[..] {
         let reprs = exp1::of_plan(plan, s, d);
         let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);
+        train.extend(label_noise::jobs(&ds1, &reprs, plan, seed, &models));
         if let Some(d2) = &data.exp2 {
             let ds2 = Dataset::open(d2, data.inputs)?;
             ds2.splits(seed)?;

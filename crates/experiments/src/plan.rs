@@ -78,7 +78,16 @@ pub struct Plan {
     /// paper's own plan, about half the training). Absent from older plans: they were.
     #[serde(default = "fusions_by_default")]
     pub fusions: bool,
+    /// Standard deviation (degrees) of the noise the label-noise ablation adds to Experiment
+    /// 1's training labels ([`LABEL_NOISE_DEG`] by default), or `None` for no ablation
+    /// (`evtac reproduce --label-noise-deg 0`). Absent from older plans: none.
+    #[serde(default)]
+    pub label_noise_deg: Option<f64>,
 }
+
+/// The label-noise ablation's standard deviation: the spread of the paper's label validation at
+/// stops (-0.01 ± 0.04 deg).
+pub const LABEL_NOISE_DEG: f64 = 0.04;
 
 /// [`Plan::fusions`] of plans written before it existed.
 fn fusions_by_default() -> bool {
@@ -112,6 +121,7 @@ impl Plan {
                 latency_intervals_ms: vec![1, 2, 5, 10],
                 noise_levels: NOISE_LEVELS.to_vec(),
                 fusions: true,
+                label_noise_deg: Some(LABEL_NOISE_DEG),
             },
             Scale::Small => Plan {
                 scale,

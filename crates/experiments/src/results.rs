@@ -153,6 +153,18 @@ pub struct Exp1Repr {
     pub test: MaeStats,
 }
 
+/// The label-noise ablation: Experiment 1's paper representations trained with noisy labels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LabelNoise {
+    /// Standard deviation of the noise added to each training label, degrees.
+    pub sd_deg: f64,
+    /// Experiment 1's results for the same representations (clean labels).
+    pub clean: Vec<Exp1Repr>,
+    /// The same representations, settings and seeds trained on the noisy labels, tested on
+    /// the clean test labels.
+    pub noisy: Vec<Exp1Repr>,
+}
+
 /// Experiment 1 at one background-noise level, for one representation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NoisePoint {
@@ -464,6 +476,9 @@ pub struct Results {
     /// The sensor at rest and in contact; not written to JSON.
     #[serde(skip)]
     pub sensor: Option<SensorView>,
+    /// The label-noise ablation (absent when the plan has none, and from older results).
+    #[serde(default)]
+    pub label_noise: Option<LabelNoise>,
     /// What the sensor figure shows: its view is not in JSON but its kind is, so that the
     /// report's caption can be rebuilt from `results.json` alone. Absent from older results.
     #[serde(default)]

@@ -174,12 +174,13 @@ pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError
     perturbed(&defaults, &p, factor)
 }
 
-/// The plan every point runs: the scale's, with the paper's three representations only and no
-/// noise study (each point is one Experiment 1).
+/// The plan every point runs: the scale's, with the paper's three representations only, no
+/// noise study and no label-noise ablation (each point is one Experiment 1).
 pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
     crate::plan::Plan {
         fusions: false,
         noise_levels: Vec::new(),
+        label_noise_deg: None,
         ..crate::plan::Plan::for_scale(scale)
     }
 }

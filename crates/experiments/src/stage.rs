@@ -7,6 +7,7 @@
 
 use crate::plan::{Kind, Plan};
 use evtac_events::manifest::Manifest;
+use evtac_repr::ReprKind;
 use evtac_sim::{DatasetConfig, Protocol, Scale};
 use std::path::Path;
 
@@ -56,6 +57,8 @@ pub enum Stage {
     NoiseSimulating,
     /// Experiment 1's training runs at a scaled background noise (units: runs).
     NoiseTraining,
+    /// The label-noise ablation's training runs (units: runs).
+    LabelNoiseTraining,
 }
 
 impl std::fmt::Display for Stage {
@@ -75,6 +78,7 @@ impl std::fmt::Display for Stage {
             Stage::SlurmTasks => f.write_str("Slurm tasks"),
             Stage::NoiseSimulating => f.write_str("simulating exp1 at other noise"),
             Stage::NoiseTraining => f.write_str("noise training"),
+            Stage::LabelNoiseTraining => f.write_str("label-noise training"),
         }
     }
 }
@@ -177,7 +181,7 @@ impl CostModel {
             Stage::Simulating(_) | Stage::NoiseSimulating => units * cost::SIMULATE_TRIAL,
             Stage::Features(_) => units * cost::FEATURES_TRIAL,
             Stage::Tuning(_) => units * plan.tuning_epochs as f64 * train(counts.exp1),
-            Stage::Exp1Training | Stage::NoiseTraining => {
+            Stage::Exp1Training | Stage::NoiseTraining | Stage::LabelNoiseTraining => {
                 units * plan.epochs as f64 * train(counts.exp1)
             }
             Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
@@ -219,6 +223,12 @@ impl CostModel {
             * (c(Stage::NoiseSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::Noise), counts.exp1)
                 + c(Stage::NoiseTraining, reprs * plan.seeds));
+        if plan.label_noise_deg.is_some_and(|sd| sd > 0.0) {
+            sum += c(
+                Stage::LabelNoiseTraining,
+                ReprKind::PAPER.len() * plan.seeds,
+            );
+        }
         sum
     }
 }

@@ -80,6 +80,7 @@ pub fn job(
             epochs: plan.tuning_epochs,
             sampling: Sampling::MOTION,
             phases: vec![Phase::Motion],
+            label_noise_deg: 0.0,
         },
         out: run_dir(out, kind, &config),
     }

@@ -142,6 +142,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if !j.fusions {
                 args.push("--no-fusions".into());
             }
+            if let Some(sd) = j.label_noise_deg {
+                args.extend(["--label-noise-deg".into(), sd.to_string()]);
+            }
         }
         Job::SensitivityPoint(j) => {
             args.push("sensitivity".into());
@@ -156,6 +159,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
 fn train_args(j: &TrainJob) -> Vec<String> {
     let mut args = vec!["train".into(), path(&j.dataset)];
     let spec = &j.spec;
+    if spec.label_noise_deg > 0.0 {
+        args.extend(["--label-noise-deg".into(), spec.label_noise_deg.to_string()]);
+    }
     args.extend(["--repr".into(), spec.repr.kind().name().into()]);
     if let Some(s) = spec.repr.static_part() {
         args.extend(["--tau-ms".into(), s.tau_ms.to_string()]);

@@ -73,6 +73,10 @@ pub struct Args {
     /// Training epochs (the default is the paper's).
     #[arg(long, default_value_t = TrainConfig::default().epochs)]
     pub epochs: usize,
+    /// Add Gaussian noise of this standard deviation (degrees) to every training label, seeded
+    /// by --seed (validation and test labels are left alone): how much label noise costs.
+    #[arg(long, default_value_t = 0.0, value_name = "SD")]
+    pub label_noise_deg: f64,
     /// Seed of the initial weights and the shuffling.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -130,9 +134,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             epochs: args.epochs,
             sampling,
             phases,
+            label_noise_deg: args.label_noise_deg,
         },
         out: args.out.clone(),
     };
+    anyhow::ensure!(
+        args.label_noise_deg.is_finite() && args.label_noise_deg >= 0.0,
+        "--label-noise-deg {}: give a standard deviation in degrees, 0 or more",
+        args.label_noise_deg
+    );
     let trials =
         evtac_events::manifest::Manifest::read(&args.dataset).map_or(0, |m| m.trials.len() as u64);
     let hidden = || indicatif::ProgressBar::hidden();
