@@ -34,9 +34,9 @@ pub fn tiny_study() -> &'static (PathBuf, String) {
     study
 }
 
-/// `dvs.pos_thres` of the dataset of one point.
+/// `dvs.pos_thres` of the dataset of one point (its copy of the dataset's `simulator.json`).
 fn on_threshold(point: &std::path::Path) -> f64 {
-    let text = std::fs::read_to_string(point.join("data").join("simulator.json")).unwrap();
+    let text = std::fs::read_to_string(point.join("simulator.json")).unwrap();
     let sim: serde_json::Value = serde_json::from_str(&text).unwrap();
     sim["params"]["dvs"]["pos_thres"]
         .as_f64()
@@ -55,6 +55,16 @@ fn a_tiny_study_varies_the_simulator_writes_its_summary_and_resumes_to_the_same_
     let base = on_threshold(&points.join("baseline/x1"));
     assert_eq!(on_threshold(&points.join("on_threshold/x0.5")), base * 0.5);
     assert_eq!(on_threshold(&points.join("on_threshold/x1.5")), base * 1.5);
+    // A finished point keeps its results and models; its dataset and feature cache are gone.
+    for point in ["baseline/x1", "on_threshold/x0.5", "on_threshold/x1.5"] {
+        let dir = points.join(point);
+        assert!(dir.join("point.json").is_file(), "{point}");
+        assert!(
+            dir.join("models/exp1/static/seed0/done").is_file(),
+            "{point}"
+        );
+        assert!(!dir.join("data").exists(), "{point} kept its dataset");
+    }
 
     let json = std::fs::read(out.join("sensitivity.json")).unwrap();
     let study: serde_json::Value = serde_json::from_slice(&json).unwrap();

@@ -191,6 +191,10 @@ pub struct SensitivityPointJob {
     pub factor: f64,
     /// The point's folder ([`crate::sensitivity::point_dir`]).
     pub out: PathBuf,
+    /// Keep the point's dataset and feature cache once it is finished (see
+    /// [`crate::sensitivity::point`]).
+    #[serde(default)]
+    pub keep_data: bool,
 }
 
 impl SensitivityPointJob {
@@ -206,7 +210,8 @@ impl SensitivityPointJob {
             models: &models,
             progress,
         };
-        crate::sensitivity::point(&self.parameter, self.factor, &params, &self.out, &run)?;
+        let point = (self.parameter.as_str(), self.factor);
+        crate::sensitivity::point(point, &params, &self.out, self.keep_data, &run)?;
         Ok(())
     }
 }
@@ -375,6 +380,7 @@ mod tests {
                 parameter: "cutoff".into(),
                 factor: 0.5,
                 out: "study/points/cutoff/x0.5".into(),
+                keep_data: true,
             }),
         ]
     }

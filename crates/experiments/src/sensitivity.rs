@@ -36,6 +36,7 @@ use crate::splits::Split;
 use crate::stage::{FeatureSet, Stage};
 use crate::tuning::{self, Kind};
 use crate::variant;
+use evtac_events::IoError;
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::ReprKind;
@@ -422,9 +423,55 @@ fn rise(points: &[Exp3Point]) -> Rise {
     }
 }
 
+/// The file a finished point's results are kept in, in its folder.
+pub const POINT_FILE: &str = "point.json";
+
 /// One point: simulate, tune, Experiment 1 with the paper's three representations, the test
-/// trials by speed and by depth, the conclusions. `dir` is the point's folder.
+/// trials by speed and by depth, the conclusions. `dir` is the point's folder. A finished point
+/// is read back from its [`POINT_FILE`], beside a copy of its dataset's `simulator.json`; unless
+/// `keep_data`, finishing a point removes its dataset and feature cache (about 1.1 GB at small
+/// scale, of which its models need none), so that a study of 35 points needs the disk of one
+/// dataset at a time.
 pub fn point(
+    (parameter, factor): (&str, f64),
+    params: &SimParams,
+    dir: &Path,
+    keep_data: bool,
+    run: &RunContext<'_>,
+) -> Result<Point, Error> {
+    let file = dir.join(POINT_FILE);
+    if crate::jobs::is_done(dir)
+        && let Ok(text) = std::fs::read_to_string(&file)
+        && let Ok(point) = serde_json::from_str::<Point>(&text)
+    {
+        return Ok(point);
+    }
+    let point = measure(parameter, factor, params, dir, run)?;
+    let json = serde_json::to_string_pretty(&point)
+        .map_err(IoError::at(&file))
+        .map_err(crate::jobs::Error::from)?;
+    crate::jobs::write_atomic(&file, json.as_bytes())
+        .map_err(IoError::at(&file))
+        .map_err(crate::jobs::Error::from)?;
+    // The marker says the point as a whole is finished: what a Slurm run submits again is what
+    // has none, and what is read back is what has one.
+    crate::jobs::mark_done(dir)?;
+    // What made the point stays beside its results, with or without its dataset.
+    let data = dir.join("data");
+    let made_by = dir.join(evtac_events::layout::SIMULATOR_FILE);
+    std::fs::copy(data.join(evtac_events::layout::SIMULATOR_FILE), &made_by)
+        .map_err(IoError::at(&made_by))
+        .map_err(crate::jobs::Error::from)?;
+    if !keep_data {
+        std::fs::remove_dir_all(&data)
+            .map_err(IoError::at(&data))
+            .map_err(crate::jobs::Error::from)?;
+    }
+    Ok(point)
+}
+
+/// [`point`]'s measurement, every part of it resuming on its own.
+fn measure(
     parameter: &str,
     factor: f64,
     params: &SimParams,
@@ -484,9 +531,6 @@ pub fn point(
         rises.push(rise(&levels));
     }
     let (slow, shallow) = (rises[0], rises[1]);
-    // Every part resumes on its own; the marker says the point as a whole is finished (what a
-    // Slurm run submits again is what has none).
-    crate::jobs::mark_done(dir)?;
     let mean = |s: &MaeStats| s.overall.mean;
     let [st_mae, dy_mae, co_mae] = [mean(&test[0]), mean(&test[1]), mean(&test[2])];
     Ok(Point {
@@ -510,11 +554,13 @@ pub fn point(
 /// The study: the baseline, then every parameter of `parameters` at every factor of `factors`
 /// ([`points`]), under `out`. `run.models` is unused (each point has its own); `run.plan`
 /// ([`plan`]) sizes the datasets, `run.seed` seeds the datasets, splits and training. Points
-/// already finished (by an earlier run, or by Slurm tasks) are read back from their runs.
+/// already finished (by an earlier run, or by Slurm tasks) are read back; `keep_data` as in
+/// [`point`].
 pub fn run(
     parameters: &[Parameter],
     factors: &[f64],
     out: &Path,
+    keep_data: bool,
     run: &RunContext<'_>,
 ) -> Result<Study, Error> {
     evtac_learn::flush_denormals();
@@ -541,13 +587,8 @@ pub fn run(
             k + 1,
             todo.len()
         ));
-        points.push(point(
-            name,
-            *factor,
-            params,
-            &point_dir(out, name, *factor),
-            run,
-        )?);
+        let dir = point_dir(out, name, *factor);
+        points.push(point((name, *factor), params, &dir, keep_data, run)?);
     }
     Ok(Study {
         scale: run.plan.scale.name().to_string(),

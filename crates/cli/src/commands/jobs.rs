@@ -150,6 +150,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             args.push("sensitivity".into());
             args.extend(one_thread(j.scale, j.seed, &j.out));
             args.extend(["--point".into(), format!("{}:{}", j.parameter, j.factor)]);
+            if j.keep_data {
+                args.push("--keep-data".into());
+            }
         }
     }
     args

@@ -53,6 +53,11 @@ pub struct Args {
     /// Extra `sbatch` arguments, e.g. "--partition=cpu --time=1:00:00".
     #[arg(long, allow_hyphen_values = true)]
     pub slurm_args: Option<String>,
+    /// Keep each finished point's dataset and feature cache (about 1.1 GB a point at small
+    /// scale); by default they are removed once the point's results are in its `point.json`,
+    /// and its models are kept.
+    #[arg(long)]
+    pub keep_data: bool,
     /// Run one point only, PARAMETER:FACTOR (`baseline:1` for the defaults), into OUT as the
     /// point's folder, and write no summary: a Slurm task's work.
     #[arg(long, value_name = "PARAMETER:FACTOR")]
@@ -71,6 +76,7 @@ fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
         parameter: name.to_string(),
         factor,
         out: args.out.clone(),
+        keep_data: args.keep_data,
     };
     let pool = args.workers.pool()?;
     let bars = Bars::default();
@@ -92,6 +98,7 @@ fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> 
                 parameter: name.to_string(),
                 factor,
                 out: sensitivity::point_dir(&out, name, factor),
+                keep_data: args.keep_data,
             })
         })
         .collect();
@@ -163,7 +170,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         models: &models,
         progress: &bars,
     };
-    let study = pool.install(|| sensitivity::run(&parameters, &args.factors, &args.out, &run))?;
+    let study = pool.install(|| {
+        sensitivity::run(&parameters, &args.factors, &args.out, args.keep_data, &run)
+    })?;
     let written = evtac_report::sensitivity::write(&args.out, &study)?;
     bars.finish();
     for path in &written {
