@@ -453,15 +453,16 @@ pub fn point(
     crate::jobs::write_atomic(&file, json.as_bytes())
         .map_err(IoError::at(&file))
         .map_err(crate::jobs::Error::from)?;
-    // The marker says the point as a whole is finished: what a Slurm run submits again is what
-    // has none, and what is read back is what has one.
-    crate::jobs::mark_done(dir)?;
     // What made the point stays beside its results, with or without its dataset.
     let data = dir.join("data");
     let made_by = dir.join(evtac_events::layout::SIMULATOR_FILE);
     std::fs::copy(data.join(evtac_events::layout::SIMULATOR_FILE), &made_by)
         .map_err(IoError::at(&made_by))
         .map_err(crate::jobs::Error::from)?;
+    // The marker says the point as a whole is finished (its results and what made them are
+    // written): what a Slurm run submits again is what has none, and what is read back is what
+    // has one. The dataset goes after it, so a point is never left without both.
+    crate::jobs::mark_done(dir)?;
     if !keep_data {
         std::fs::remove_dir_all(&data)
             .map_err(IoError::at(&data))

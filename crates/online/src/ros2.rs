@@ -40,7 +40,8 @@
 //!
 //! An earlier version handed each estimate to a publishing thread of evtac's own through a
 //! queue. That thread was one more wake-up between the estimate and the wire, and on a shared
-//! core each wake-up is a scheduler's decision: it put the added latency's P99 at 176 us.
+//! core each wake-up is a scheduler's decision: the added latency's P99 was 143 us with it,
+//! 108-114 us without (`benches/ros2_latency.rs`, idle).
 //! What it protected against, a write that waits, the zero blocking time rules out. What a
 //! write still shares with RustDDS's event loop is the send buffer's lock, held for the
 //! moment of an insert or a send; the publish time in the summary is that write's duration.
@@ -54,8 +55,9 @@
 //! announcement arrives, the reader matches the writer when ours does, and the two need not
 //! happen together. A reliable, volatile reader (Cyclone's, as rclpy's) that matches the writer
 //! late starts at the writer's next sequence number, so what was written in between is lost to
-//! it (the likeliest cause of a CI run whose subscriber missed 7 of 401 estimates). RustDDS says when *it* matched, not
-//! when the reader did, so the wait adds [`DISCOVERY_SETTLE`] after the match.
+//! it (the likeliest cause of a CI run whose subscriber missed 7 of 401 estimates). RustDDS
+//! says when *it* matched, not when the reader did, so the wait adds [`DISCOVERY_SETTLE`] after
+//! the match.
 
 use crate::estimator::Estimate;
 use crate::latency::LatencyStats;
@@ -413,8 +415,8 @@ impl std::fmt::Display for PublishStats {
         )?;
         write!(
             f,
-            "ROS 2 publish time (the DDS write, on the thread that delivers estimates): median {:.1} us, \
-             P99 {:.1} us, max {:.1} us",
+            "ROS 2 publish time (the DDS write, on the thread that delivers estimates): median \
+             {:.1} us, P99 {:.1} us, max {:.1} us",
             us(self.latency_median),
             us(self.latency_p99),
             us(self.latency_max)

@@ -16,7 +16,9 @@ struct Row<'a> {
     gaps: Vec<(f64, f64)>,
 }
 
-fn rows(study: &Study) -> Vec<Row<'_>> {
+/// The parameters' rows, sorted by how far either factor moves the gap from `base`'s (the
+/// farthest last).
+fn rows(study: &Study, base: f64) -> Vec<Row<'_>> {
     let mut rows: Vec<Row<'_>> = Vec::new();
     for p in study.points.iter().filter(|p| p.parameter != BASELINE) {
         match rows.iter_mut().find(|r| r.name == p.parameter) {
@@ -28,8 +30,10 @@ fn rows(study: &Study) -> Vec<Row<'_>> {
         }
     }
     let spread = |r: &Row<'_>| {
-        let gaps = r.gaps.iter().map(|g| g.1);
-        gaps.clone().fold(f64::NEG_INFINITY, f64::max) - gaps.fold(f64::INFINITY, f64::min)
+        r.gaps
+            .iter()
+            .map(|g| (g.1 - base).abs())
+            .fold(0.0, f64::max)
     };
     // Smallest first: plotters' y axis grows upwards, so the largest lands on top.
     rows.sort_by(|a, b| spread(a).total_cmp(&spread(b)));
@@ -38,8 +42,8 @@ fn rows(study: &Study) -> Vec<Row<'_>> {
 
 /// The tornado figure of `study` at `path`.
 pub fn gap_tornado(path: &Path, study: &Study) -> Result<(), Error> {
-    let rows = rows(study);
     let base = study.baseline().map_or(0.0, |b| b.gap_deg);
+    let rows = rows(study, base);
     let height = 120 + 34 * rows.len() as u32;
     let root = canvas(path, (900, height), !rows.is_empty())?;
     let e = draw_err(path);
