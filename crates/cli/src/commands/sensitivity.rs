@@ -20,11 +20,9 @@ use std::time::Instant;
 /// Arguments of `evtac sensitivity`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Parameters: pin_rings, pin_size, normal_gain, spread_gain, skin_tau, \
-    shear, trial_variation, creep, on_threshold, off_threshold, threshold_mismatch, cutoff, \
-    refractory, leak_rate, shot_noise, hot_pixels, imu_noise (each described in OUT/README.md).\n\n\
-    Example: evtac sensitivity --scale small --out sensitivity  (35 points, about an hour on \
-    2 cores)"
+    after_help = "The parameters and what each is: OUT/README.md, or the error a name \
+    that is none of them gets.\n\nExample: evtac sensitivity --scale small --out sensitivity \
+    (35 points, about 80 minutes on 2 cores)"
 )]
 pub struct Args {
     /// Size of each point's dataset and plan: tiny (tests), small or paper.
@@ -33,7 +31,8 @@ pub struct Args {
     /// Master seed (simulation, splits, training), the same at every point.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Output folder: `points/<parameter>/x<factor>/` (data, models), the summary.
+    /// Output folder: the summary, and `points/<parameter>/x<factor>/` (each point's
+    /// `point.json`, `simulator.json` and models; its dataset too with --keep-data).
     #[arg(long)]
     pub out: PathBuf,
     /// Parameters to vary, comma-separated (default: all 17).
