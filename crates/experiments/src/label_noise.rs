@@ -27,6 +27,15 @@ pub fn models_dir(models: &Path, sd: f64) -> PathBuf {
     models.join("label-noise").join(format!("sd{sd}"))
 }
 
+/// The paper's representations among `reprs`: the ones the ablation trains.
+fn paper(reprs: &[ReprConfig]) -> Vec<ReprConfig> {
+    reprs
+        .iter()
+        .filter(|c| ReprKind::PAPER.contains(&c.kind()))
+        .copied()
+        .collect()
+}
+
 /// The ablation's training jobs: Experiment 1's for the paper's representations among `reprs`,
 /// with label noise `sd`, under [`models_dir`]. Empty when the plan has no ablation.
 pub fn jobs(
@@ -39,11 +48,7 @@ pub fn jobs(
     let Some(sd) = plan.label_noise_deg.filter(|sd| *sd > 0.0) else {
         return Vec::new();
     };
-    let paper: Vec<ReprConfig> = reprs
-        .iter()
-        .filter(|c| ReprKind::PAPER.contains(&c.kind()))
-        .copied()
-        .collect();
+    let paper = paper(reprs);
     let mut jobs = exp1::jobs(ds, &paper, plan, seed, &models_dir(models, sd));
     for job in &mut jobs {
         job.spec.label_noise_deg = sd;
@@ -69,11 +74,7 @@ pub fn run(
         models: &models,
         ..*run
     };
-    let paper: Vec<ReprConfig> = reprs
-        .iter()
-        .filter(|c| ReprKind::PAPER.contains(&c.kind()))
-        .copied()
-        .collect();
+    let paper = paper(reprs);
     let noisy = exp1::run_jobs(
         cache,
         splits,

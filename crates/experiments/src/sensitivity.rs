@@ -393,10 +393,10 @@ pub fn point_dir(out: &Path, parameter: &str, factor: f64) -> PathBuf {
 
 /// Static's and dynamic's rise at the lowest level of `points`.
 fn rise(points: &[Exp3Point]) -> Rise {
-    let level = points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min);
     let mut values: Vec<f64> = points.iter().map(|p| p.value).collect();
     values.sort_by(f64::total_cmp);
     values.dedup();
+    let level = values.first().copied().unwrap_or(f64::INFINITY);
     let of = |kind: ReprKind| {
         let at: Vec<&Exp3Point> = points.iter().filter(|p| p.name == kind).collect();
         let extreme = at

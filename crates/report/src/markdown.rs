@@ -275,6 +275,12 @@ fn exp3_table(md: &mut String, points: &[Exp3Point], (axis, unit): (&str, &str))
     flagged
 }
 
+/// What the sensor figure shows: from its view when the run made one, else from
+/// `results.json`'s record of it.
+fn sensor_kind(r: &Results) -> Option<SensorKind> {
+    r.sensor.as_ref().map(|v| v.kind).or(r.sensor_kind)
+}
+
 /// The report's Markdown.
 pub fn markdown(r: &Results, figures: &[&str]) -> String {
     let mut md = String::new();
@@ -341,12 +347,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
 
     if figures.contains(&FIGURES[7].0) || figures.contains(&FIGURES[8].0) {
         let _ = writeln!(md, "## The sensor and the representations\n");
-        figure(
-            &mut md,
-            figures,
-            8,
-            r.sensor.as_ref().map(|v| v.kind).or(r.sensor_kind),
-        );
+        figure(&mut md, figures, 8, sensor_kind(r));
         figure(&mut md, figures, 7, None);
     }
 
@@ -462,8 +463,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         }
         if !r.exp3_depth.is_empty() {
             let flagged = exp3_table(&mut md, &r.exp3_depth, ("depth", "mm"));
-            let simulated =
-                r.sensor.as_ref().map(|v| v.kind).or(r.sensor_kind) == Some(SensorKind::Simulated);
+            let simulated = sensor_kind(r) == Some(SensorKind::Simulated);
             if simulated && flagged {
                 let _ = writeln!(
                     md,

@@ -119,12 +119,9 @@ fn chosen(names: Option<&[String]>) -> anyhow::Result<Vec<Parameter>> {
     names
         .iter()
         .map(|n| {
-            sensitivity::parameter(n).ok_or_else(|| {
-                anyhow::anyhow!(
-                    "--parameters: no simulator parameter {n:?}; the parameters are {}",
-                    sensitivity::names()
-                )
-            })
+            sensitivity::parameter(n)
+                .ok_or_else(|| sensitivity::PerturbError::Unknown { name: n.clone() })
+                .context("--parameters")
         })
         .collect()
 }
