@@ -117,15 +117,17 @@ pub(crate) fn seed_jobs(
     v
 }
 
-/// Runs (or resumes) `jobs` on `cache`'s dataset, in parallel.
+/// Runs (or resumes) `jobs` on `cache`'s dataset, in parallel, the longest first
+/// ([`crate::schedule`]).
 pub fn train_all(
     cache: &FeatureCache<'_>,
     splits: &Splits,
     jobs: &[TrainJob],
     progress: &dyn Progress,
 ) -> Result<(), Error> {
+    let ordered = crate::schedule::longest_first(cache, splits, jobs)?;
     jobs::run_all(
-        jobs,
+        &ordered,
         |j| j.out.clone(),
         |j| j.run_on(cache, splits, |_| {}).map(|_| ()),
         |skipped| progress.finished(skipped),

@@ -4,8 +4,9 @@
 //! as one `evtac ...` command per line for a Slurm array or GNU parallel.
 
 use evtac_events::IoError;
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Name of the marker file a finished job writes last.
 pub const DONE: &str = "done";
@@ -51,9 +52,16 @@ pub fn tmp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Runs `work` on every item in parallel (rayon), skipping those whose `dir(item)` is done, and
+/// Runs `work` on every item in parallel, skipping those whose `dir(item)` is done, and
 /// calling `progress(skipped)` after each item (`true` when it was done already). Returns the
-/// first error, after the other items finished (their work is kept for a resumed run).
+/// first error in `items`' order, after the other items finished (their work is kept for a
+/// resumed run).
+///
+/// Items start in the order given: each of rayon's threads takes the next item as it frees.
+/// Callers put the longest first (`crate::exp1::train_all` orders training runs by their
+/// features' density), so the last items to finish are short and the tail, where a core has
+/// nothing left to take, is short too. (rayon's `par_iter` splits the slice in halves instead,
+/// so a long item can start last.)
 pub fn run_all<T, E, D, W, P>(items: &[T], dir: D, work: W, progress: P) -> Result<(), E>
 where
     T: Sync,
@@ -62,17 +70,31 @@ where
     W: Fn(&T) -> Result<(), E> + Sync,
     P: Fn(bool) + Sync,
 {
-    let errors: Vec<E> = items
-        .par_iter()
-        .filter_map(|item| {
-            let skipped = is_done(&dir(item));
-            let result = if skipped { Ok(()) } else { work(item) };
-            progress(skipped);
-            result.err()
-        })
-        .collect();
-    match errors.into_iter().next() {
-        Some(e) => Err(e),
+    let next = AtomicUsize::new(0);
+    let errors = Mutex::new(Vec::new());
+    let workers = rayon::current_num_threads().clamp(1, items.len().max(1));
+    rayon::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|_| {
+                loop {
+                    let index = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(item) = items.get(index) else { break };
+                    let skipped = is_done(&dir(item));
+                    let result = if skipped { Ok(()) } else { work(item) };
+                    progress(skipped);
+                    if let Err(e) = result {
+                        errors
+                            .lock()
+                            .unwrap_or_else(|p| p.into_inner())
+                            .push((index, e));
+                    }
+                }
+            });
+        }
+    });
+    let errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
+    match errors.into_iter().min_by_key(|(index, _)| *index) {
+        Some((_, e)) => Err(e),
         None => Ok(()),
     }
 }
@@ -101,7 +123,6 @@ pub fn command_line(args: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::atomic::{AtomicUsize, Ordering};
 
     #[test]
     fn finished_jobs_are_skipped_and_failures_keep_the_rest() {
@@ -146,6 +167,44 @@ mod tests {
         assert_eq!(ran_again.load(Ordering::SeqCst), 1);
         // The seven finished ones are reported as skipped, for the ETA to leave them out.
         assert_eq!(skipped_again.load(Ordering::SeqCst), 7);
+    }
+
+    /// Items start in the order given (what lets callers put the longest first), on one
+    /// thread and on several; the first error is the first in that order.
+    #[test]
+    fn items_start_in_the_order_given() {
+        let dir = tempfile::tempdir().unwrap();
+        let items: Vec<usize> = (0..20).collect();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let started = Mutex::new(Vec::new());
+            let result = pool.install(|| {
+                run_all(
+                    &items,
+                    |i| dir.path().join(format!("job{i}")),
+                    |&i| {
+                        started.lock().unwrap().push(i);
+                        std::thread::sleep(std::time::Duration::from_millis(2));
+                        if i % 7 == 6 { Err(i) } else { Ok(()) }
+                    },
+                    |_| {},
+                )
+            });
+            assert_eq!(result, Err(6), "{threads} threads");
+            let started = started.into_inner().unwrap();
+            assert_eq!(started.len(), items.len());
+            // A worker takes item k only after items 0..k were handed out, so k starts
+            // within `threads` places of k (the recording itself can race by that much).
+            for (place, &i) in started.iter().enumerate() {
+                assert!(
+                    place.abs_diff(i) < threads,
+                    "{threads} threads: {started:?}"
+                );
+            }
+        }
     }
 
     #[test]

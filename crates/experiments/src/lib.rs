@@ -16,7 +16,7 @@
 //! - [`context`]: the plan, seed, model folder and progress an experiment run shares.
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA), reported
-//!   through [`progress`].
+//!   through [`progress`]; the crate's `schedule` starts a stage's training runs longest first.
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
 //! - [`plan`], [`tuning`], [`exp1`], [`latency`] and the crate's own `noise`, `exp2`, `exp3` and
 //!   `examples`: the experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and
@@ -70,6 +70,7 @@ pub mod progress;
 pub mod repr_example;
 pub mod results;
 pub mod sampling;
+mod schedule;
 pub mod sensitivity;
 pub mod sensor_view;
 pub mod slurm;

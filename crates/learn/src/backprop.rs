@@ -12,12 +12,17 @@
 //!   for four samples ([`crate::panels::GROUPED_DENSITY`]);
 //! - its weight gradient is built row by row from the batch's non-zeros (a column-major index
 //!   built once per step) and handed straight to AdamW, so the 900 x 256 gradient is never
-//!   stored and rows no sample reached take the zero-gradient update;
+//!   stored and rows no sample reached take the zero-gradient update; a dense batch's is
+//!   formed four input rows at a time from its dense rows instead ([`crate::gradient_tile`],
+//!   AVX-512F);
 //! - the other layers skip the zeros of the ReLU outputs forward and backward.
 //!
-//! The arithmetic is the same as PyTorch's up to the order of additions (tested against burn's
-//! autodiff gradients below and against PyTorch's losses in `tests/pytorch.rs`), and it is
-//! deterministic: one order, the same on every CPU.
+//! The arithmetic is PyTorch's up to rounding (the order of additions, fused multiply-adds,
+//! AdamW's refined estimates: [`crate::adamw`]); tested against burn's autodiff gradients
+//! below, against PyTorch's losses step by step in `tests/pytorch.rs` and against whole
+//! PyTorch runs in `tests/converges.rs`. It is deterministic: a given binary on a given CPU
+//! takes the same path for the same batch and gives the same bits (CPUs without AVX-512F round
+//! some steps differently).
 
 use crate::adamw::{self, AdamW, StepScalars};
 use crate::model::{
@@ -218,7 +223,13 @@ pub(crate) fn step(
     let n = y.len() / OUTPUTS;
     let inputs = net.inputs();
     debug_assert!(n <= MAX_BATCH && x.len() == n * inputs);
-    scratch.index_batch(x, n, inputs);
+    let dense = panels::dense_enough(x);
+    // A dense batch's first-layer gradient comes from its dense rows (`gradient_tile`); the
+    // per-sample and per-feature indexes of its non-zeros are for sparse batches.
+    let tiled_gradient = dense && tiled_gradient_runs(inputs);
+    if !tiled_gradient {
+        scratch.index_batch(x, n, inputs);
+    }
     for k in 0..LAYERS {
         scratch.h[k].resize(n * LAYER_SIZES[k + 1], 0.0);
         scratch.d[k].resize(n * LAYER_SIZES[k + 1], 0.0);
@@ -229,7 +240,7 @@ pub(crate) fn step(
     let [h1, h2, h3, out] = &mut scratch.h;
     // Each block of the first layer from its inputs only (late fusion: a branch per frame).
     let blocks = net.architecture.first_layer_blocks();
-    if scratch.index.len() as f64 > crate::panels::GROUPED_DENSITY * x.len() as f64 {
+    if dense {
         for (x, h) in x.chunks(GROUP * inputs).zip(h1.chunks_mut(GROUP * H1)) {
             let rows = x.len() / inputs;
             for block in blocks {
@@ -323,13 +334,39 @@ pub(crate) fn step(
         optimizer.update(&s, 2 * (k + 1), &mut layer.weights, &g.weights);
         optimizer.update(&s, 2 * (k + 1) + 1, &mut layer.bias, &g.bias);
     }
-    let columns = Columns {
-        start: &scratch.col_start,
-        sample: &scratch.col_sample,
-        value: &scratch.col_value,
+    let gradient = if tiled_gradient {
+        Gradient::Dense(x)
+    } else {
+        Gradient::Columns(Columns {
+            start: &scratch.col_start,
+            sample: &scratch.col_sample,
+            value: &scratch.col_value,
+        })
     };
-    first_layer_update(net, optimizer, &s, &columns, d1, &scratch.bias0);
+    first_layer_update(net, optimizer, &s, gradient, d1, &scratch.bias0);
     loss * norm
+}
+
+/// Whether a dense batch of `inputs` features takes [`crate::gradient_tile`] (AVX-512F, and
+/// whole tiles of input rows).
+fn tiled_gradient_runs(inputs: usize) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        inputs.is_multiple_of(crate::gradient_tile::ROWS) && crate::gradient_tile::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = inputs;
+        false
+    }
+}
+
+/// What the first layer's weight gradient is formed from.
+enum Gradient<'a> {
+    /// The batch's non-zero features by feature (sparse batches).
+    Columns(Columns<'a>),
+    /// The batch's dense rows (`n x inputs`), on [`crate::gradient_tile`].
+    Dense(&'a [f32]),
 }
 
 /// The batch's non-zero features by feature (see [`Scratch`]).
@@ -345,7 +382,7 @@ fn first_layer_update(
     net: &mut Network,
     optimizer: &mut AdamW,
     s: &StepScalars,
-    columns: &Columns,
+    gradient: Gradient,
     d1: &[f32],
     bias_grad: &[f32],
 ) {
@@ -356,8 +393,52 @@ fn first_layer_update(
         fan_in: layer.fan_in,
         architecture,
     };
-    first_layer_rows(s, columns, d1, rows, &mut layer.weights, m, v);
+    match gradient {
+        Gradient::Columns(columns) => {
+            first_layer_rows(s, &columns, d1, rows, &mut layer.weights, m, v)
+        }
+        #[cfg(target_arch = "x86_64")]
+        Gradient::Dense(x) => first_layer_tiles(s, x, d1, rows, &mut layer.weights, m, v),
+        #[cfg(not(target_arch = "x86_64"))]
+        Gradient::Dense(_) => unreachable!("the tiled gradient runs on x86-64 only"),
+    }
     optimizer.update(s, 1, &mut layer.bias, bias_grad);
+}
+
+/// [`first_layer_rows`] for a dense batch `x` (`n x fan_in`): the gradient of four input rows
+/// of a block at a time on [`crate::gradient_tile`], then their update. The caller has checked
+/// [`tiled_gradient_runs`].
+#[cfg(target_arch = "x86_64")]
+fn first_layer_tiles(
+    s: &StepScalars,
+    x: &[f32],
+    d1: &[f32],
+    layer: FirstLayer,
+    weights: &mut [f32],
+    m: &mut [f32],
+    v: &mut [f32],
+) {
+    use crate::gradient_tile::{ROWS, tile};
+    let fan_in = layer.fan_in;
+    let mut g = [0.0_f32; ROWS * BLOCK];
+    for b in 0..weights.len() / (fan_in * BLOCK) {
+        for first in (0..fan_in).step_by(ROWS) {
+            // A tile's rows are all in one frame (`fan_in` and the branches' 900 inputs are
+            // multiples of ROWS): a cross-branch tile is skipped whole, as in the column path.
+            if !layer.architecture.connects(b * BLOCK, first) {
+                continue;
+            }
+            // SAFETY: the caller checked AVX-512F (`tiled_gradient_runs`).
+            unsafe { tile((x, fan_in), first, (&d1[b * BLOCK..], H1), &mut g) };
+            let rows = (b * fan_in + first) * BLOCK..(b * fan_in + first + ROWS) * BLOCK;
+            let (p, m, v) = (
+                &mut weights[rows.clone()],
+                &mut m[rows.clone()],
+                &mut v[rows],
+            );
+            adamw::update(s, p, &g, m, v);
+        }
+    }
 }
 
 /// The first layer's shape as [`first_layer_rows`] needs it.
@@ -368,9 +449,8 @@ struct FirstLayer {
 }
 
 /// The loop of [`first_layer_update`] over the weight's rows, compiled for AVX-512 and AVX2
-/// besides the baseline (the same bits on each: see [`crate::panels`]). Most of its time is
-/// AdamW's square root and two divisions per weight (fused multiply-adds in the gradient sum
-/// were tried: no change).
+/// besides the baseline (the gradient's sums have the same bits on each: see
+/// [`crate::panels`]); each row's update is [`adamw::update`].
 ///
 /// Late fusion's cross-branch rows (a block of one branch's units and an input of the other
 /// frame) are skipped: they get no gradient, and AdamW with a zero gradient and zero moments
@@ -408,9 +488,7 @@ fn first_layer_rows(
             }
         }
         // A row no sample reached has a zero gradient: the same update as any other.
-        for (((p, &g), m), v) in p.iter_mut().zip(&g).zip(m.iter_mut()).zip(v.iter_mut()) {
-            adamw::update_one(s, p, g, m, v);
-        }
+        adamw::update(s, p, &g, m, v);
     }
 }
 

@@ -6,7 +6,7 @@
 //!   seeded `ChaCha8Rng`; [`architecture`]: the networks for two frames side by side
 //!   (`stacked`, and `late` fusion's two branches), stored and run as the same four layers.
 //! - [`data`]: in-memory [`FeatureSet`]s and the seeded epoch shuffling.
-//! - [`training`]: [`train`] with SmoothL1 (beta 1) and PyTorch-exact AdamW ([`adamw`]), batch
+//! - [`training`]: [`train`] with SmoothL1 (beta 1) and AdamW as PyTorch computes it ([`adamw`]), batch
 //!   32, 100 epochs, validation MAE per epoch, best checkpoint kept.
 //! - [`bundle`]: the [`ModelBundle`] folder (`model.safetensors`, `config.json`, `mask.npy`,
 //!   `history.csv`).
@@ -50,6 +50,8 @@ mod burn_reference;
 pub mod cell_layer;
 pub mod data;
 pub mod ftz;
+#[cfg(target_arch = "x86_64")]
+mod gradient_tile;
 #[cfg(target_arch = "x86_64")]
 mod grouped_tile;
 pub mod metrics;

@@ -10,9 +10,11 @@
 //! Every kernel adds its products in a fixed order (input order, then sample order) with
 //! separate multiplies and adds (no FMA; training's grouped first layer is the one exception,
 //! fused on every target). The kernels are compiled for AVX-512 and AVX2 besides the baseline
-//! and picked at run time, and all three give bit-identical results: a model trained or
-//! evaluated on one x86-64 machine is the same bytes as on any other (a cluster's nodes need
-//! not match). Where a kernel serves several samples at once (the grouped forward, the input
+//! and picked at run time, and all three give bit-identical results: a model evaluated on one
+//! x86-64 machine gives the same outputs as on any other. (Training adds AdamW and the dense
+//! gradient tile, which round differently where the CPU lacks AVX-512F: a model is the same
+//! bytes on every CPU of one kind, so a cluster whose nodes differ in it trains different
+//! last bits. See [`crate::adamw`].) Where a kernel serves several samples at once (the grouped forward, the input
 //! gradient) its AVX-512 form is written by hand in [`crate::grouped_tile`], with the same
 //! operations in the same order, because LLVM keeps the portable form's register tile in
 //! memory.
@@ -327,7 +329,7 @@ pub(crate) fn grouped_forward_portable(
 }
 
 /// Whether more than [`GROUPED_DENSITY`] of `x` is non-zero.
-fn dense_enough(x: &[f32]) -> bool {
+pub(crate) fn dense_enough(x: &[f32]) -> bool {
     let non_zero = x.iter().filter(|&&v| v != 0.0).count();
     non_zero as f64 > GROUPED_DENSITY * x.len() as f64
 }

@@ -1,5 +1,6 @@
 //! The training loop: seeded initialisation and shuffling, SmoothL1 (Huber, beta 1) loss,
-//! PyTorch-exact AdamW, validation MAE after every epoch and the best-validation checkpoint.
+//! AdamW as PyTorch computes it, validation MAE after every epoch and the best-validation
+//! checkpoint.
 //!
 //! [`train`] runs the paper's recipe end to end; [`Trainer`] exposes single steps on given
 //! batches (used by the PyTorch comparison test and available for custom loops).
