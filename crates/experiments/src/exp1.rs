@@ -118,7 +118,7 @@ pub(crate) fn seed_jobs(
 }
 
 /// Runs (or resumes) `jobs` on `cache`'s dataset, in parallel, the longest first
-/// ([`crate::schedule`]).
+/// (the crate's `schedule` module).
 pub fn train_all(
     cache: &FeatureCache<'_>,
     splits: &Splits,

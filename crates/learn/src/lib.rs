@@ -6,8 +6,8 @@
 //!   seeded `ChaCha8Rng`; [`architecture`]: the networks for two frames side by side
 //!   (`stacked`, and `late` fusion's two branches), stored and run as the same four layers.
 //! - [`data`]: in-memory [`FeatureSet`]s and the seeded epoch shuffling.
-//! - [`training`]: [`train`] with SmoothL1 (beta 1) and AdamW as PyTorch computes it ([`adamw`]), batch
-//!   32, 100 epochs, validation MAE per epoch, best checkpoint kept.
+//! - [`training`]: [`train`] with SmoothL1 (beta 1) and AdamW as PyTorch computes it
+//!   ([`adamw`]), batch 32, 100 epochs, validation MAE per epoch, best checkpoint kept.
 //! - [`bundle`]: the [`ModelBundle`] folder (`model.safetensors`, `config.json`, `mask.npy`,
 //!   `history.csv`).
 //! - [`Model`]: a bundle loaded for use (predictor, representation, mask): what every consumer

@@ -14,10 +14,10 @@
 //! x86-64 machine gives the same outputs as on any other. (Training adds AdamW and the dense
 //! gradient tile, which round differently where the CPU lacks AVX-512F: a model is the same
 //! bytes on every CPU of one kind, so a cluster whose nodes differ in it trains different
-//! last bits. See [`crate::adamw`].) Where a kernel serves several samples at once (the grouped forward, the input
-//! gradient) its AVX-512 form is written by hand in [`crate::grouped_tile`], with the same
-//! operations in the same order, because LLVM keeps the portable form's register tile in
-//! memory.
+//! last bits. See [`crate::adamw`].) Where a kernel serves several samples at once (the
+//! grouped forward, the input gradient) its AVX-512 form is written by hand in
+//! [`crate::grouped_tile`], with the same operations in the same order, because LLVM keeps the
+//! portable form's register tile in memory.
 
 use std::ops::Range;
 
