@@ -81,26 +81,7 @@ pub(crate) unsafe fn tile(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A deterministic stream of floats in [-1, 1), a fraction `zeros` of them zero.
-    fn floats(n: usize, seed: u64, zeros: f32) -> Vec<f32> {
-        let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
-        (0..n)
-            .map(|_| {
-                if next() < zeros {
-                    0.0
-                } else {
-                    2.0 * next() - 1.0
-                }
-            })
-            .collect()
-    }
+    use crate::grouped_tile::tests::floats;
 
     /// The tile gives the fused sums of the non-zero terms in sample order to the bit (a zero
     /// term adds nothing), for full and short batches and rows at both ends.

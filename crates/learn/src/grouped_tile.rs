@@ -90,12 +90,12 @@ pub(crate) unsafe fn tile<const FUSED: bool>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::panels::grouped_forward_portable;
 
     /// A deterministic stream of floats in [-1, 1), a fraction of them zero.
-    fn floats(n: usize, seed: u64, zeros: f32) -> Vec<f32> {
+    pub(crate) fn floats(n: usize, seed: u64, zeros: f32) -> Vec<f32> {
         let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
         let mut next = move || {
             state ^= state << 13;
