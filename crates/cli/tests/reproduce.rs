@@ -35,7 +35,8 @@ pub fn tiny_run() -> &'static Path {
         }
         let exp1 = |out: &Path| results(out)["exp1"].clone();
         let noise = |out: &Path| results(out)["noise"].clone();
-        let (first, first_noise) = (exp1(&out), noise(&out));
+        let other = |out: &Path| results(out)["dataset_seeds"].clone();
+        let (first, first_noise, first_other) = (exp1(&out), noise(&out), other(&out));
         let resumed = String::from_utf8_lossy(&run_ok(&args).stderr).into_owned();
         // Its stages say what an earlier run had finished (features and training alike).
         for line in [
@@ -52,6 +53,11 @@ pub fn tiny_run() -> &'static Path {
             noise(&out),
             first_noise,
             "a resumed run changed the noise study"
+        );
+        assert_eq!(
+            other(&out),
+            first_other,
+            "a resumed run changed the other datasets' results"
         );
         (dir, out)
     });
@@ -224,6 +230,26 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         );
     }
     assert!(report.contains("Dynamic minus static test MAE: "));
+    // Experiment 1 on the plan's two simulated datasets: the first is Experiment 1 itself, the
+    // second another simulation (its own folder and models) with other results.
+    let points = results["dataset_seeds"].as_array().unwrap();
+    assert_eq!(points.len(), reprs * Plan::for_scale(Scale::Tiny).datasets);
+    let e1 = results["exp1"].as_array().unwrap();
+    for p in points {
+        let same = e1.iter().find(|e| e["name"] == p["name"]).unwrap();
+        let first = p["dataset_seed"] == results["run"]["seed"];
+        assert_eq!(same["runs"] == p["runs"], first, "{p}");
+    }
+    let seed = results["run"]["seed"].as_u64().unwrap();
+    let other = format!("datasets/seed{}", seed + 1);
+    assert!(out.join(&other).join("simulator.json").is_file());
+    assert!(out.join("models").join(&other).join("exp1").is_dir());
+    assert!(
+        report.contains("## Experiment 1 on other simulated datasets")
+            && report.contains("| SD across datasets |")
+            && report.contains("pairs differ beyond both spreads"),
+        "{report}"
+    );
     // The label-noise ablation: the paper's three, trained on noisy labels, beside Experiment 1
     // on the clean ones, its models apart from Experiment 1's.
     let ablation = &results["label_noise"];
@@ -450,6 +476,16 @@ fn no_fusions_trains_the_papers_three_representations_only() {
     let stderr = String::from_utf8_lossy(&bad.stderr);
     assert!(
         !bad.status.success() && stderr.contains("\"x3\" is not a factor"),
+        "{stderr}"
+    );
+    let none = crate::common::evtac()
+        .args(["reproduce", "--scale", "tiny", "--out", &out_s])
+        .args(["--datasets", "0"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&none.stderr);
+    assert!(
+        !none.status.success() && stderr.contains("--datasets"),
         "{stderr}"
     );
 }

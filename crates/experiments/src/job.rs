@@ -175,6 +175,9 @@ pub struct ReproduceJob {
     /// The label-noise ablation's standard deviation (0: none), or `None` for the plan's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub label_noise_deg: Option<f64>,
+    /// Simulated datasets Experiment 1 runs on, its own included, or `None` for the plan's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub datasets: Option<usize>,
 }
 
 /// One point of a sensitivity study: Experiment 1, tuning included, on a dataset simulated with
@@ -373,6 +376,7 @@ mod tests {
                 noise_levels: Some(vec![0.0, 2.5]),
                 fusions: false,
                 label_noise_deg: Some(0.0),
+                datasets: Some(3),
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

@@ -26,6 +26,8 @@
 //!   experiments); [`choices`] lists the values evtac chose where the paper states none.
 //! - [`sensitivity`]: Experiment 1, tuning included, with each unmeasured simulator parameter
 //!   scaled, one at a time: which of the paper's conclusions hold on which simulator.
+//! - [`dataset_seeds`]: Experiment 1 on datasets simulated with other seeds, the spread across
+//!   datasets the report sets beside the training seeds'.
 //!
 //! Modules that only the pipeline calls (`noise`, `variant`, `exp2`, `exp3`, `examples`,
 //! `label_check`) are private: their results are in [`results`], their errors in
@@ -53,6 +55,7 @@ pub mod cache;
 pub mod choices;
 pub mod context;
 pub mod dataset;
+pub mod dataset_seeds;
 mod error;
 mod examples;
 pub mod exp1;

@@ -10,11 +10,9 @@
 //! needs a simulated Experiment 1 dataset (`simulator.json`): recordings cannot be re-recorded at
 //! another noise.
 
-use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::Dataset;
 use crate::error::Error;
-use crate::exp1;
 use crate::results::{Exp1Repr, NoisePoint};
 use crate::stage::{FeatureSet, Stage};
 use crate::variant;
@@ -69,31 +67,21 @@ pub fn run(
             all.extend(points(level, background_rate(ds1, seconds)?, e1));
             continue;
         }
-        let dir = dataset_dir(out, level);
         // Same protocol, scale and seed as Experiment 1's dataset: only the noise differs.
         let mut params = sim.params.clone();
         params.dvs = params.dvs.with_noise_scaled(level);
-        variant::simulate(
+        let at = variant::Place {
+            dir: &dataset_dir(out, level),
+            models: &dataset_dir(run.models, level),
+            simulating: Stage::NoiseSimulating,
+            training: (FeatureSet::Noise, Stage::NoiseTraining),
+        };
+        let (ds, results) = variant::exp1_on(
             &params,
             (sim.scale, sim.seed),
-            &dir,
-            Stage::NoiseSimulating,
-            run.progress,
-        )?;
-        let ds = Dataset::open(&dir, ds1.inputs)?;
-        let splits = ds.splits(run.seed)?;
-        let cache = FeatureCache::new(&ds)?;
-        let models = dataset_dir(run.models, level);
-        let at_level = RunContext {
-            models: &models,
-            ..*run
-        };
-        let results = exp1::run_as(
-            &cache,
-            &splits,
-            reprs,
-            &at_level,
-            (FeatureSet::Noise, Stage::NoiseTraining),
+            &at,
+            (reprs, ds1.inputs),
+            run,
         )?;
         all.extend(points(level, background_rate(&ds, seconds)?, &results));
     }

@@ -17,8 +17,8 @@ use crate::stage_log::StageLog;
 use crate::training;
 use crate::tuning::{self, Kind};
 use crate::{
-    choices, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise, repr_example,
-    sensor_view,
+    choices, dataset_seeds, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise,
+    repr_example, sensor_view,
 };
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
@@ -153,6 +153,10 @@ pub fn reproduce(
     if !noise.is_empty() {
         stages.done("experiment 1 at other noise")?;
     }
+    let dataset_seeds = dataset_seeds::run(&ds1, &e1, &reprs, &run, out)?;
+    if !dataset_seeds.is_empty() {
+        stages.done("experiment 1 on other datasets")?;
+    }
     let label_noise = label_noise::run(&cache1, &splits1, &reprs, &e1, &run)?;
     if label_noise.is_some() {
         stages.done("label-noise ablation")?;
@@ -286,6 +290,7 @@ pub fn reproduce(
         repr_example,
         sensor_kind: sensor.as_ref().map(|v| v.kind),
         sensor,
+        dataset_seeds,
     };
     results.run.stage_seconds = stages.list;
     results.run.stage_history = log.records();

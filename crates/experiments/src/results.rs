@@ -438,6 +438,20 @@ pub struct LabelCheck {
     pub label_source: evtac_labels::LabelSource,
 }
 
+/// Experiment 1 on one simulated dataset of the spread across datasets, for one
+/// representation ([`crate::dataset_seeds`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DatasetSeedPoint {
+    /// The seed the dataset was simulated with (the first: Experiment 1's own).
+    pub dataset_seed: u64,
+    /// The representation.
+    pub name: ReprKind,
+    /// Test MAE per training seed.
+    pub runs: Vec<Mae>,
+    /// Test MAE statistics over training seeds.
+    pub test: MaeStats,
+}
+
 /// Everything a reproduction measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Results {
@@ -483,6 +497,10 @@ pub struct Results {
     /// report's caption can be rebuilt from `results.json` alone. Absent from older results.
     #[serde(default)]
     pub sensor_kind: Option<SensorKind>,
+    /// Experiment 1 per simulated dataset and representation, Experiment 1's own dataset
+    /// first (empty when the plan has one dataset, and in older results).
+    #[serde(default)]
+    pub dataset_seeds: Vec<DatasetSeedPoint>,
 }
 
 #[cfg(test)]

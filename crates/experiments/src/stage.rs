@@ -34,6 +34,8 @@ pub enum FeatureSet {
     Exp3Depth,
     /// Experiment 1 at a scaled background noise.
     Noise,
+    /// Experiment 1 on a dataset simulated with another seed.
+    DatasetSeed,
 }
 
 /// One stage of a reproduction; its units of work are given with it.
@@ -59,6 +61,10 @@ pub enum Stage {
     NoiseTraining,
     /// The label-noise ablation's training runs (units: runs).
     LabelNoiseTraining,
+    /// Simulating Experiment 1's dataset with another seed (units: trials).
+    DatasetSeedSimulating,
+    /// Experiment 1's training runs on a dataset simulated with another seed (units: runs).
+    DatasetSeedTraining,
 }
 
 impl std::fmt::Display for Stage {
@@ -79,6 +85,9 @@ impl std::fmt::Display for Stage {
             Stage::NoiseSimulating => f.write_str("simulating exp1 at other noise"),
             Stage::NoiseTraining => f.write_str("noise training"),
             Stage::LabelNoiseTraining => f.write_str("label-noise training"),
+            Stage::Features(FeatureSet::DatasetSeed) => f.write_str("features (other datasets)"),
+            Stage::DatasetSeedSimulating => f.write_str("simulating exp1 with other seeds"),
+            Stage::DatasetSeedTraining => f.write_str("other datasets' training"),
         }
     }
 }
@@ -178,12 +187,15 @@ impl CostModel {
         let train =
             |n: usize| cost::EPOCH_FIXED + n as f64 * cost::TRAIN_SHARE * cost::EPOCH_TRAIN_TRIAL;
         match stage {
-            Stage::Simulating(_) | Stage::NoiseSimulating => units * cost::SIMULATE_TRIAL,
+            Stage::Simulating(_) | Stage::NoiseSimulating | Stage::DatasetSeedSimulating => {
+                units * cost::SIMULATE_TRIAL
+            }
             Stage::Features(_) => units * cost::FEATURES_TRIAL,
             Stage::Tuning(_) => units * plan.tuning_epochs as f64 * train(counts.exp1),
-            Stage::Exp1Training | Stage::NoiseTraining | Stage::LabelNoiseTraining => {
-                units * plan.epochs as f64 * train(counts.exp1)
-            }
+            Stage::Exp1Training
+            | Stage::NoiseTraining
+            | Stage::LabelNoiseTraining
+            | Stage::DatasetSeedTraining => units * plan.epochs as f64 * train(counts.exp1),
             Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
             Stage::Latency => {
                 let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
@@ -223,6 +235,12 @@ impl CostModel {
             * (c(Stage::NoiseSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::Noise), counts.exp1)
                 + c(Stage::NoiseTraining, reprs * plan.seeds));
+        // Every dataset but Experiment 1's own: the same, with another simulation seed.
+        let others = plan.datasets.saturating_sub(1);
+        sum += others as f64
+            * (c(Stage::DatasetSeedSimulating, counts.exp1)
+                + c(Stage::Features(FeatureSet::DatasetSeed), counts.exp1)
+                + c(Stage::DatasetSeedTraining, reprs * plan.seeds));
         if plan.label_noise_deg.is_some_and(|sd| sd > 0.0) {
             sum += c(
                 Stage::LabelNoiseTraining,
@@ -279,6 +297,20 @@ mod tests {
             (noise - 2.0 * per_level).abs() < 1e-9,
             "{noise} vs 2 x {per_level}"
         );
+        // One dataset instead of the tiny plan's two: one simulation, its features and runs.
+        let one = Plan {
+            datasets: 1,
+            ..plan.clone()
+        };
+        let per_dataset = model.seconds(Stage::DatasetSeedSimulating, 60)
+            + model.seconds(Stage::Features(FeatureSet::DatasetSeed), 60)
+            + model.seconds(Stage::DatasetSeedTraining, (reprs * plan.seeds) as u64);
+        let dropped = model.total_seconds() - CostModel::new(&one, counts).total_seconds();
+        assert_eq!(plan.datasets, 2);
+        assert!(
+            (dropped - per_dataset).abs() < 1e-9,
+            "{dropped} vs {per_dataset}"
+        );
         // Without the learned fusions: three representations' runs instead of five.
         let paper_only = Plan {
             fusions: false,
@@ -291,7 +323,9 @@ mod tests {
         let fewer = CostModel::new(&paper_only, counts).total_seconds();
         let per_repr = model.seconds(Stage::Exp1Training, plan.seeds as u64)
             + model.seconds(Stage::Latency, plan.latency_intervals_ms.len() as u64)
-            + 2.0 * model.seconds(Stage::NoiseTraining, plan.seeds as u64);
+            + 2.0 * model.seconds(Stage::NoiseTraining, plan.seeds as u64)
+            + (plan.datasets - 1) as f64
+                * model.seconds(Stage::DatasetSeedTraining, plan.seeds as u64);
         let saved = model.total_seconds() - fewer;
         assert!(
             (saved - 2.0 * per_repr).abs() < 1e-6,

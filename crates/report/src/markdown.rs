@@ -10,9 +10,24 @@ use evtac_repr::ReprKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod dataset_seeds;
 mod fusion;
 mod label_noise;
 mod labels;
+
+/// Test runs whose pitch, roll and overall MAE are each `values`' value: the sections' tests
+/// build their results from these.
+#[cfg(test)]
+fn runs_of(values: &[f64]) -> Vec<evtac_experiments::results::Mae> {
+    values
+        .iter()
+        .map(|&m| evtac_experiments::results::Mae {
+            overall: m,
+            pitch: m,
+            roll: m,
+        })
+        .collect()
+}
 
 /// A mean and a standard deviation, in degrees.
 pub type MeanStd = (f64, f64);
@@ -312,7 +327,8 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         md,
         "Plan: static taus {} ms x thresholds {}; dynamic windows {} ms x thresholds {}; {}; \
          {} epochs per tuning run, {} epochs per final run; {} seeds per representation in \
-         Experiment 1, {} in Experiment 2; latency on up to {} test trials at {} ms.\n",
+         Experiment 1, {} in Experiment 2; Experiment 1 on {} simulated dataset{}; latency on up \
+         to {} test trials at {} ms.\n",
         json(&plan.static_taus_ms),
         json(&plan.static_thresholds),
         json(&plan.dynamic_windows_ms),
@@ -331,6 +347,8 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         plan.epochs,
         plan.seeds,
         plan.exp2_seeds,
+        plan.datasets,
+        if plan.datasets == 1 { "" } else { "s" },
         plan.latency_trials,
         json(&plan.latency_intervals_ms),
     );
@@ -413,6 +431,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         );
     }
 
+    dataset_seeds::section(&mut md, r);
     noise_section(&mut md, r, figures);
     md.push_str(&label_noise::section(r.label_noise.as_ref()));
 

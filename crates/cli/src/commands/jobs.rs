@@ -145,6 +145,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if let Some(sd) = j.label_noise_deg {
                 args.extend(["--label-noise-deg".into(), sd.to_string()]);
             }
+            if let Some(n) = j.datasets {
+                args.extend(["--datasets".into(), n.to_string()]);
+            }
         }
         Job::SensitivityPoint(j) => {
             args.push("sensitivity".into());

@@ -52,6 +52,13 @@ pub struct Args {
     /// the ablation. Default: the plan's, 0.04 (the spread of the paper's label check).
     #[arg(long, value_name = "SD")]
     pub label_noise_deg: Option<f64>,
+    /// Simulated datasets to run Experiment 1 on, its own included: each other one is simulated
+    /// with the same parameters and the next seed, and trained with the settings tuned on the
+    /// first, so the report can set the spread across datasets beside the training seeds'.
+    /// 1 runs Experiment 1's dataset alone (the paper's plan). Default: the plan's (5 at
+    /// `small`, 2 at `tiny`, 1 at `paper`). Needs simulated Experiment 1 data.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub datasets: Option<u64>,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -103,6 +110,7 @@ impl Args {
             seed: job.seed,
             out: job.out.clone(),
             label_noise_deg: job.label_noise_deg,
+            datasets: job.datasets.map(|n| n as u64),
             noise_levels: job
                 .noise_levels
                 .as_ref()
@@ -319,6 +327,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         noise_levels: args.noise_levels(),
         fusions: !args.no_fusions,
         label_noise_deg: args.label_noise_deg,
+        datasets: args.datasets.map(|n| n as usize),
     };
     let (slurm, task) = (
         crate::cluster::slurm(args.slurm_args.as_deref()),
@@ -354,6 +363,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "--label-noise-deg {sd}: give a standard deviation in degrees, 0 (no ablation) or more"
         );
         plan.label_noise_deg = (sd > 0.0).then_some(sd);
+    }
+    if let Some(n) = args.datasets {
+        plan.datasets = n as usize;
     }
     anyhow::ensure!(
         args.slurm_args.is_none() || args.executor == Executor::Slurm,

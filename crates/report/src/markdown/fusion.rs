@@ -3,29 +3,29 @@
 //! Experiment 2 they keep static's stop-phase accuracy and dynamic's motion response.
 //!
 //! Every sentence is computed from the run's numbers. A difference counts only when it is
-//! larger than the seeds' spread (the two standard deviations added in quadrature); anything
-//! smaller is called a tie, so a verdict never rests on the luck of a few seeds.
+//! larger than the seeds' spread (the two standard deviations added in quadrature) and, in
+//! Experiment 1 when the run simulated several datasets, larger than the datasets' spread too
+//! ([`Spread`]); anything smaller is called a tie, so a verdict never rests on the luck of a few
+//! seeds or of one dataset.
 
 use std::fmt::Write as _;
 
 use evtac_experiments::results::{Exp2Setting, MeanStd, Results};
 use evtac_repr::ReprKind;
 
-/// Whether `fusion` beats `reference` (test MAE, lower is better) beyond the seeds' spread.
-fn beats(fusion: &MeanStd, reference: &MeanStd) -> bool {
-    reference.mean - fusion.mean > fusion.std.hypot(reference.std)
+use super::dataset_seeds::{self, Spread};
+
+/// Whether `fusion` beats `reference` (test MAE, lower is better) beyond `spread`.
+fn beats(fusion: &MeanStd, reference: &MeanStd, spread: &Spread) -> bool {
+    reference.mean - fusion.mean > spread.bound()
 }
 
-/// How `fusion` compares with `reference` (test MAE, lower is better).
-fn compare(fusion: &MeanStd, reference: &MeanStd) -> String {
+/// How `fusion` compares with `reference` (test MAE, lower is better), beyond `spread`.
+fn compare(fusion: &MeanStd, reference: &MeanStd, spread: &Spread) -> String {
     let diff = fusion.mean - reference.mean;
-    let spread = fusion.std.hypot(reference.std);
     let percent = 100.0 * diff.abs() / reference.mean.max(f64::MIN_POSITIVE);
-    if diff.abs() <= spread {
-        format!(
-            "ties ({:+.3} deg, within the seeds' spread of {spread:.3})",
-            diff
-        )
+    if diff.abs() <= spread.bound() {
+        format!("ties ({diff:+.3} deg, within {})", spread.describe())
     } else if diff < 0.0 {
         format!("beats it by {:.3} deg ({percent:.0} %)", -diff)
     } else {
@@ -43,11 +43,13 @@ fn best_single(cells: &[(ReprKind, MeanStd)]) -> Option<(ReprKind, MeanStd)> {
 }
 
 /// One line per fusion against the best single representation among `cells`; the wins
-/// (`where_`, fusion, by how many degrees) are added to `wins`.
+/// (`where_`, fusion, by how many degrees) are added to `wins`. `datasets_sd` gives a
+/// representation's standard deviation across datasets where the run measured it.
 fn against_best(
     md: &mut String,
     where_: &str,
     cells: &[(ReprKind, MeanStd)],
+    datasets_sd: &dyn Fn(ReprKind) -> Option<f64>,
     wins: &mut Vec<String>,
 ) {
     let Some((best, best_stats)) = best_single(cells) else {
@@ -57,7 +59,8 @@ fn against_best(
         let Some((_, f)) = cells.iter().find(|(n, _)| *n == fusion) else {
             continue;
         };
-        if beats(f, &best_stats) {
+        let spread = Spread::of(f, &best_stats, datasets_sd(fusion).zip(datasets_sd(best)));
+        if beats(f, &best_stats, &spread) {
             wins.push(format!(
                 "{fusion} at {where_} (by {:.3} deg)",
                 best_stats.mean - f.mean
@@ -69,7 +72,7 @@ fn against_best(
              {}.",
             f.display(),
             best_stats.display(),
-            compare(f, &best_stats)
+            compare(f, &best_stats, &spread)
         );
     }
 }
@@ -93,7 +96,9 @@ pub(super) fn section(md: &mut String, r: &Results) {
     let mut lines = String::new();
     let mut wins = Vec::new();
     let exp1: Vec<(ReprKind, MeanStd)> = r.exp1.iter().map(|e| (e.name, e.test.overall)).collect();
-    against_best(&mut lines, "Experiment 1", &exp1, &mut wins);
+    let across = dataset_seeds::across(r);
+    let exp1_sd = |kind| dataset_seeds::datasets_sd(&across, kind);
+    against_best(&mut lines, "Experiment 1", &exp1, &exp1_sd, &mut wins);
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
@@ -104,7 +109,13 @@ pub(super) fn section(md: &mut String, r: &Results) {
             .filter(|p| p.level == level)
             .map(|p| (p.name, p.test.overall))
             .collect();
-        against_best(&mut lines, &format!("noise x{level}"), &cells, &mut wins);
+        against_best(
+            &mut lines,
+            &format!("noise x{level}"),
+            &cells,
+            &|_| None,
+            &mut wins,
+        );
     }
     // Experiment 2 under the pause-inclusive setting: static's stop, dynamic's motion.
     let (setting, label) = (
@@ -125,10 +136,18 @@ pub(super) fn section(md: &mut String, r: &Results) {
                  {}; its motion phase ({}) against dynamic's ({}): {}.",
                 f.stop.overall.display(),
                 st.stop.overall.display(),
-                compare(&f.stop.overall, &st.stop.overall),
+                compare(
+                    &f.stop.overall,
+                    &st.stop.overall,
+                    &Spread::of(&f.stop.overall, &st.stop.overall, None)
+                ),
                 f.motion.overall.display(),
                 dy.motion.overall.display(),
-                compare(&f.motion.overall, &dy.motion.overall)
+                compare(
+                    &f.motion.overall,
+                    &dy.motion.overall,
+                    &Spread::of(&f.motion.overall, &dy.motion.overall, None)
+                )
             );
         }
     }
@@ -164,13 +183,22 @@ mod tests {
         MeanStd { mean, std, n: 3 }
     }
 
+    fn seeds(a: &MeanStd, b: &MeanStd) -> String {
+        compare(a, b, &Spread::of(a, b, None))
+    }
+
     #[test]
     fn a_difference_counts_only_beyond_the_seeds_spread() {
         assert!(
-            compare(&ms(0.10, 0.01), &ms(0.20, 0.01)).starts_with("beats it by 0.100 deg (50 %)")
+            seeds(&ms(0.10, 0.01), &ms(0.20, 0.01)).starts_with("beats it by 0.100 deg (50 %)")
         );
-        assert!(compare(&ms(0.30, 0.01), &ms(0.20, 0.01)).starts_with("is worse by 0.100 deg"));
-        assert!(compare(&ms(0.21, 0.01), &ms(0.20, 0.01)).starts_with("ties (+0.010 deg"));
+        assert!(seeds(&ms(0.30, 0.01), &ms(0.20, 0.01)).starts_with("is worse by 0.100 deg"));
+        assert!(seeds(&ms(0.21, 0.01), &ms(0.20, 0.01)).starts_with("ties (+0.010 deg"));
+        // Beyond the seeds' spread but within the datasets': a tie.
+        let (f, s) = (ms(0.10, 0.01), ms(0.20, 0.01));
+        let wide = Spread::of(&f, &s, Some((0.1, 0.1)));
+        assert!(compare(&f, &s, &wide).starts_with("ties (-0.100 deg, within the larger"));
+        assert!(!beats(&f, &s, &wide));
         let cells = [
             (ReprKind::Static, ms(0.2, 0.0)),
             (ReprKind::Dynamic, ms(0.1, 0.0)),
@@ -178,7 +206,7 @@ mod tests {
         ];
         assert_eq!(best_single(&cells).map(|b| b.0), Some(ReprKind::Dynamic));
         let (mut md, mut wins) = (String::new(), Vec::new());
-        against_best(&mut md, "Experiment 1", &cells, &mut wins);
+        against_best(&mut md, "Experiment 1", &cells, &|_| None, &mut wins);
         assert_eq!(wins, ["Late at Experiment 1 (by 0.050 deg)"]);
         assert!(
             md.contains("Late (0.050 ± 0.000) against the best single representation, Dynamic"),

@@ -72,18 +72,11 @@ pub fn section(ablation: Option<&LabelNoise>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use evtac_experiments::results::{Exp1Repr, Mae, MaeStats};
+    use evtac_experiments::results::{Exp1Repr, MaeStats};
     use evtac_repr::{DynamicConfig, ReprKind, StaticConfig};
 
     fn repr(maes: &[f64]) -> Exp1Repr {
-        let runs: Vec<Mae> = maes
-            .iter()
-            .map(|&m| Mae {
-                overall: m,
-                pitch: m,
-                roll: m,
-            })
-            .collect();
+        let runs = super::super::runs_of(maes);
         Exp1Repr {
             name: ReprKind::Static,
             config: ReprKind::Static.config(StaticConfig::default(), DynamicConfig::default()),
