@@ -7,10 +7,17 @@ use evtac_events::manifest::Manifest;
 
 use crate::common::{evtac, run_ok};
 
-/// Simulates two Experiment 2 trials (each with a stop) into `out`.
+/// Simulates two Experiment 2 trials (each with a stop) into `out`, with the sensor seated
+/// without a turn: the labels keep the commanded rolling axis, so a seating's turn would show
+/// in their comparison with the truth (sensor frame) as the rig's error, not the labeller's.
 fn simulate(out: &Path) {
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    let params = out.with_extension("params.json");
+    std::fs::write(&params, r#"{"rig": {"reseat_rotation_sd_deg": 0.0}}"#).unwrap();
     run_ok(&[
         "simulate",
+        "--params",
+        params.to_str().unwrap(),
         "--protocol",
         "exp2",
         "--scale",

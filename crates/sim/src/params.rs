@@ -376,6 +376,14 @@ pub struct RigParams {
     /// Standard deviation of the contact patch's position on the dome per axis, millimetres
     /// along the surface.
     pub patch_offset_sd_mm: f64,
+    /// Standard deviation of the sensor's turn about its axis each time it is seated in its
+    /// mount (once per pass over the conditions, [`crate::rig::Seating`]), degrees.
+    pub reseat_rotation_sd_deg: f64,
+    /// Standard deviation of the sensor's tilt in its mount per seating, per axis, degrees.
+    pub reseat_tilt_sd_deg: f64,
+    /// Standard deviation of the sensor's reach (its length in the mount) per seating,
+    /// millimetres.
+    pub reseat_height_sd_mm: f64,
 }
 
 impl Default for RigParams {
@@ -391,6 +399,13 @@ impl Default for RigParams {
             plane_height_sd_mm: 0.0033,
             rolling_centre_sd_mm: 0.5,
             patch_offset_sd_mm: 0.02,
+            // Assumed, not measured (no NeuroTac's mount is characterised): a sensor screwed
+            // into a printed mount again sits within about a degree of its turn (0.5 SD),
+            // a few tenths of a degree of its tilt (0.1 SD per axis), and a few hundredths of
+            // a millimetre of its reach (0.02 SD).
+            reseat_rotation_sd_deg: 0.5,
+            reseat_tilt_sd_deg: 0.1,
+            reseat_height_sd_mm: 0.02,
         }
     }
 }
@@ -403,6 +418,9 @@ impl RigParams {
             plane_height_sd_mm: 0.0,
             rolling_centre_sd_mm: 0.0,
             patch_offset_sd_mm: 0.0,
+            reseat_rotation_sd_deg: 0.0,
+            reseat_tilt_sd_deg: 0.0,
+            reseat_height_sd_mm: 0.0,
         }
     }
 }

@@ -222,6 +222,17 @@ pub struct TrialSpec {
     pub contact: bool,
     /// The trial's own seed (noise, IMU errors, per-trial variation).
     pub seed: u64,
+    /// The seed of the sensor's seating in its mount ([`crate::rig::Seating`]): one per pass
+    /// over the conditions (Experiments 1 and 2 seat the sensor again for each repeat) and one
+    /// for each other protocol, so trials of one pass share it. Absent from older files: 0.
+    #[serde(default)]
+    pub seating: u64,
+}
+
+/// The seating seed of pass `pass` of a protocol whose trial seeds come from `base`.
+fn seating_seed(base: u64, pass: usize) -> u64 {
+    // Far from the trial indices (0, 1, ...) and from the protocol seeds (usize::MAX - 2 - k).
+    trial_seed(base, usize::MAX / 2 + pass)
 }
 
 /// The seed of trial `index` of a dataset with seed `seed`: independent of how trials are
@@ -246,8 +257,8 @@ pub fn plan(
         .position(|&p| p == protocol)
         .unwrap_or(0);
     let base = trial_seed(seed, usize::MAX - 2 - protocol_index);
-    // (direction, speed, depth, group)
-    let mut rows: Vec<(f64, f64, f64, Option<String>)> = Vec::new();
+    // (direction, speed, depth, group, pass)
+    let mut rows: Vec<(f64, f64, f64, Option<String>, usize)> = Vec::new();
     let group = |levels: &[f64], v: f64| {
         let seen = levels.iter().any(|&l| (l - v).abs() < 1e-9);
         Some(if seen { "seen" } else { "unseen" }.to_string())
@@ -257,8 +268,8 @@ pub fn plan(
             for &direction in &design.directions {
                 for &speed in &design.speeds {
                     for &depth in &design.depths {
-                        for _ in 0..design.repeats {
-                            rows.push((direction, speed, depth, None));
+                        for pass in 0..design.repeats {
+                            rows.push((direction, speed, depth, None, pass));
                         }
                     }
                 }
@@ -268,7 +279,7 @@ pub fn plan(
             let combos = combinations(&design.directions, &design.depths, design.exp3_speed_trials);
             for &speed in &design.exp3_speeds {
                 for &(direction, depth) in &combos {
-                    rows.push((direction, speed, depth, group(&design.speeds, speed)));
+                    rows.push((direction, speed, depth, group(&design.speeds, speed), 0));
                 }
             }
         }
@@ -276,7 +287,7 @@ pub fn plan(
             let combos = combinations(&design.directions, &design.speeds, design.exp3_depth_trials);
             for &depth in &design.exp3_depths {
                 for &(direction, speed) in &combos {
-                    rows.push((direction, speed, depth, group(&design.depths, depth)));
+                    rows.push((direction, speed, depth, group(&design.depths, depth), 0));
                 }
             }
         }
@@ -284,13 +295,13 @@ pub fn plan(
             let n = design.no_contact_trials;
             let fastest = design.speeds.iter().copied().fold(0.0, f64::max);
             for i in 0..n {
-                rows.push((360.0 * i as f64 / n.max(1) as f64, fastest, 0.0, None));
+                rows.push((360.0 * i as f64 / n.max(1) as f64, fastest, 0.0, None, 0));
             }
         }
     }
     rows.into_iter()
         .enumerate()
-        .map(|(i, (direction_deg, speed_deg_s, depth_mm, group))| {
+        .map(|(i, (direction_deg, speed_deg_s, depth_mm, group, pass))| {
             let seed = trial_seed(base, i);
             let stop_deg = (protocol == Protocol::Exp2).then(|| {
                 // A separate stream, so that the stop does not shift the trial's other draws.
@@ -308,6 +319,7 @@ pub fn plan(
                 group,
                 contact: protocol != Protocol::NoContact,
                 seed,
+                seating: seating_seed(base, pass),
             }
         })
         .collect()

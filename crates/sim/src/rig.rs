@@ -3,7 +3,11 @@
 //!
 //! A real rig never repeats itself: the robot reaches each commanded angle within its
 //! repeatability, the plane's height and the rotation centre are known only to a calibration's
-//! accuracy, and the contact patch sits a little differently on the dome each time. Without
+//! accuracy, and the contact patch sits a little differently on the dome each time. Between
+//! passes over the conditions (the repeats) the sensor is taken off and seated again
+//! ([`Seating`]): it sits turned a little about its axis, tilted a little in its mount, and a
+//! little longer or shorter, so two repeats of one condition differ by more than the robot's
+//! repeatability; trials of one pass share their seating. Without
 //! these, simulated trials of one condition differed only by sensor noise and the skin's gain
 //! variation, the labels matched the commanded stop angle to 0.001 deg (the paper validates its
 //! labels to -0.01 +- 0.04 deg), and simulated errors were optimistic. Each error is drawn once
@@ -31,6 +35,41 @@ pub struct TrialErrors {
     /// Where the contact patch sits on the dome at zero tilt, as a tilt offset (x, y) in
     /// degrees in the sensor frame.
     pub patch_offset_deg: [f64; 2],
+    /// The sensor's turn about its own axis in the mount (its seating), degrees: the tilt's
+    /// direction in the sensor's frame is the commanded one plus this. The labels, which
+    /// project the gyroscope on the commanded rolling axis, do not see it.
+    pub rotation_deg: f64,
+}
+
+/// How the sensor sits in its mount for one pass over the conditions: drawn once per seating
+/// from [`RigParams`]'s `reseat_*` values, from its own seed, and added to each trial's errors
+/// ([`TrialErrors::seated`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Seating {
+    /// Turn about the sensor's axis, degrees.
+    pub rotation_deg: f64,
+    /// Tilt of the sensor's axis against the tool's (x, y), degrees: at zero commanded tilt the
+    /// dome already meets the plane this much off its tip.
+    pub tilt_deg: [f64; 2],
+    /// How much farther the tip reaches than in the calibration, millimetres: added to every
+    /// indentation.
+    pub height_mm: f64,
+}
+
+impl Seating {
+    /// Draws a seating from `params` with `seed`.
+    pub fn draw(params: &RigParams, seed: u64) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut normal = |sd: f64| sd * gaussian(&mut rng);
+        Self {
+            rotation_deg: normal(params.reseat_rotation_sd_deg),
+            tilt_deg: [
+                normal(params.reseat_tilt_sd_deg),
+                normal(params.reseat_tilt_sd_deg),
+            ],
+            height_mm: normal(params.reseat_height_sd_mm),
+        }
+    }
 }
 
 impl TrialErrors {
@@ -55,7 +94,27 @@ impl TrialErrors {
             plane_height_mm,
             rolling_centre_mm,
             patch_offset_deg,
+            rotation_deg: 0.0,
         }
+    }
+
+    /// These errors with the sensor seated as `seating`: its turn, its tilt added to the
+    /// patch's offset and its reach to the plane's height error.
+    pub fn seated(self, seating: &Seating) -> Self {
+        Self {
+            plane_height_mm: self.plane_height_mm + seating.height_mm,
+            patch_offset_deg: [
+                self.patch_offset_deg[0] + seating.tilt_deg[0],
+                self.patch_offset_deg[1] + seating.tilt_deg[1],
+            ],
+            rotation_deg: self.rotation_deg + seating.rotation_deg,
+            ..self
+        }
+    }
+
+    /// The tilt's direction in the sensor's frame for a commanded direction `commanded_deg`.
+    pub fn direction_deg(&self, commanded_deg: f64) -> f64 {
+        commanded_deg + self.rotation_deg
     }
 
     /// Indentation added at tilt `theta_deg`: the plane's height error, less the rise of the
@@ -106,6 +165,40 @@ mod tests {
         assert!(close(sd(&|e| e.rolling_centre_mm), p.rolling_centre_sd_mm));
         let patch_deg = (p.patch_offset_sd_mm / 20.0).to_degrees();
         assert!(close(sd(&|e| e.patch_offset_deg[0]), patch_deg));
+    }
+
+    #[test]
+    fn a_seating_adds_to_every_trial_of_its_pass() {
+        let p = RigParams::default();
+        let seating = Seating::draw(&p, 11);
+        assert_eq!(seating, Seating::draw(&p, 11));
+        assert_ne!(seating, Seating::draw(&p, 12));
+        let trial = TrialErrors::draw(&p, 20.0, 3);
+        let seated = trial.seated(&seating);
+        assert_eq!(seated.stop_deg, trial.stop_deg);
+        assert_eq!(seated.rolling_centre_mm, trial.rolling_centre_mm);
+        assert_eq!(
+            seated.plane_height_mm,
+            trial.plane_height_mm + seating.height_mm
+        );
+        assert_eq!(
+            seated.patch_offset_deg[1],
+            trial.patch_offset_deg[1] + seating.tilt_deg[1]
+        );
+        assert_eq!(seated.direction_deg(90.0), 90.0 + seating.rotation_deg);
+        // Spread as asked.
+        let draws: Vec<Seating> = (0..4000).map(|s| Seating::draw(&p, s)).collect();
+        let sd = |f: &dyn Fn(&Seating) -> f64| {
+            let v: Vec<f64> = draws.iter().map(f).collect();
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 0.06;
+        assert!(close(sd(&|s| s.rotation_deg), p.reseat_rotation_sd_deg));
+        assert!(close(sd(&|s| s.tilt_deg[0]), p.reseat_tilt_sd_deg));
+        assert!(close(sd(&|s| s.height_mm), p.reseat_height_sd_mm));
+        // A perfect rig seats the sensor the same way every time.
+        assert_eq!(Seating::draw(&RigParams::perfect(), 5), Seating::default());
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! SESSION/robot_log.csv      one row per motion (evtac import's log), on the robot's clock
 //! SESSION/no_contact.aedat4  the sensor at rest out of contact (as in a dataset)
 //! SESSION/calibration.json   the IMU-to-sensor rotation (as in a dataset)
-//! SESSION/truth/<trial>.csv  the commanded pose, on the session's clock
+//! SESSION/truth/<trial>.csv  the pose reached (sensor frame), on the session's clock
 //! SESSION/session.json       the settings, the true clock offset and the true trial times
 //! ```
 //!

@@ -27,7 +27,7 @@ use crate::dvs::{Dvs, PixelArray, gaussian};
 use crate::imu::simulate_imu;
 use crate::params::SimParams;
 use crate::protocol::{Motion, TrialSpec};
-use crate::rig::TrialErrors;
+use crate::rig::{Seating, TrialErrors};
 use crate::sensor::{Dome, Gains, PinImage, SkinPose};
 
 /// One ground-truth sample: the commanded pose.
@@ -159,6 +159,7 @@ impl Simulator {
         }
         let seed = rand::Rng::next_u64(&mut trial_stream(spec.seed, 4));
         TrialErrors::draw(&self.params.rig, self.params.sensor.tip_radius_mm, seed)
+            .seated(&Seating::draw(&self.params.rig, spec.seating))
     }
 
     /// The `no_contact.aedat4` recording: the sensor at rest out of contact, noise only.
@@ -178,6 +179,7 @@ impl Simulator {
             group: None,
             contact: false,
             seed,
+            seating: 0,
         };
         let motion = Motion::rest(duration_s, self.params.contact.no_contact_gap_mm);
         self.run(&spec, &motion, &TrialErrors::default())
@@ -208,11 +210,13 @@ impl Simulator {
             errors,
             rand::Rng::next_u64(&mut stream(2)),
         );
+        // The direction in the sensor's frame: the commanded one turned by the seating.
+        let direction_deg = errors.direction_deg(spec.direction_deg);
         let imu = simulate_imu(
             &self.params.imu,
             &self.calibration,
             motion,
-            spec.direction_deg,
+            direction_deg,
             rand::Rng::next_u64(&mut stream(3)),
             rand::Rng::next_u64(&mut stream(5)),
         );
@@ -225,7 +229,7 @@ impl Simulator {
             .map(|k| {
                 let t_us = k * period;
                 let theta = motion.theta(t_us as f64 * 1e-6);
-                let (pitch, roll) = contact_angles(theta, spec.direction_deg);
+                let (pitch, roll) = contact_angles(theta, direction_deg);
                 TruthSample {
                     t_us,
                     theta_deg: theta,
@@ -271,7 +275,8 @@ impl Simulator {
         let pose = |fast: [f64; 2], slow: [f64; 2], t: f64| {
             let mix = |k: usize| (1.0 - creep) * fast[k] + creep * slow[k];
             let theta_s = mix(0);
-            let (theta_deg, phi_deg) = errors.patch_tilt(theta_s, spec.direction_deg);
+            let (theta_deg, phi_deg) =
+                errors.patch_tilt(theta_s, errors.direction_deg(spec.direction_deg));
             SkinPose {
                 theta_deg,
                 phi_deg,
@@ -362,6 +367,45 @@ mod tests {
             .filter(|e| e.t >= r.motion_start_us && e.t < r.motion_end_us)
             .count();
         n as f64 / ((r.motion_end_us - r.motion_start_us) as f64 * 1e-6)
+    }
+
+    #[test]
+    fn the_seatings_turn_moves_the_truth_but_not_the_command() {
+        // Only the seating's turn: the truth's direction is the command's plus the turn.
+        let rig = crate::params::RigParams {
+            reseat_rotation_sd_deg: 2.0,
+            ..crate::params::RigParams::perfect()
+        };
+        let sim = Simulator::new(
+            SimParams {
+                rig: rig.clone(),
+                ..SimParams::default()
+            },
+            1,
+        );
+        let spec = spec(8.0, 1.5);
+        let turn = Seating::draw(&rig, spec.seating).rotation_deg;
+        assert!(turn.abs() > 1e-3, "the draw is a turn: {turn}");
+        let errors = sim.errors(&spec);
+        assert_eq!(
+            errors.direction_deg(spec.direction_deg),
+            spec.direction_deg + turn
+        );
+        let r = sim.simulate(&spec);
+        let last = r.truth.last().unwrap();
+        let (pitch, roll) = contact_angles(last.theta_deg, spec.direction_deg + turn);
+        assert!((last.pitch_deg - pitch).abs() < 1e-12 && (last.roll_deg - roll).abs() < 1e-12);
+        assert_eq!(
+            r.meta("t.aedat4", None, 20.0).direction_deg,
+            spec.direction_deg
+        );
+        // Trials of one pass share a seating; the next pass has its own.
+        let plan = crate::protocol::plan(Protocol::Exp1, Scale::Paper, 1, &Default::default());
+        assert_eq!(plan[0].seating, plan[2].seating);
+        assert_ne!(
+            plan[0].seating, plan[1].seating,
+            "two repeats, two seatings"
+        );
     }
 
     #[test]
