@@ -35,6 +35,7 @@ fn jobs_file(dir: &std::path::Path) -> std::path::PathBuf {
             scale: Scale::Tiny,
             seed: 1,
             out: dir.join("exp1"),
+            repeats: None,
         }),
     ];
     let file = dir.join("test.jobs");

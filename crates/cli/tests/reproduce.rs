@@ -543,3 +543,81 @@ fn a_resumed_reproductions_report_tables_every_invocations_stages() {
         "the report's total is not the invocations' sum ({total:.1})"
     );
 }
+
+#[test]
+fn two_repeats_measure_the_split_that_keeps_them_together() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.display().to_string();
+    run_ok(&[
+        "reproduce",
+        "--scale",
+        "tiny",
+        "--out",
+        &out_s,
+        "--repeats",
+        "2",
+        "--datasets",
+        "1",
+        "--no-fusions",
+        "--noise-levels",
+        "",
+        "--label-noise-deg",
+        "0",
+    ]);
+    let r = results(&out);
+    // Two passes over tiny's 16 conditions, each with its own seating.
+    let trials = |name: &str| {
+        r["run"]["datasets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|d| d[0] == name)
+            .and_then(|d| d[1].as_u64())
+    };
+    assert_eq!(trials("exp1"), Some(32));
+    assert_eq!(trials("exp2"), Some(32));
+    let sim: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("data/exp1/simulator.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(sim["repeats"], 2);
+    let split = &r["repeat_split"];
+    assert_eq!(split["repeats"], 2);
+    let together = split["together"].as_array().unwrap();
+    assert_eq!(together.len(), 3);
+    for (t, p) in together
+        .iter()
+        .zip(split["paper_split"].as_array().unwrap())
+    {
+        assert_eq!(t["name"], p["name"]);
+        assert_eq!(t["config"], p["config"], "the same settings on both splits");
+        assert_ne!(t["runs"], p["runs"], "another split, other test trials");
+    }
+    assert!(
+        out.join("models/repeats-together/exp1/static").is_dir(),
+        "the grouped split's models have their own folder"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Repeats across the split"), "{report}");
+    assert!(!report.contains("## Experiment 1 on other simulated datasets"));
+    // The one-pass scale measures nothing of the kind.
+    assert!(results(tiny_run())["repeat_split"].is_null());
+    let bad = crate::common::evtac()
+        .args([
+            "reproduce",
+            "--scale",
+            "tiny",
+            "--out",
+            &out_s,
+            "--repeats",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && stderr.contains("not a number of passes"),
+        "{stderr}"
+    );
+}

@@ -104,6 +104,21 @@ pub struct Simulated {
     pub seed: u64,
     /// Every simulator parameter.
     pub params: evtac_sim::SimParams,
+    /// Passes over the conditions (absent from older files: the scale's).
+    #[serde(default)]
+    pub repeats: Option<usize>,
+}
+
+impl Simulated {
+    /// The configuration that simulates this dataset again with seed `seed`: the same
+    /// protocol, scale, repeats and parameters.
+    pub fn config(&self, seed: u64) -> evtac_sim::DatasetConfig {
+        evtac_sim::DatasetConfig {
+            params: self.params.clone(),
+            repeats: self.repeats,
+            ..evtac_sim::DatasetConfig::new(self.protocol, self.scale, seed)
+        }
+    }
 }
 
 /// An opened dataset folder.

@@ -71,6 +71,9 @@ pub struct SimulateJob {
     pub seed: u64,
     /// The dataset folder to write.
     pub out: PathBuf,
+    /// Passes over the conditions of Experiments 1 and 2 instead of the scale's, or `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeats: Option<usize>,
 }
 
 impl SimulateJob {
@@ -80,7 +83,7 @@ impl SimulateJob {
         if crate::jobs::is_done(&self.out) {
             return Ok(());
         }
-        let config = evtac_sim::DatasetConfig::new(self.protocol, self.scale, self.seed);
+        let config = self.config();
         evtac_sim::simulate_dataset(&config, &self.out, |_| on_trial()).map_err(|source| {
             Error::Simulation {
                 protocol: self.protocol,
@@ -92,16 +95,17 @@ impl SimulateJob {
         Ok(())
     }
 
+    /// What the job simulates.
+    pub fn config(&self) -> evtac_sim::DatasetConfig {
+        evtac_sim::DatasetConfig {
+            repeats: self.repeats,
+            ..evtac_sim::DatasetConfig::new(self.protocol, self.scale, self.seed)
+        }
+    }
+
     /// How many trials the dataset has (for a progress bar).
     pub fn trials(&self) -> usize {
-        let config = evtac_sim::DatasetConfig::new(self.protocol, self.scale, self.seed);
-        evtac_sim::plan(
-            self.protocol,
-            self.scale,
-            self.seed,
-            &config.params.timeline,
-        )
-        .len()
+        self.config().trials().len()
     }
 }
 
@@ -178,6 +182,10 @@ pub struct ReproduceJob {
     /// Simulated datasets Experiment 1 runs on, its own included, or `None` for the plan's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub datasets: Option<usize>,
+    /// Passes over the conditions of the simulated Experiments 1 and 2 instead of the scale's,
+    /// or `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeats: Option<usize>,
 }
 
 /// One point of a sensitivity study: Experiment 1, tuning included, on a dataset simulated with
@@ -359,6 +367,7 @@ mod tests {
                 scale: Scale::Tiny,
                 seed: 1,
                 out: "data/exp2".into(),
+                repeats: Some(2),
             }),
             Job::Train(TrainJob {
                 dataset: "data with spaces/exp1".into(),
@@ -377,6 +386,7 @@ mod tests {
                 fusions: false,
                 label_noise_deg: Some(0.0),
                 datasets: Some(3),
+                repeats: Some(2),
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

@@ -27,8 +27,9 @@ pub fn models_dir(models: &Path, sd: f64) -> PathBuf {
     models.join("label-noise").join(format!("sd{sd}"))
 }
 
-/// The paper's representations among `reprs`: the ones the ablation trains.
-fn paper(reprs: &[ReprConfig]) -> Vec<ReprConfig> {
+/// The paper's representations among `reprs`: the ones the ablation (and the grouped split's
+/// measurement, `crate::repeat_split`) trains.
+pub(crate) fn paper(reprs: &[ReprConfig]) -> Vec<ReprConfig> {
     reprs
         .iter()
         .filter(|c| ReprKind::PAPER.contains(&c.kind()))

@@ -27,7 +27,8 @@
 //! - [`sensitivity`]: Experiment 1, tuning included, with each unmeasured simulator parameter
 //!   scaled, one at a time: which of the paper's conclusions hold on which simulator.
 //! - [`dataset_seeds`]: Experiment 1 on datasets simulated with other seeds, the spread across
-//!   datasets the report sets beside the training seeds'.
+//!   datasets the report sets beside the training seeds'; [`repeat_split`]: what a condition's
+//!   repeats on both sides of the split are worth.
 //!
 //! Modules that only the pipeline calls (`noise`, `variant`, `exp2`, `exp3`, `examples`,
 //! `label_check`) are private: their results are in [`results`], their errors in
@@ -70,6 +71,7 @@ mod noise;
 pub mod pipeline;
 pub mod plan;
 pub mod progress;
+pub mod repeat_split;
 pub mod repr_example;
 pub mod results;
 pub mod sampling;

@@ -68,21 +68,15 @@ pub fn run(
             continue;
         }
         // Same protocol, scale and seed as Experiment 1's dataset: only the noise differs.
-        let mut params = sim.params.clone();
-        params.dvs = params.dvs.with_noise_scaled(level);
+        let mut config = sim.config(sim.seed);
+        config.params.dvs = config.params.dvs.with_noise_scaled(level);
         let at = variant::Place {
             dir: &dataset_dir(out, level),
             models: &dataset_dir(run.models, level),
             simulating: Stage::NoiseSimulating,
             training: (FeatureSet::Noise, Stage::NoiseTraining),
         };
-        let (ds, results) = variant::exp1_on(
-            &params,
-            (sim.scale, sim.seed),
-            &at,
-            (reprs, ds1.inputs),
-            run,
-        )?;
+        let (ds, results) = variant::exp1_on(&config, &at, (reprs, ds1.inputs), run)?;
         all.extend(points(level, background_rate(&ds, seconds)?, &results));
     }
     Ok(all)

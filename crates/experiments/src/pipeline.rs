@@ -18,7 +18,7 @@ use crate::training;
 use crate::tuning::{self, Kind};
 use crate::{
     choices, dataset_seeds, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise,
-    repr_example, sensor_view,
+    repeat_split, repr_example, sensor_view,
 };
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
@@ -64,12 +64,13 @@ impl Datasets {
     }
 }
 
-/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) at `scale` into
-/// `dir`, laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked done is
-/// kept, so an interrupted simulation resumes.
+/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) at `scale` (with
+/// `repeats` passes over Experiments 1 and 2's conditions instead of the scale's) into `dir`,
+/// laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked done is kept,
+/// so an interrupted simulation resumes.
 pub fn simulate_all(
     dir: &Path,
-    scale: evtac_sim::Scale,
+    (scale, repeats): (evtac_sim::Scale, Option<usize>),
     seed: u64,
     progress: &dyn Progress,
 ) -> Result<(), Error> {
@@ -79,6 +80,7 @@ pub fn simulate_all(
             scale,
             seed,
             out: dir.join(protocol.name()),
+            repeats,
         };
         if jobs::is_done(&job.out) {
             continue;
@@ -156,6 +158,10 @@ pub fn reproduce(
     let dataset_seeds = dataset_seeds::run(&ds1, &e1, &reprs, &run, out)?;
     if !dataset_seeds.is_empty() {
         stages.done("experiment 1 on other datasets")?;
+    }
+    let repeat_split = repeat_split::run(&cache1, &reprs, &e1, &run)?;
+    if repeat_split.is_some() {
+        stages.done("repeats kept together")?;
     }
     let label_noise = label_noise::run(&cache1, &splits1, &reprs, &e1, &run)?;
     if label_noise.is_some() {
@@ -291,6 +297,7 @@ pub fn reproduce(
         sensor_kind: sensor.as_ref().map(|v| v.kind),
         sensor,
         dataset_seeds,
+        repeat_split,
     };
     results.run.stage_seconds = stages.list;
     results.run.stage_history = log.records();

@@ -438,6 +438,18 @@ pub struct LabelCheck {
     pub label_source: evtac_labels::LabelSource,
 }
 
+/// Experiment 1's paper representations on a split that keeps each condition's repeats on one
+/// side, beside the paper's split ([`crate::repeat_split`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RepeatSplit {
+    /// The most trials one condition has in Experiment 1's dataset.
+    pub repeats: usize,
+    /// Experiment 1's results (the paper's split: repeats may fall on both sides).
+    pub paper_split: Vec<Exp1Repr>,
+    /// The same representations, settings and seeds on the grouped split.
+    pub together: Vec<Exp1Repr>,
+}
+
 /// Experiment 1 on one simulated dataset of the spread across datasets, for one
 /// representation ([`crate::dataset_seeds`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -501,6 +513,10 @@ pub struct Results {
     /// first (empty when the plan has one dataset, and in older results).
     #[serde(default)]
     pub dataset_seeds: Vec<DatasetSeedPoint>,
+    /// Experiment 1 with each condition's repeats kept on one side of the split (absent when
+    /// no condition has two trials, and from older results).
+    #[serde(default)]
+    pub repeat_split: Option<RepeatSplit>,
 }
 
 #[cfg(test)]

@@ -482,9 +482,12 @@ fn measure(
     run: &RunContext<'_>,
 ) -> Result<Point, Error> {
     let data = dir.join("data");
+    let config = evtac_sim::DatasetConfig {
+        params: params.clone(),
+        ..evtac_sim::DatasetConfig::new(Protocol::Exp1, run.plan.scale, run.seed)
+    };
     variant::simulate(
-        params,
-        (run.plan.scale, run.seed),
+        &config,
         &data,
         Stage::Simulating(Protocol::Exp1),
         run.progress,

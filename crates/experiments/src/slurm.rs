@@ -241,6 +241,7 @@ fn simulation_jobs(reproduction: &ReproduceJob) -> Vec<Job> {
             scale: reproduction.scale,
             seed: reproduction.seed,
             out: sim_dir(reproduction).join(protocol.name()),
+            repeats: reproduction.repeats,
         })
         .filter(|j| !jobs::is_done(&j.out))
         .map(Job::Simulate)

@@ -185,6 +185,47 @@ impl Splits {
         out
     }
 
+    /// Splits like [`Splits::make`], but with every trial of one condition (speed, depth and
+    /// direction) in the same split, so a condition's repeats never fall on both sides: the
+    /// conditions are split 70:15:15 with balanced marginals, and each trial follows its own.
+    /// Each split keeps the manifest's order of trials.
+    pub fn make_grouped(trials: &[Stratum], seed: u64) -> Splits {
+        let mut conditions: Vec<Stratum> = Vec::new();
+        let mut index: HashMap<[String; 3], usize> = HashMap::new();
+        let condition_of: Vec<usize> = trials
+            .iter()
+            .map(|t| {
+                *index.entry(t.keys()).or_insert_with(|| {
+                    conditions.push(t.clone());
+                    conditions.len() - 1
+                })
+            })
+            .collect();
+        let by_condition = Splits::make(&conditions, seed);
+        let split_of_condition: HashMap<&str, Split> = Split::ALL
+            .into_iter()
+            .flat_map(|split| {
+                by_condition
+                    .get(split)
+                    .iter()
+                    .map(move |name| (name.as_str(), split))
+            })
+            .collect();
+        let mut out = Splits {
+            seed,
+            ..Splits::default()
+        };
+        for (t, &c) in trials.iter().zip(&condition_of) {
+            let list = match split_of_condition[conditions[c].trial.as_str()] {
+                Split::Train => &mut out.train,
+                Split::Val => &mut out.val,
+                Split::Test => &mut out.test,
+            };
+            list.push(t.trial.clone());
+        }
+        out
+    }
+
     /// The trials of `split`.
     pub fn get(&self, split: Split) -> &[String] {
         match split {
@@ -284,6 +325,43 @@ mod tests {
             }
         }
         v
+    }
+
+    #[test]
+    fn grouped_splits_keep_each_conditions_repeats_on_one_side() {
+        let trials = paper_grid();
+        let s = Splits::make_grouped(&trials, 7);
+        assert_eq!((s.train.len(), s.val.len(), s.test.len()), (700, 150, 150));
+        let names: Vec<String> = trials.iter().map(|t| t.trial.clone()).collect();
+        s.check(&names, Path::new(".")).unwrap();
+        let split_of: HashMap<&str, Split> = Split::ALL
+            .into_iter()
+            .flat_map(|sp| s.get(sp).iter().map(move |n| (n.as_str(), sp)))
+            .collect();
+        // The grid's two repeats of a condition are neighbours: always the same split.
+        for pair in trials.chunks(2) {
+            assert_eq!(
+                split_of[pair[0].trial.as_str()],
+                split_of[pair[1].trial.as_str()]
+            );
+        }
+        // The paper's split puts some conditions' repeats on both sides.
+        let paper = Splits::make(&trials, 7);
+        let paper_of: HashMap<&str, Split> = Split::ALL
+            .into_iter()
+            .flat_map(|sp| paper.get(sp).iter().map(move |n| (n.as_str(), sp)))
+            .collect();
+        let straddling = trials
+            .chunks(2)
+            .filter(|p| paper_of[p[0].trial.as_str()] != paper_of[p[1].trial.as_str()])
+            .count();
+        assert!(
+            straddling > 100,
+            "{straddling} conditions straddle the paper's split"
+        );
+        // One trial per condition: the same as the plain split.
+        let single: Vec<Stratum> = trials.iter().step_by(2).cloned().collect();
+        assert_eq!(Splits::make_grouped(&single, 3), Splits::make(&single, 3));
     }
 
     #[test]

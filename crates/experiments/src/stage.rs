@@ -65,6 +65,9 @@ pub enum Stage {
     DatasetSeedSimulating,
     /// Experiment 1's training runs on a dataset simulated with another seed (units: runs).
     DatasetSeedTraining,
+    /// Experiment 1's paper representations on the split that keeps each condition's repeats
+    /// on one side (units: runs).
+    RepeatSplitTraining,
 }
 
 impl std::fmt::Display for Stage {
@@ -88,6 +91,7 @@ impl std::fmt::Display for Stage {
             Stage::Features(FeatureSet::DatasetSeed) => f.write_str("features (other datasets)"),
             Stage::DatasetSeedSimulating => f.write_str("simulating exp1 with other seeds"),
             Stage::DatasetSeedTraining => f.write_str("other datasets' training"),
+            Stage::RepeatSplitTraining => f.write_str("repeats-together training"),
         }
     }
 }
@@ -127,26 +131,47 @@ pub struct TrialCounts {
     pub exp3: usize,
     /// Trials still to simulate.
     pub simulate: usize,
+    /// Whether some condition of Experiment 1 has two or more trials (then the report measures
+    /// the grouped split, `crate::repeat_split`).
+    pub exp1_repeated: bool,
 }
 
 impl TrialCounts {
     /// The counts of the datasets in `data` (their manifests; a missing one counts 0).
     pub fn of_datasets(data: &Path) -> Self {
-        Self::count(|protocol| {
+        let mut counts = Self::count(|protocol| {
             let n = Manifest::read(data.join(protocol.name())).map_or(0, |m| m.trials.len());
             (n, 0)
-        })
+        });
+        counts.exp1_repeated = Manifest::read(data.join(Protocol::Exp1.name())).is_ok_and(|m| {
+            let mut seen = std::collections::HashSet::new();
+            m.trials.iter().any(|t| {
+                !seen.insert(format!(
+                    "{} {} {}",
+                    t.speed_deg_s, t.depth_mm, t.direction_deg
+                ))
+            })
+        });
+        counts
     }
 
     /// The counts of the datasets [`crate::pipeline::simulate_all`] writes into `dir` (the
     /// simulation plans; datasets already simulated there count as done).
-    pub fn of_simulation(dir: &Path, scale: Scale, seed: u64) -> Self {
-        Self::count(|protocol| {
-            let config = DatasetConfig::new(protocol, scale, seed);
-            let n = evtac_sim::plan(protocol, scale, seed, &config.params.timeline).len();
+    pub fn of_simulation(dir: &Path, (scale, repeats): (Scale, Option<usize>), seed: u64) -> Self {
+        let exp1_repeated = repeats.unwrap_or(scale.design().repeats) >= 2;
+        let counts = Self::count(|protocol| {
+            let config = DatasetConfig {
+                repeats,
+                ..DatasetConfig::new(protocol, scale, seed)
+            };
+            let n = config.trials().len();
             let done = crate::jobs::is_done(&dir.join(protocol.name()));
             (n, if done { 0 } else { n })
-        })
+        });
+        Self {
+            exp1_repeated,
+            ..counts
+        }
     }
 
     fn count(mut trials: impl FnMut(Protocol) -> (usize, usize)) -> Self {
@@ -195,7 +220,8 @@ impl CostModel {
             Stage::Exp1Training
             | Stage::NoiseTraining
             | Stage::LabelNoiseTraining
-            | Stage::DatasetSeedTraining => units * plan.epochs as f64 * train(counts.exp1),
+            | Stage::DatasetSeedTraining
+            | Stage::RepeatSplitTraining => units * plan.epochs as f64 * train(counts.exp1),
             Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
             Stage::Latency => {
                 let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
@@ -241,6 +267,12 @@ impl CostModel {
             * (c(Stage::DatasetSeedSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::DatasetSeed), counts.exp1)
                 + c(Stage::DatasetSeedTraining, reprs * plan.seeds));
+        if counts.exp1_repeated {
+            sum += c(
+                Stage::RepeatSplitTraining,
+                ReprKind::PAPER.len() * plan.seeds,
+            );
+        }
         if plan.label_noise_deg.is_some_and(|sd| sd > 0.0) {
             sum += c(
                 Stage::LabelNoiseTraining,
@@ -276,12 +308,23 @@ mod tests {
             exp2: 0,
             exp3: 20,
             simulate: 80,
+            exp1_repeated: false,
         };
         let model = CostModel::new(&plan, counts);
         let reprs = plan.representations();
         let training = model.seconds(Stage::Exp1Training, (reprs * plan.seeds) as u64);
         assert!(training > 0.0);
         let with_exp2 = CostModel::new(&plan, TrialCounts { exp2: 30, ..counts });
+        // Repeats in Experiment 1: the paper's three trained again on the grouped split.
+        let repeated = CostModel::new(
+            &plan,
+            TrialCounts {
+                exp1_repeated: true,
+                ..counts
+            },
+        );
+        let grouped = model.seconds(Stage::RepeatSplitTraining, (3 * plan.seeds) as u64);
+        assert!((repeated.total_seconds() - model.total_seconds() - grouped).abs() < 1e-9);
         assert!(with_exp2.total_seconds() > model.total_seconds());
         assert_eq!(model.seconds(Stage::Exp2Training, 0), 0.0);
         let quiet = Plan {

@@ -16,7 +16,6 @@ use crate::results::Exp1Repr;
 use crate::stage::{FeatureSet, Stage};
 use evtac_import::inputs::Inputs;
 use evtac_repr::ReprConfig;
-use evtac_sim::{Protocol, Scale, SimParams};
 use std::path::Path;
 
 /// Where a variant lives and how its stages are reported: its dataset folder, its models
@@ -32,17 +31,16 @@ pub(crate) struct Place<'a> {
     pub training: (FeatureSet, Stage),
 }
 
-/// Simulates (or keeps) the variant with `params` at `scale` and `seed` into `at.dir` and runs
-/// Experiment 1 on it for `reprs` (settings tuned elsewhere), with `run`'s plan and seeds and
-/// its models under `at.models`; returns the dataset (opened with `inputs`) and the results.
+/// Simulates (or keeps) the variant `config` into `at.dir` and runs Experiment 1 on it for
+/// `reprs` (settings tuned elsewhere), with `run`'s plan and seeds and its models under
+/// `at.models`; returns the dataset (opened with `inputs`) and the results.
 pub(crate) fn exp1_on(
-    params: &SimParams,
-    (scale, seed): (Scale, u64),
+    config: &evtac_sim::DatasetConfig,
     at: &Place<'_>,
     (reprs, inputs): (&[ReprConfig], Inputs),
     run: &RunContext<'_>,
 ) -> Result<(Dataset, Vec<Exp1Repr>), Error> {
-    simulate(params, (scale, seed), at.dir, at.simulating, run.progress)?;
+    simulate(config, at.dir, at.simulating, run.progress)?;
     let ds = Dataset::open(at.dir, inputs)?;
     let splits = ds.splits(run.seed)?;
     let results = {
@@ -56,11 +54,10 @@ pub(crate) fn exp1_on(
     Ok((ds, results))
 }
 
-/// Simulates (or, when `dir` is marked done, keeps) Experiment 1's dataset at `scale` and
-/// `seed` with `params` into `dir`, reporting its trials as `stage`.
+/// Simulates (or, when `dir` is marked done, keeps) the dataset of `config` into `dir`,
+/// reporting its trials as `stage`.
 pub(crate) fn simulate(
-    params: &SimParams,
-    (scale, seed): (Scale, u64),
+    config: &evtac_sim::DatasetConfig,
     dir: &Path,
     stage: Stage,
     progress: &dyn Progress,
@@ -68,15 +65,10 @@ pub(crate) fn simulate(
     if jobs::is_done(dir) {
         return Ok(());
     }
-    let config = evtac_sim::DatasetConfig {
-        params: params.clone(),
-        ..evtac_sim::DatasetConfig::new(Protocol::Exp1, scale, seed)
-    };
-    let n = evtac_sim::plan(Protocol::Exp1, scale, seed, &config.params.timeline).len();
-    progress.stage(stage, n as u64);
-    evtac_sim::simulate_dataset(&config, dir, |_| progress.advance(1)).map_err(|source| {
+    progress.stage(stage, config.trials().len() as u64);
+    evtac_sim::simulate_dataset(config, dir, |_| progress.advance(1)).map_err(|source| {
         Error::Simulation {
-            protocol: Protocol::Exp1,
+            protocol: config.protocol,
             dir: dir.to_path_buf(),
             source: Box::new(source),
         }

@@ -14,6 +14,7 @@ mod dataset_seeds;
 mod fusion;
 mod label_noise;
 mod labels;
+mod repeat_split;
 
 /// Test runs whose pitch, roll and overall MAE are each `values`' value: the sections' tests
 /// build their results from these.
@@ -27,6 +28,20 @@ fn runs_of(values: &[f64]) -> Vec<evtac_experiments::results::Mae> {
             roll: m,
         })
         .collect()
+}
+
+/// An Experiment 1 result of `name` with test runs of `values` (see [`runs_of`]).
+#[cfg(test)]
+fn repr_of(name: ReprKind, values: &[f64]) -> evtac_experiments::results::Exp1Repr {
+    let runs = runs_of(values);
+    evtac_experiments::results::Exp1Repr {
+        name,
+        config: name.config(Default::default(), Default::default()),
+        seeds: (0..values.len() as u64).collect(),
+        test: evtac_experiments::results::MaeStats::of(&runs),
+        val_runs: runs.clone(),
+        runs,
+    }
 }
 
 /// A mean and a standard deviation, in degrees.
@@ -432,6 +447,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     }
 
     dataset_seeds::section(&mut md, r);
+    repeat_split::section(&mut md, r.repeat_split.as_ref());
     noise_section(&mut md, r, figures);
     md.push_str(&label_noise::section(r.label_noise.as_ref()));
 

@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::params::SimParams;
-use crate::protocol::{Protocol, Scale, TrialSpec, plan, trial_seed};
+use crate::protocol::{Design, Protocol, Scale, TrialSpec, plan_design, trial_seed};
 use crate::trial::{Simulator, TrialRecording, TruthSample};
 
 /// The camera name written into every AEDAT4 file.
@@ -84,6 +84,9 @@ pub struct DatasetConfig {
     pub compression: Compression,
     /// Simulate only the first this many trials of the plan (tests, benchmarks); `None`: all.
     pub limit: Option<usize>,
+    /// Passes over the conditions of Experiments 1 and 2 (each with the sensor seated again)
+    /// instead of the scale's; `None`: the scale's.
+    pub repeats: Option<usize>,
 }
 
 impl DatasetConfig {
@@ -96,6 +99,7 @@ impl DatasetConfig {
             params: SimParams::default(),
             compression: Compression::Lz4,
             limit: None,
+            repeats: None,
         }
     }
 }
@@ -107,6 +111,7 @@ struct SimulatorRecord<'a> {
     protocol: Protocol,
     scale: Scale,
     seed: u64,
+    repeats: usize,
     trials: usize,
     hot_pixels: Vec<(u16, u16, f64)>,
     params: &'a SimParams,
@@ -118,9 +123,19 @@ fn camera_seed(seed: u64) -> u64 {
 }
 
 impl DatasetConfig {
+    /// The scale's design, with the repeats asked for.
+    pub fn design(&self) -> Design {
+        let design = self.scale.design();
+        match self.repeats {
+            Some(n) => design.with_repeats(n),
+            None => design,
+        }
+    }
+
     /// The trials to simulate: the plan, cut at the limit.
     pub fn trials(&self) -> Vec<TrialSpec> {
-        let mut trials = plan(self.protocol, self.scale, self.seed, &self.params.timeline);
+        let design = self.design();
+        let mut trials = plan_design(self.protocol, &design, self.seed, &self.params.timeline);
         trials.truncate(self.limit.unwrap_or(usize::MAX));
         trials
     }
@@ -203,6 +218,7 @@ pub fn simulate_dataset(
             protocol: config.protocol,
             scale: config.scale,
             seed: config.seed,
+            repeats: config.design().repeats,
             trials: manifest.trials.len(),
             hot_pixels: sim.pixel_array().hot_pixels(),
             params: &config.params,

@@ -29,7 +29,7 @@ pub mod trial;
 pub use dataset::{DatasetConfig, DatasetError, simulate_dataset};
 pub use params::SimParams;
 pub use params_file::{ParamsError, read_params};
-pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan};
+pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan, plan_design};
 pub use sensor::SkinPose;
 pub use session::{SessionConfig, SessionRecord, simulate_session};
 pub use trial::{Simulator, TrialRecording, TruthSample};

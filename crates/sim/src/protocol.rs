@@ -203,6 +203,13 @@ pub struct Design {
     pub no_contact_trials: usize,
 }
 
+impl Design {
+    /// This design with `repeats` passes over the conditions of Experiments 1 and 2.
+    pub fn with_repeats(self, repeats: usize) -> Design {
+        Design { repeats, ..self }
+    }
+}
+
 /// What one trial does.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialSpec {
@@ -251,7 +258,16 @@ pub fn plan(
     seed: u64,
     timeline: &TimelineParams,
 ) -> Vec<TrialSpec> {
-    let design = scale.design();
+    plan_design(protocol, &scale.design(), seed, timeline)
+}
+
+/// [`plan`] on a given design (a scale's, e.g. with other repeats, [`Design::with_repeats`]).
+pub fn plan_design(
+    protocol: Protocol,
+    design: &Design,
+    seed: u64,
+    timeline: &TimelineParams,
+) -> Vec<TrialSpec> {
     let protocol_index = Protocol::ALL
         .iter()
         .position(|&p| p == protocol)

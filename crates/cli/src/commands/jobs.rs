@@ -126,6 +126,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
                 j.protocol.name().into(),
             ]);
             args.extend(one_thread(j.scale, j.seed, &j.out));
+            if let Some(n) = j.repeats {
+                args.extend(["--repeats".into(), n.to_string()]);
+            }
         }
         Job::Train(j) => args.extend(train_args(j)),
         Job::Reproduce(j) => {
@@ -147,6 +150,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             }
             if let Some(n) = j.datasets {
                 args.extend(["--datasets".into(), n.to_string()]);
+            }
+            if let Some(n) = j.repeats {
+                args.extend(["--repeats".into(), n.to_string()]);
             }
         }
         Job::SensitivityPoint(j) => {

@@ -59,6 +59,12 @@ pub struct Args {
     /// `small`, 2 at `tiny`, 1 at `paper`). Needs simulated Experiment 1 data.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub datasets: Option<u64>,
+    /// Passes over the conditions of the simulated Experiments 1 and 2, each with the sensor
+    /// seated again, instead of the scale's (2 at `paper`, 1 at `small` and `tiny`). With 2 or
+    /// more, the report measures what repeats on both sides of the split are worth: Experiment
+    /// 1 trained again with each condition's repeats kept on one side.
+    #[arg(long, value_name = "N", value_parser = parse_repeats)]
+    pub repeats: Option<usize>,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -92,6 +98,14 @@ fn noise_level(s: &str) -> Result<NoiseLevel, String> {
         .map_err(|e| format!("{s:?} is not a factor: {e}"))
 }
 
+/// `--repeats` (here and in `evtac simulate`): a count of at least 1.
+pub(crate) fn parse_repeats(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("{s:?} is not a number of passes (1 or more)")),
+    }
+}
+
 impl Args {
     /// The noise levels asked for (empty values dropped), or `None` for the plan's.
     pub fn noise_levels(&self) -> Option<Vec<f64>> {
@@ -111,6 +125,7 @@ impl Args {
             out: job.out.clone(),
             label_noise_deg: job.label_noise_deg,
             datasets: job.datasets.map(|n| n as u64),
+            repeats: job.repeats,
             noise_levels: job
                 .noise_levels
                 .as_ref()
@@ -328,6 +343,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         fusions: !args.no_fusions,
         label_noise_deg: args.label_noise_deg,
         datasets: args.datasets.map(|n| n as usize),
+        repeats: args.repeats,
     };
     let (slurm, task) = (
         crate::cluster::slurm(args.slurm_args.as_deref()),
@@ -383,7 +399,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sim_dir = args.out.join("data");
     let counts = match &args.data {
         Some(data) => TrialCounts::of_datasets(data),
-        None => TrialCounts::of_simulation(&sim_dir, args.scale, args.seed),
+        None => TrialCounts::of_simulation(&sim_dir, (args.scale, args.repeats), args.seed),
     };
     let bars = Overall::new(&bars, CostModel::new(&plan, counts));
     // Every invocation's stage times go to OUT/stage-times.csv: a resumed run's report
@@ -393,7 +409,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(d) => d.clone(),
         None => {
             let d = sim_dir;
-            pool.install(|| pipeline::simulate_all(&d, args.scale, args.seed, &bars))?;
+            pool.install(|| {
+                pipeline::simulate_all(&d, (args.scale, args.repeats), args.seed, &bars)
+            })?;
             let seconds = started.elapsed().as_secs_f64();
             bars.message(&format!("simulated datasets ready in {seconds:.1} s"));
             log.record("simulation", seconds)?;

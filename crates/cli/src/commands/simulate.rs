@@ -36,6 +36,10 @@ pub struct Args {
     /// Simulate only the first N trials of the protocol.
     #[arg(long)]
     pub limit: Option<usize>,
+    /// Passes over the conditions of Experiments 1 and 2, each with the sensor seated again,
+    /// instead of the scale's (2 at `paper`, 1 at `small` and `tiny`).
+    #[arg(long, value_name = "N", value_parser = super::reproduce::parse_repeats)]
+    pub repeats: Option<usize>,
     /// Write a recording session instead of a dataset: one session.aedat4 with every trial
     /// back to back (still gaps between them, a trigger at each motion onset), the robot's log
     /// robot_log.csv on its own clock (a seeded offset, jittered times), no_contact.aedat4,
@@ -57,6 +61,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let config = DatasetConfig {
         params,
         limit: args.limit,
+        repeats: args.repeats,
         ..DatasetConfig::new(args.protocol, args.scale, args.seed)
     };
     let trials = config.trials().len();

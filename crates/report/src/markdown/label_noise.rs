@@ -72,19 +72,11 @@ pub fn section(ablation: Option<&LabelNoise>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use evtac_experiments::results::{Exp1Repr, MaeStats};
-    use evtac_repr::{DynamicConfig, ReprKind, StaticConfig};
+    use evtac_experiments::results::Exp1Repr;
+    use evtac_repr::ReprKind;
 
     fn repr(maes: &[f64]) -> Exp1Repr {
-        let runs = super::super::runs_of(maes);
-        Exp1Repr {
-            name: ReprKind::Static,
-            config: ReprKind::Static.config(StaticConfig::default(), DynamicConfig::default()),
-            seeds: (0..maes.len() as u64).collect(),
-            test: MaeStats::of(&runs),
-            val_runs: runs.clone(),
-            runs,
-        }
+        super::super::repr_of(ReprKind::Static, maes)
     }
 
     #[test]
