@@ -218,16 +218,7 @@ impl Dataset {
 
     /// Every trial's conditions, for splitting.
     pub fn strata(&self) -> Vec<Stratum> {
-        self.manifest
-            .trials
-            .iter()
-            .map(|t| Stratum {
-                trial: t.trial.clone(),
-                speed_deg_s: t.speed_deg_s,
-                depth_mm: t.depth_mm,
-                direction_deg: t.direction_deg,
-            })
-            .collect()
+        Stratum::of_manifest(&self.manifest)
     }
 
     /// The dataset's splits: `splits.json`, made (with `seed`) and written when missing.

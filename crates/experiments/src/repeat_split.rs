@@ -18,25 +18,14 @@ use crate::context::RunContext;
 use crate::error::Error;
 use crate::exp1;
 use crate::results::{Exp1Repr, RepeatSplit};
-use crate::splits::Splits;
+use crate::splits::{Splits, Stratum};
 use crate::stage::{FeatureSet, Stage};
 use evtac_repr::{ReprConfig, ReprKind};
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The folder of the grouped split's models under the run's models folder.
 pub fn models_dir(models: &Path) -> PathBuf {
     models.join("repeats-together")
-}
-
-/// The most trials any one condition (speed, depth, direction) of `cache`'s dataset has.
-fn most_repeats(cache: &FeatureCache<'_>) -> usize {
-    let mut counts: HashMap<String, usize> = HashMap::new();
-    for t in &cache.dataset().manifest.trials {
-        let key = format!("{} {} {}", t.speed_deg_s, t.depth_mm, t.direction_deg);
-        *counts.entry(key).or_default() += 1;
-    }
-    counts.into_values().max().unwrap_or(0)
 }
 
 /// Trains and tests the paper's representations among `reprs` on the grouped split of
@@ -48,11 +37,12 @@ pub fn run(
     paper_split: &[Exp1Repr],
     run: &RunContext<'_>,
 ) -> Result<Option<RepeatSplit>, Error> {
-    let repeats = most_repeats(cache);
+    let strata = cache.dataset().strata();
+    let repeats = Stratum::most_repeats(&strata);
     if repeats < 2 {
         return Ok(None);
     }
-    let grouped = Splits::make_grouped(&cache.dataset().strata(), run.seed);
+    let grouped = Splits::make_grouped(&strata, run.seed);
     let paper = crate::label_noise::paper(reprs);
     let models = models_dir(run.models);
     let at = RunContext {

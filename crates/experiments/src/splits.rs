@@ -97,6 +97,30 @@ pub struct Stratum {
 }
 
 impl Stratum {
+    /// Every trial's conditions in `manifest`, in its order.
+    pub fn of_manifest(manifest: &evtac_events::manifest::Manifest) -> Vec<Stratum> {
+        manifest
+            .trials
+            .iter()
+            .map(|t| Stratum {
+                trial: t.trial.clone(),
+                speed_deg_s: t.speed_deg_s,
+                depth_mm: t.depth_mm,
+                direction_deg: t.direction_deg,
+            })
+            .collect()
+    }
+
+    /// The most trials any one condition (speed, depth and direction) has among `trials`: the
+    /// repeats per condition.
+    pub fn most_repeats(trials: &[Stratum]) -> usize {
+        let mut counts: HashMap<[String; 3], usize> = HashMap::new();
+        for t in trials {
+            *counts.entry(t.keys()).or_default() += 1;
+        }
+        counts.into_values().max().unwrap_or(0)
+    }
+
     fn keys(&self) -> [String; 3] {
         [
             format!("speed={}", self.speed_deg_s),
@@ -359,9 +383,12 @@ mod tests {
             straddling > 100,
             "{straddling} conditions straddle the paper's split"
         );
+        assert_eq!(Stratum::most_repeats(&trials), 2);
         // One trial per condition: the same as the plain split.
         let single: Vec<Stratum> = trials.iter().step_by(2).cloned().collect();
         assert_eq!(Splits::make_grouped(&single, 3), Splits::make(&single, 3));
+        assert_eq!(Stratum::most_repeats(&single), 1);
+        assert_eq!(Stratum::most_repeats(&[]), 0);
     }
 
     #[test]

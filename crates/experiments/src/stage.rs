@@ -6,6 +6,7 @@
 //! stages against each other, so the ETA follows the actual machine's pace.
 
 use crate::plan::{Kind, Plan};
+use crate::splits::Stratum;
 use evtac_events::manifest::Manifest;
 use evtac_repr::ReprKind;
 use evtac_sim::{DatasetConfig, Protocol, Scale};
@@ -143,15 +144,8 @@ impl TrialCounts {
             let n = Manifest::read(data.join(protocol.name())).map_or(0, |m| m.trials.len());
             (n, 0)
         });
-        counts.exp1_repeated = Manifest::read(data.join(Protocol::Exp1.name())).is_ok_and(|m| {
-            let mut seen = std::collections::HashSet::new();
-            m.trials.iter().any(|t| {
-                !seen.insert(format!(
-                    "{} {} {}",
-                    t.speed_deg_s, t.depth_mm, t.direction_deg
-                ))
-            })
-        });
+        counts.exp1_repeated = Manifest::read(data.join(Protocol::Exp1.name()))
+            .is_ok_and(|m| Stratum::most_repeats(&Stratum::of_manifest(&m)) >= 2);
         counts
     }
 
