@@ -222,8 +222,8 @@ pub(super) fn section(md: &mut String, r: &Results) {
         let _ = writeln!(
             md,
             "\nThe spread across datasets against the training seeds': {}. On evtac's simulator: \
-             datasets differ here in their trials' noise, the rig's errors and the camera's \
-             fixed pattern, not in the sensor's build.\n",
+             datasets differ here in their trials' noise, the rig's errors, the sensor's \
+             seatings and the camera's fixed pattern, not in the sensor's build.\n",
             ratio.join(", ")
         );
     }

@@ -38,8 +38,10 @@ pub fn section(check: Option<&LabelCheck>) -> String {
     }
     if let Some(r) = &check.truth_rms_deg {
         md.push_str(&format!(
-            " Against the simulator's exact ground truth, the labels' RMS error over pitch and \
-             roll is {:.3} deg per trial on average (at most {:.3}, {} trials). On simulated \
+            " Against the simulator's exact ground truth (the pose in the sensor's frame), the \
+             labels' RMS error over pitch and roll is {:.3} deg per trial on average (at most \
+             {:.3}, {} trials); it includes the turn of the sensor's seating, which labels on \
+             the commanded rolling axis do not see (`rig.reseat_rotation_sd_deg`). On simulated \
              data the stop check measures the labels' own error together with the robot's \
              repeatability, which the simulator takes from the ABB IRB 120's specification \
              (`rig.angle_sd_deg` in `docs/simulator.md`), not tuned to the paper's spread: a \
