@@ -4,7 +4,7 @@
 //! ```text
 //! DIR/trials.csv            the manifest (evtac_events::manifest)
 //! DIR/t0000.aedat4 ...      events (640x480) and IMU samples of each trial
-//! DIR/truth/t0000.csv ...   t_us,theta_deg,pitch_deg,roll_deg at 1 kHz (the pose reached, in the sensor's frame)
+//! DIR/truth/t0000.csv ...   t_us,theta_deg,pitch_deg,roll_deg at 1 kHz (pose reached, sensor frame)
 //! DIR/no_contact.aedat4     the sensor at rest out of contact (for the static mask)
 //! DIR/calibration.json      evtac_labels::geometry::Calibration
 //! DIR/simulator.json        protocol, scale, seed and every SimParams value

@@ -238,7 +238,7 @@ pub struct TrialSpec {
 
 /// The seating seed of pass `pass` of a protocol whose trial seeds come from `base`.
 fn seating_seed(base: u64, pass: usize) -> u64 {
-    // Far from the trial indices (0, 1, ...) and from the protocol seeds (usize::MAX - 2 - k).
+    // Indices far above the trial indices (0, 1, ...) drawn from the same `base`.
     trial_seed(base, usize::MAX / 2 + pass)
 }
 

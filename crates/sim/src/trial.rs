@@ -10,8 +10,9 @@
 //! A share `creep_fraction` of the skin's response follows with the much slower `creep_tau_s`
 //! instead (silicone's creep and hysteresis): after a stop the skin keeps settling for a second
 //! or so, at a trickle of events. The rig's per-trial errors ([`crate::rig`]) move the angles the
-//! robot reaches, the indentation and where the patch sits; the manifest keeps the commanded
-//! values and the ground truth follows the robot's actual motion, as on a real rig.
+//! robot reaches, the indentation and where the patch sits, and the sensor's seating turns the
+//! tilt's direction in its frame; the manifest keeps the commanded values and the ground truth
+//! follows the robot's actual motion in the sensor's frame, as on a real rig.
 //!
 //! Steps are adaptive: each is as long as possible (up to `max_step_s`) such that no pin's image
 //! moves more than `max_px_per_step` pixels.
@@ -30,7 +31,8 @@ use crate::protocol::{Motion, TrialSpec};
 use crate::rig::{Seating, TrialErrors};
 use crate::sensor::{Dome, Gains, PinImage, SkinPose};
 
-/// One ground-truth sample: the commanded pose.
+/// One ground-truth sample: the pose the robot reached, in the sensor's frame (the seating's
+/// turn included).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TruthSample {
     /// Time, microseconds.
@@ -52,7 +54,7 @@ pub struct TrialRecording {
     pub events: Vec<Event>,
     /// IMU samples at the IMU's rate.
     pub imu: Vec<ImuSample>,
-    /// The commanded pose at the truth rate.
+    /// The pose reached, in the sensor's frame, at the truth rate.
     pub truth: Vec<TruthSample>,
     /// When the tilt starts, microseconds.
     pub motion_start_us: i64,
