@@ -620,4 +620,16 @@ fn two_repeats_measure_the_split_that_keeps_them_together() {
         !bad.status.success() && stderr.contains("not a number of passes"),
         "{stderr}"
     );
+    // Given datasets are already simulated: their passes cannot be changed.
+    let data = out.join("data").display().to_string();
+    let given = crate::common::evtac()
+        .args(["reproduce", "--scale", "tiny", "--out", &out_s])
+        .args(["--data", &data, "--repeats", "3"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&given.stderr);
+    assert!(
+        !given.status.success() && stderr.contains("--repeats sets how the datasets are simulated"),
+        "{stderr}"
+    );
 }

@@ -384,6 +384,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         plan.datasets = n as usize;
     }
     anyhow::ensure!(
+        args.repeats.is_none() || args.data.is_none(),
+        "--repeats sets how the datasets are simulated; the --data datasets are already made \
+         (simulate them with `evtac simulate --repeats N`)"
+    );
+    anyhow::ensure!(
         args.slurm_args.is_none() || args.executor == Executor::Slurm,
         "--slurm-args is for --executor slurm"
     );
