@@ -149,16 +149,23 @@ mod tests {
         assert_eq!(e.depth_offset_mm(20.0), 0.0);
     }
 
+    /// The standard deviation of `values` (over n: the draws are the whole population here).
+    fn population_sd(values: impl Iterator<Item = f64>) -> f64 {
+        let v: Vec<f64> = values.collect();
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+    }
+
+    /// Whether a measured spread `a` is within 6 % of the asked `b`.
+    fn close(a: f64, b: f64) -> bool {
+        (a / b - 1.0).abs() < 0.06
+    }
+
     #[test]
     fn errors_have_the_given_spread() {
         let p = RigParams::default();
         let draws: Vec<TrialErrors> = (0..4000).map(|s| TrialErrors::draw(&p, 20.0, s)).collect();
-        let sd = |f: &dyn Fn(&TrialErrors) -> f64| {
-            let v: Vec<f64> = draws.iter().map(f).collect();
-            let m = v.iter().sum::<f64>() / v.len() as f64;
-            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-        };
-        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 0.06;
+        let sd = |f: &dyn Fn(&TrialErrors) -> f64| population_sd(draws.iter().map(f));
         assert!(close(sd(&|e| e.stop_deg), p.angle_sd_deg));
         assert!(close(sd(&|e| e.total_deg), p.angle_sd_deg));
         assert!(close(sd(&|e| e.plane_height_mm), p.plane_height_sd_mm));
@@ -188,12 +195,7 @@ mod tests {
         assert_eq!(seated.direction_deg(90.0), 90.0 + seating.rotation_deg);
         // Spread as asked.
         let draws: Vec<Seating> = (0..4000).map(|s| Seating::draw(&p, s)).collect();
-        let sd = |f: &dyn Fn(&Seating) -> f64| {
-            let v: Vec<f64> = draws.iter().map(f).collect();
-            let m = v.iter().sum::<f64>() / v.len() as f64;
-            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-        };
-        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 0.06;
+        let sd = |f: &dyn Fn(&Seating) -> f64| population_sd(draws.iter().map(f));
         assert!(close(sd(&|s| s.rotation_deg), p.reseat_rotation_sd_deg));
         assert!(close(sd(&|s| s.tilt_deg[0]), p.reseat_tilt_sd_deg));
         assert!(close(sd(&|s| s.height_mm), p.reseat_height_sd_mm));
