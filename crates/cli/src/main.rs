@@ -120,3 +120,35 @@ fn report(err: &anyhow::Error) -> String {
     }
     text
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Cli, Command};
+    use clap::Parser;
+    use evtac_experiments::job::{Job, ReproduceJob};
+
+    /// A Slurm reproduction's last task runs `Args::for_job`, and `evtac jobs show` prints the
+    /// command line the same job equals: both must mean the same run, every flag included.
+    #[test]
+    fn a_reproduce_jobs_command_line_parses_back_to_its_arguments() {
+        let job = ReproduceJob {
+            scale: evtac_sim::Scale::Tiny,
+            seed: 7,
+            out: "runs/out".into(),
+            data: Some("data sets".into()),
+            inputs: evtac_import::inputs::Inputs::from_flags(true, true),
+            noise_levels: Some(vec![0.0, 2.5]),
+            fusions: false,
+            label_noise_deg: Some(0.0),
+            datasets: Some(3),
+            repeats: Some(2),
+            repeat_split: false,
+        };
+        let line = crate::commands::jobs::equivalent_command("evtac", &Job::Reproduce(job.clone()));
+        let Command::Reproduce(parsed) = Cli::try_parse_from(&line).unwrap().command else {
+            panic!("{line:?} is not a reproduce command");
+        };
+        let expected = crate::commands::reproduce::Args::for_job(&job);
+        assert_eq!(format!("{parsed:?}"), format!("{expected:?}"));
+    }
+}

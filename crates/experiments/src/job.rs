@@ -186,6 +186,20 @@ pub struct ReproduceJob {
     /// or `None`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub repeats: Option<usize>,
+    /// Whether Experiment 1 is trained again with each condition's repeats kept on one side of
+    /// the split (when the dataset has repeats). Absent from older jobs files: it was.
+    #[serde(default = "yes", skip_serializing_if = "is_yes")]
+    pub repeat_split: bool,
+}
+
+/// The default of a flag that older jobs files do not carry.
+fn yes() -> bool {
+    true
+}
+
+/// Whether a flag is its default ([`yes`]), so it is left out of the jobs file.
+fn is_yes(b: &bool) -> bool {
+    *b
 }
 
 /// One point of a sensitivity study: Experiment 1, tuning included, on a dataset simulated with
@@ -387,6 +401,7 @@ mod tests {
                 label_noise_deg: Some(0.0),
                 datasets: Some(3),
                 repeats: Some(2),
+                repeat_split: false,
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

@@ -90,6 +90,12 @@ pub struct Plan {
     /// reproduce --datasets 1`). Absent from older plans: 1.
     #[serde(default = "one_dataset")]
     pub datasets: usize,
+    /// Whether Experiment 1's paper representations are trained again on a split that keeps
+    /// each condition's repeats on one side (`crate::repeat_split`), when the dataset has
+    /// repeats (`evtac reproduce --no-repeat-split` leaves it out: the paper's own plan). Absent
+    /// from older plans: it was.
+    #[serde(default = "repeat_split_by_default")]
+    pub repeat_split: bool,
 }
 
 /// The label-noise ablation's standard deviation: the spread of the paper's label validation at
@@ -103,6 +109,11 @@ fn one_dataset() -> usize {
 
 /// [`Plan::fusions`] of plans written before it existed.
 fn fusions_by_default() -> bool {
+    true
+}
+
+/// [`Plan::repeat_split`] of plans written before it existed.
+fn repeat_split_by_default() -> bool {
     true
 }
 
@@ -137,6 +148,8 @@ impl Plan {
                 // The paper's plan has one dataset; more are `--datasets N` (each adds a
                 // simulation and Experiment 1's runs, about a quarter of the plan's training).
                 datasets: 1,
+                // Runs only on a dataset with repeats (the paper's scale has two passes).
+                repeat_split: true,
             },
             Scale::Small => Plan {
                 scale,

@@ -11,7 +11,7 @@
 //! spread is no evidence either way; the report says so.
 //!
 //! Runs only when some condition of Experiment 1's dataset has two or more trials (the paper's
-//! scale, or `--repeats 2`). Models go under `models/repeats-together/exp1/`, so a run resumes.
+//! scale, or `--repeats 2`) and the plan asks for it ([`crate::plan::Plan::repeat_split`]). Models go under `models/repeats-together/exp1/`, so a run resumes.
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
@@ -30,7 +30,7 @@ pub fn models_dir(models: &Path) -> PathBuf {
 
 /// Trains and tests the paper's representations among `reprs` on the grouped split of
 /// `cache`'s dataset (Experiment 1's); `paper_split` are Experiment 1's results. `None` when no
-/// condition has two trials.
+/// condition has two trials or the plan leaves the study out.
 pub fn run(
     cache: &FeatureCache<'_>,
     reprs: &[ReprConfig],
@@ -39,7 +39,7 @@ pub fn run(
 ) -> Result<Option<RepeatSplit>, Error> {
     let strata = cache.dataset().strata();
     let repeats = Stratum::most_repeats(&strata);
-    if repeats < 2 {
+    if repeats < 2 || !run.plan.repeat_split {
         return Ok(None);
     }
     let grouped = Splits::make_grouped(&strata, run.seed);

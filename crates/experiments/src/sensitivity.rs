@@ -176,14 +176,15 @@ pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError
 }
 
 /// The plan every point runs: the scale's, with the paper's three representations only, no
-/// noise study, no label-noise ablation and no other simulation seeds (each point is one
-/// Experiment 1).
+/// noise study, no label-noise ablation, no other simulation seeds and no repeats-together
+/// split (each point is one Experiment 1).
 pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
     crate::plan::Plan {
         fusions: false,
         noise_levels: Vec::new(),
         label_noise_deg: None,
         datasets: 1,
+        repeat_split: false,
         ..crate::plan::Plan::for_scale(scale)
     }
 }

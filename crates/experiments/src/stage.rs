@@ -261,7 +261,7 @@ impl CostModel {
             * (c(Stage::DatasetSeedSimulating, counts.exp1)
                 + c(Stage::Features(FeatureSet::DatasetSeed), counts.exp1)
                 + c(Stage::DatasetSeedTraining, reprs * plan.seeds));
-        if counts.exp1_repeated {
+        if counts.exp1_repeated && plan.repeat_split {
             sum += c(
                 Stage::RepeatSplitTraining,
                 ReprKind::PAPER.len() * plan.seeds,
@@ -319,6 +319,19 @@ mod tests {
         );
         let grouped = model.seconds(Stage::RepeatSplitTraining, (3 * plan.seeds) as u64);
         assert!((repeated.total_seconds() - model.total_seconds() - grouped).abs() < 1e-9);
+        // ... unless the plan leaves the study out (`--no-repeat-split`).
+        let unsplit = Plan {
+            repeat_split: false,
+            ..plan.clone()
+        };
+        let left_out = CostModel::new(
+            &unsplit,
+            TrialCounts {
+                exp1_repeated: true,
+                ..counts
+            },
+        );
+        assert!((left_out.total_seconds() - model.total_seconds()).abs() < 1e-9);
         assert!(with_exp2.total_seconds() > model.total_seconds());
         assert_eq!(model.seconds(Stage::Exp2Training, 0), 0.0);
         let quiet = Plan {

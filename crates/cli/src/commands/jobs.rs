@@ -154,6 +154,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if let Some(n) = j.repeats {
                 args.extend(["--repeats".into(), n.to_string()]);
             }
+            if !j.repeat_split {
+                args.push("--no-repeat-split".into());
+            }
         }
         Job::SensitivityPoint(j) => {
             args.push("sensitivity".into());

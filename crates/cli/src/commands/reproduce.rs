@@ -43,8 +43,9 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', num_args = 0.., value_parser = noise_level)]
     pub noise_levels: Option<Vec<NoiseLevel>>,
     /// Leave out evtac's learned fusions (stacked, late): train and report the paper's three
-    /// representations only. With `--noise-levels` given empty and `--label-noise-deg 0`, this
-    /// is the paper's own plan (195 training runs at `--scale paper` instead of 405).
+    /// representations only. With `--noise-levels` given empty, `--label-noise-deg 0` and
+    /// `--no-repeat-split`, this is the paper's own plan (195 training runs at `--scale paper`
+    /// instead of 435).
     #[arg(long)]
     pub no_fusions: bool,
     /// Standard deviation (degrees) of the noise the label-noise ablation adds to Experiment
@@ -65,6 +66,11 @@ pub struct Args {
     /// 1 trained again with each condition's repeats kept on one side.
     #[arg(long, value_name = "N", value_parser = parse_repeats)]
     pub repeats: Option<usize>,
+    /// Leave out Experiment 1 trained again with each condition's repeats kept on one side of
+    /// the split (30 training runs at `--scale paper`, which has two repeats; nothing at one
+    /// repeat, where the study does not run).
+    #[arg(long)]
+    pub no_repeat_split: bool,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -126,6 +132,7 @@ impl Args {
             label_noise_deg: job.label_noise_deg,
             datasets: job.datasets.map(|n| n as u64),
             repeats: job.repeats,
+            no_repeat_split: !job.repeat_split,
             noise_levels: job
                 .noise_levels
                 .as_ref()
@@ -344,6 +351,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         label_noise_deg: args.label_noise_deg,
         datasets: args.datasets.map(|n| n as usize),
         repeats: args.repeats,
+        repeat_split: !args.no_repeat_split,
     };
     let (slurm, task) = (
         crate::cluster::slurm(args.slurm_args.as_deref()),
@@ -373,6 +381,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         plan.noise_levels = levels.clone();
     }
     plan.fusions = !args.no_fusions;
+    plan.repeat_split = !args.no_repeat_split;
     if let Some(sd) = args.label_noise_deg {
         anyhow::ensure!(
             sd.is_finite() && sd >= 0.0,
