@@ -64,7 +64,7 @@ pub struct Parameter {
 /// and timeline, the camera's resolution), the rig's specification (the IRB 120's
 /// repeatability), or only shape the image without a physical meaning of their own
 /// (brightness, vignetting; the pins' count and size are varied instead).
-pub const PARAMETERS: [Parameter; 17] = [
+pub const PARAMETERS: [Parameter; 19] = [
     Parameter {
         name: "pin_rings",
         what: "rings of pins (pin spacing: more rings, closer pins)",
@@ -149,6 +149,20 @@ pub const PARAMETERS: [Parameter; 17] = [
         name: "imu_noise",
         what: "IMU's gyroscope and accelerometer white noise",
         fields: &["imu.gyro_noise_deg_s", "imu.accel_noise_g"],
+    },
+    Parameter {
+        name: "rig_calibration",
+        what: "rig: the rolling centre's and the contact patch's offsets (tool-centre calibration)",
+        fields: &["rig.rolling_centre_sd_mm", "rig.patch_offset_sd_mm"],
+    },
+    Parameter {
+        name: "seating",
+        what: "rig: the sensor's turn, tilt and reach each time it is seated in its mount",
+        fields: &[
+            "rig.reseat_rotation_sd_deg",
+            "rig.reseat_tilt_sd_deg",
+            "rig.reseat_height_sd_mm",
+        ],
     },
 ];
 
@@ -433,7 +447,7 @@ pub const POINT_FILE: &str = "point.json";
 /// trials by speed and by depth, the conclusions. `dir` is the point's folder. A finished point
 /// is read back from its [`POINT_FILE`], beside a copy of its dataset's `simulator.json`; unless
 /// `keep_data`, finishing a point removes its dataset and feature cache (about 1.1 GB at small
-/// scale, of which its models need none), so that a study of 35 points needs the disk of one
+/// scale, of which its models need none), so that a study of 39 points needs the disk of one
 /// dataset at a time.
 pub fn point(
     (parameter, factor): (&str, f64),

@@ -22,7 +22,7 @@ use std::time::Instant;
 #[command(
     after_help = "The parameters and what each is: OUT/README.md, or the error a name \
     that is none of them gets.\n\nExample: evtac sensitivity --scale small --out sensitivity \
-    (35 points, about 80 minutes on 2 cores)"
+    (39 points, about 90 minutes on 2 cores)"
 )]
 pub struct Args {
     /// Size of each point's dataset and plan: tiny (tests), small or paper.
@@ -35,7 +35,7 @@ pub struct Args {
     /// `point.json`, `simulator.json` and models; its dataset too with --keep-data).
     #[arg(long)]
     pub out: PathBuf,
-    /// Parameters to vary, comma-separated (default: all 17).
+    /// Parameters to vary, comma-separated (default: all 19).
     #[arg(long, value_delimiter = ',')]
     pub parameters: Option<Vec<String>>,
     /// Factors on each parameter's default, comma-separated.
