@@ -187,11 +187,26 @@ pub(crate) fn update(
         // SAFETY: the CPU has AVX-512F (checked) and the four slices hold `n >= done` floats.
         unsafe { avx512::update(s, param, grad, m, v, done) };
     }
-    for (((p, &g), m), v) in param[done..]
+    update_portable(
+        s,
+        &mut param[done..],
+        &grad[done..],
+        &mut m[done..],
+        &mut v[done..],
+    );
+}
+
+/// [`update_one`] over whole slices, compiled for AVX2 besides the baseline: the same exact
+/// square root and division eight elements per instruction (correctly rounded either way, so
+/// the same bits as one element at a time). On the baseline alone, this pass was 20 % of a
+/// dense training run on an AVX2-only CPU (AMD Zen 3), four elements per instruction.
+#[multiversion::multiversion(targets("x86_64+avx2+fma"))]
+fn update_portable(s: &StepScalars, param: &mut [f32], grad: &[f32], m: &mut [f32], v: &mut [f32]) {
+    for (((p, &g), m), v) in param
         .iter_mut()
-        .zip(&grad[done..])
-        .zip(m[done..].iter_mut())
-        .zip(v[done..].iter_mut())
+        .zip(grad)
+        .zip(m.iter_mut())
+        .zip(v.iter_mut())
     {
         update_one(s, p, g, m, v);
     }
@@ -350,6 +365,35 @@ mod tests {
                 prop_assert!(
                     close(p[k], want_p, scale, 8.0),
                     "element {k}: {} against PyTorch's {want_p}", p[k]
+                );
+            }
+        }
+
+        /// The portable pass, vectorised or not, gives each element the bits [`update_one`]
+        /// gives it alone.
+        #[test]
+        fn the_portable_pass_is_update_one_per_element(
+            step in 1_u64..20_000,
+            values in proptest::collection::vec(
+                (-1.0_f32..1.0, -10.0_f32..10.0, -1.0_f32..1.0, 0.0_f32..10.0),
+                0..80,
+            ),
+        ) {
+            let mut optimizer = AdamW::new(AdamWConfig::default());
+            optimizer.step = step - 1;
+            let s = optimizer.begin_step();
+            let mut p: Vec<f32> = values.iter().map(|t| t.0).collect();
+            let g: Vec<f32> = values.iter().map(|t| t.1).collect();
+            let mut m: Vec<f32> = values.iter().map(|t| t.2).collect();
+            let mut v: Vec<f32> = values.iter().map(|t| t.3).collect();
+            let mut want = values.clone();
+            update_portable(&s, &mut p, &g, &mut m, &mut v);
+            for (k, (pk, gk, mk, vk)) in want.iter_mut().enumerate() {
+                update_one(&s, pk, *gk, mk, vk);
+                prop_assert_eq!(
+                    (p[k].to_bits(), m[k].to_bits(), v[k].to_bits()),
+                    (pk.to_bits(), mk.to_bits(), vk.to_bits()),
+                    "element {}", k
                 );
             }
         }

@@ -14,15 +14,15 @@
 //!   built once per step) and handed straight to AdamW, so the 900 x 256 gradient is never
 //!   stored and rows no sample reached take the zero-gradient update; a dense batch's is
 //!   formed four input rows at a time from its dense rows instead ([`crate::gradient_tile`],
-//!   AVX-512F);
+//!   on x86-64);
 //! - the other layers skip the zeros of the ReLU outputs forward and backward.
 //!
 //! The arithmetic is PyTorch's up to rounding (the order of additions, fused multiply-adds,
 //! AdamW's refined estimates: [`crate::adamw`]); tested against burn's autodiff gradients
 //! below, against PyTorch's losses step by step in `tests/pytorch.rs` and against whole
 //! PyTorch runs in `tests/converges.rs`. It is deterministic: a given binary on a given CPU
-//! takes the same path for the same batch and gives the same bits (CPUs without AVX-512F round
-//! some steps differently).
+//! takes the same path for the same batch and gives the same bits (x86-64 CPUs without
+//! AVX-512F round AdamW's step differently, and other architectures a dense batch's gradient).
 
 use crate::adamw::{self, AdamW, StepScalars};
 use crate::model::{
@@ -347,12 +347,12 @@ pub(crate) fn step(
     loss * norm
 }
 
-/// Whether a dense batch of `inputs` features takes [`crate::gradient_tile`] (AVX-512F, and
-/// whole tiles of input rows).
+/// Whether a dense batch of `inputs` features takes [`crate::gradient_tile`] (x86-64, and whole
+/// tiles of input rows).
 fn tiled_gradient_runs(inputs: usize) -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        inputs.is_multiple_of(crate::gradient_tile::ROWS) && crate::gradient_tile::available()
+        inputs.is_multiple_of(crate::gradient_tile::ROWS)
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -418,7 +418,7 @@ fn first_layer_tiles(
     m: &mut [f32],
     v: &mut [f32],
 ) {
-    use crate::gradient_tile::{ROWS, tile};
+    use crate::gradient_tile::{ROWS, gradient};
     let fan_in = layer.fan_in;
     let mut g = [0.0_f32; ROWS * BLOCK];
     for b in 0..weights.len() / (fan_in * BLOCK) {
@@ -428,8 +428,7 @@ fn first_layer_tiles(
             if !layer.architecture.connects(b * BLOCK, first) {
                 continue;
             }
-            // SAFETY: the caller checked AVX-512F (`tiled_gradient_runs`).
-            unsafe { tile((x, fan_in), first, (&d1[b * BLOCK..], H1), &mut g) };
+            gradient((x, fan_in), first, (&d1[b * BLOCK..], H1), &mut g);
             let rows = (b * fan_in + first) * BLOCK..(b * fan_in + first + ROWS) * BLOCK;
             let (p, m, v) = (
                 &mut weights[rows.clone()],

@@ -11,13 +11,13 @@
 //! separate multiplies and adds (no FMA; training's grouped first layer is the one exception,
 //! fused on every target). The kernels are compiled for AVX-512 and AVX2 besides the baseline
 //! and picked at run time, and all three give bit-identical results: a model evaluated on one
-//! x86-64 machine gives the same outputs as on any other. (Training adds AdamW and the dense
-//! gradient tile, which round differently where the CPU lacks AVX-512F: a model is the same
-//! bytes on every CPU of one kind, so a cluster whose nodes differ in it trains different
-//! last bits. See [`crate::adamw`].) Where a kernel serves several samples at once (the
-//! grouped forward, the input gradient) its AVX-512 form is written by hand in
-//! [`crate::grouped_tile`], with the same operations in the same order, because LLVM keeps the
-//! portable form's register tile in memory.
+//! x86-64 machine gives the same outputs as on any other. (Training adds AdamW, which rounds
+//! differently where the CPU lacks AVX-512F: a model is the same bytes on every CPU of one
+//! kind, so a cluster whose nodes differ in it trains different last bits. See
+//! [`crate::adamw`].) Where a kernel serves several samples at once (the grouped forward, the
+//! input gradient) its AVX-512 form is written by hand in [`crate::grouped_tile`], with the
+//! same operations in the same order, because LLVM keeps the portable form's register tile in
+//! memory; the portable form sweeps a block a chunk of outputs at a time for the same reason.
 
 use std::ops::Range;
 
@@ -283,7 +283,22 @@ fn tile_blocks<const FUSED: bool>(
     }
 }
 
-/// [`grouped_forward`] in portable code (any group size, any CPU).
+/// Outputs of a block that [`grouped_forward_portable`] accumulates at once: the group's
+/// tile of `GROUP x CHUNK` sums is 8 AVX2 (or 4 AVX-512) registers. A whole block's tile
+/// (`GROUP x BLOCK`, 32 AVX2 registers) does not fit the 16 that AVX2 has, and LLVM then keeps
+/// it on the stack, loading and storing every sum at every input: perf on the paper's static
+/// tuning on an AVX2-only CPU (AMD Zen 3) put 35 % of a dense run there.
+const CHUNK: usize = 16;
+
+/// Inputs whose group values [`grouped_forward_portable`] gathers at a time (on the stack):
+/// the gathering, and the test of whether every sample has an input at zero, then run once
+/// per input instead of once per chunk of outputs.
+const SPAN: usize = 256;
+
+/// [`grouped_forward`] in portable code (any group size, any CPU). Each output's sum is the
+/// same fused multiply-adds in the same input order as [`crate::grouped_tile::tile`]'s, so
+/// the same bits: the inputs are taken [`SPAN`] at a time, the outputs a [`CHUNK`] at a time
+/// (so that the sums stay in registers), and a chunk's sums wait in `out` between spans.
 #[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
 pub(crate) fn grouped_forward_portable(
     weights: &[f32],
@@ -295,32 +310,44 @@ pub(crate) fn grouped_forward_portable(
 ) {
     let fan_out = bias.len();
     let fan_in = x.len() / rows;
-    let blocks = units.start / BLOCK..units.end / BLOCK;
-    for (b, panel) in weights.chunks_exact(fan_in * BLOCK).enumerate() {
-        if !blocks.contains(&b) {
-            continue;
-        }
-        let mut acc = [[0.0_f32; BLOCK]; GROUP];
-        for a in acc.iter_mut() {
-            a.copy_from_slice(&bias[b * BLOCK..][..BLOCK]);
-        }
-        let panel_rows = panel.chunks_exact(BLOCK).enumerate();
-        for (i, row) in panel_rows.skip(inputs.start).take(inputs.len()) {
+    for sample in out[..rows * fan_out].chunks_exact_mut(fan_out) {
+        sample[units.clone()].copy_from_slice(&bias[units.clone()]);
+    }
+    let mut active = [0_usize; SPAN];
+    let mut values = [[0.0_f32; GROUP]; SPAN];
+    for start in inputs.clone().step_by(SPAN) {
+        // The span's inputs that some sample of the group has non-zero, with their values.
+        let mut n = 0;
+        for i in start..(start + SPAN).min(inputs.end) {
             let mut xs = [0.0_f32; GROUP];
             for (k, v) in xs.iter_mut().enumerate().take(rows) {
                 *v = x[k * fan_in + i];
             }
-            if xs.iter().all(|&v| v == 0.0) {
-                continue;
-            }
-            for (a, &xk) in acc.iter_mut().zip(&xs) {
-                for (a, &w) in a.iter_mut().zip(row) {
-                    *a = xk.mul_add(w, *a);
-                }
+            if xs.iter().any(|&v| v != 0.0) {
+                (active[n], values[n]) = (i, xs);
+                n += 1;
             }
         }
-        for (k, a) in acc.iter().enumerate().take(rows) {
-            out[k * fan_out + b * BLOCK..][..BLOCK].copy_from_slice(a);
+        for b in units.start / BLOCK..units.end / BLOCK {
+            let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];
+            for first in (b * BLOCK..(b + 1) * BLOCK).step_by(CHUNK) {
+                let within = first - b * BLOCK;
+                let mut acc = [[0.0_f32; CHUNK]; GROUP];
+                for (k, a) in acc.iter_mut().enumerate().take(rows) {
+                    a.copy_from_slice(&out[k * fan_out + first..][..CHUNK]);
+                }
+                for (&i, xs) in active[..n].iter().zip(&values[..n]) {
+                    let row = &panel[i * BLOCK + within..][..CHUNK];
+                    for (a, &xk) in acc.iter_mut().zip(xs) {
+                        for (a, &w) in a.iter_mut().zip(row) {
+                            *a = xk.mul_add(w, *a);
+                        }
+                    }
+                }
+                for (k, a) in acc.iter().enumerate().take(rows) {
+                    out[k * fan_out + first..][..CHUNK].copy_from_slice(a);
+                }
+            }
         }
     }
     if relu {
@@ -447,6 +474,65 @@ mod tests {
             assert_eq!(layer.to_pytorch(), (weight.clone(), bias));
             // Row i of the transposed weight is input i's contributions, output by output.
             assert_eq!(layer.weights[position(fan_in, fan_out, 1, 0)], weight[1]);
+        }
+    }
+
+    /// The grouped kernel, swept a chunk of outputs at a time, is each output's fused
+    /// multiply-adds in input order (inputs every sample of the group has at zero skipped),
+    /// bit for bit, for every group size and for late fusion's input and unit ranges, over
+    /// inputs that take several spans.
+    #[test]
+    fn the_grouped_kernel_is_fused_sums_in_input_order() {
+        let (fan_in, fan_out) = (2 * SPAN + 88, 128);
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        };
+        let weight: Vec<f32> = (0..fan_in * fan_out).map(|_| next()).collect();
+        let bias: Vec<f32> = (0..fan_out).map(|_| next()).collect();
+        let layer = Dense::from_pytorch(&weight, &bias, fan_in, fan_out);
+        // Inputs 3 and 300 are zero in every sample, input 5 in all but the last.
+        let x: Vec<f32> = (0..GROUP * fan_in)
+            .map(|k| match (k / fan_in, k % fan_in) {
+                (_, 3 | 300) => 0.0,
+                (s, 5) if s + 1 < GROUP => 0.0,
+                _ => next(),
+            })
+            .collect();
+        for rows in 1..=GROUP {
+            for (units, inputs) in [(0..fan_out, 0..fan_in), (64..128, 200..530)] {
+                let mut got = vec![f32::NAN; rows * fan_out];
+                let shape = (units.clone(), inputs.clone());
+                let x = &x[..rows * fan_in];
+                grouped_forward_portable(
+                    &layer.weights,
+                    &layer.bias,
+                    (x, rows),
+                    &mut got,
+                    shape,
+                    false,
+                );
+                for s in 0..rows {
+                    for o in units.clone() {
+                        let mut want = bias[o];
+                        for i in inputs.clone() {
+                            if (0..rows).all(|t| x[t * fan_in + i] == 0.0) {
+                                continue;
+                            }
+                            want = x[s * fan_in + i].mul_add(weight[o * fan_in + i], want);
+                        }
+                        let got = got[s * fan_out + o];
+                        assert_eq!(
+                            got.to_bits(),
+                            want.to_bits(),
+                            "rows {rows}, sample {s}, output {o}"
+                        );
+                    }
+                }
+            }
         }
     }
 
