@@ -32,6 +32,9 @@ use rand_chacha::ChaCha8Rng;
 /// Samples in the benchmark epoch (the paper's Experiment 1 training set is about this size).
 const SAMPLES: usize = 35_000;
 
+/// Validation samples an epoch predicts (the paper-sized Experiment 1's validation set).
+const VALIDATION: usize = 7_500;
+
 /// Fractions of non-zero features, measured on the pooled features of a simulated Experiment 1
 /// trial (`evtac simulate --protocol exp1 --scale tiny --seed 0`, trial t0000, every 2 ms of the
 /// motion, default settings): static 0.138; dynamic and combined 0.752 (a 640 ms window at
@@ -106,6 +109,15 @@ fn bench(c: &mut Criterion) {
                 (trainer, Shuffler::new(data.len(), seed))
             })
             .collect();
+        // Validation's forward pass over an epoch's 7,500 validation samples (the paper-sized
+        // Experiment 1's), the first layer a group of samples at a time.
+        let (mut validation, mut validation_labels) = (Vec::new(), Vec::new());
+        let rows: Vec<usize> = (0..VALIDATION).collect();
+        data.gather(&rows, &mut validation, &mut validation_labels);
+        group.bench_function("validation_7500", |b| {
+            b.iter(|| black_box(trainer.predict(&validation).expect("predict")))
+        });
+
         group.bench_function("two_runs_on_two_threads", |b| {
             b.iter(|| {
                 std::thread::scope(|scope| {

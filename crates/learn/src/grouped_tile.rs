@@ -130,7 +130,14 @@ pub(crate) mod tests {
                 let mut want = vec![0.0; GROUP * fan_out];
                 let units = 0..fan_out;
                 let shape = (units.clone(), inputs.clone());
-                grouped_forward_portable(&weights, &bias, (&x, GROUP), &mut want, shape, false);
+                grouped_forward_portable(
+                    &weights,
+                    &bias,
+                    (&x, GROUP),
+                    &mut want,
+                    shape,
+                    (false, true),
+                );
                 for b in 0..fan_out / BLOCK {
                     let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];
                     let bias = &bias[b * BLOCK..][..BLOCK];

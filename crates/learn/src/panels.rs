@@ -157,26 +157,30 @@ pub(crate) fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut 
 }
 
 /// [`dense_forward`] with ReLU of every row of `x` (`n x fan_in`) into `out` (`n x fan_out`),
-/// the same bits as one row at a time. Where the CPU has AVX-512F, a paneled layer takes
-/// [`GROUP`] rows at a time on [`crate::grouped_tile`] without fused multiply-adds if they are
-/// dense enough (as training's forward pass decides, [`GROUPED_DENSITY`]): it reads
-/// each weight row once for the group, and where one sample has a zero that another has not it
-/// adds `0 * w`, which can only turn a `-0.0` sum into `+0.0`, a difference the ReLU erases.
+/// the same bits as one row at a time. A paneled layer takes [`GROUP`] rows at a time without
+/// fused multiply-adds if they are dense enough (as training's forward pass decides,
+/// [`GROUPED_DENSITY`]), on [`crate::grouped_tile`] where the CPU has AVX-512F and on
+/// [`grouped_forward_portable`] elsewhere: it reads each weight row once for the group (one
+/// sample at a time, the 900 x 256 weights stream from beyond L2 for every sample), and where
+/// one sample has a zero that another has not it adds `0 * w`, which can only turn a `-0.0` sum
+/// into `+0.0`, a difference the ReLU erases.
 pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
     let (fan_in, fan_out) = (layer.fan_in, layer.fan_out);
     let groups = x
         .chunks(GROUP * fan_in)
         .zip(out.chunks_mut(GROUP * fan_out));
     for (x, out) in groups {
-        #[cfg(target_arch = "x86_64")]
-        if x.len() == GROUP * fan_in
-            && fan_out.is_multiple_of(BLOCK)
-            && dense_enough(x)
-            && crate::grouped_tile::available()
-        {
-            let layer_weights = (&layer.weights[..], &layer.bias[..]);
-            tile_blocks::<false>(layer_weights, x, out, 0..fan_out, 0..fan_in);
-            relu_units(out, fan_out, 0..fan_out);
+        if x.len() == GROUP * fan_in && fan_out.is_multiple_of(BLOCK) && dense_enough(x) {
+            #[cfg(target_arch = "x86_64")]
+            if crate::grouped_tile::available() {
+                let layer_weights = (&layer.weights[..], &layer.bias[..]);
+                tile_blocks::<false>(layer_weights, x, out, 0..fan_out, 0..fan_in);
+                relu_units(out, fan_out, 0..fan_out);
+                continue;
+            }
+            let (weights, bias) = (&layer.weights[..], &layer.bias[..]);
+            let shape = (0..fan_out, 0..fan_in);
+            grouped_forward_portable(weights, bias, (x, GROUP), out, shape, (true, false));
             continue;
         }
         for (x, out) in x.chunks_exact(fan_in).zip(out.chunks_exact_mut(fan_out)) {
@@ -256,7 +260,7 @@ pub(crate) fn grouped_forward(
         }
         return;
     }
-    grouped_forward_portable(weights, bias, (x, rows), out, (units, inputs), relu);
+    grouped_forward_portable(weights, bias, (x, rows), out, (units, inputs), (relu, true));
 }
 
 /// The outputs `units` (whole blocks) of one whole group of samples (`x`, `GROUP x fan_in`)
@@ -295,10 +299,12 @@ const CHUNK: usize = 16;
 /// per input instead of once per chunk of outputs.
 const SPAN: usize = 256;
 
-/// [`grouped_forward`] in portable code (any group size, any CPU). Each output's sum is the
-/// same fused multiply-adds in the same input order as [`crate::grouped_tile::tile`]'s, so
-/// the same bits: the inputs are taken [`SPAN`] at a time, the outputs a [`CHUNK`] at a time
-/// (so that the sums stay in registers), and a chunk's sums wait in `out` between spans.
+/// [`grouped_forward`] in portable code (any group size, any CPU), with fused multiply-adds when
+/// `fused` (training's forward pass) or a multiply then an add (validation's, as
+/// [`dense_forward`]). Each output's sum is the same operations in the same input order as
+/// [`crate::grouped_tile::tile`]'s, so the same bits: the inputs are taken [`SPAN`] at a time,
+/// the outputs a [`CHUNK`] at a time (so that the sums stay in registers), and a chunk's sums
+/// wait in `out` between spans.
 #[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
 pub(crate) fn grouped_forward_portable(
     weights: &[f32],
@@ -306,7 +312,7 @@ pub(crate) fn grouped_forward_portable(
     (x, rows): (&[f32], usize),
     out: &mut [f32],
     (units, inputs): (Range<usize>, Range<usize>),
-    relu: bool,
+    (relu, fused): (bool, bool),
 ) {
     let fan_out = bias.len();
     let fan_in = x.len() / rows;
@@ -339,8 +345,14 @@ pub(crate) fn grouped_forward_portable(
                 for (&i, xs) in active[..n].iter().zip(&values[..n]) {
                     let row = &panel[i * BLOCK + within..][..CHUNK];
                     for (a, &xk) in acc.iter_mut().zip(xs) {
-                        for (a, &w) in a.iter_mut().zip(row) {
-                            *a = xk.mul_add(w, *a);
+                        if fused {
+                            for (a, &w) in a.iter_mut().zip(row) {
+                                *a = xk.mul_add(w, *a);
+                            }
+                        } else {
+                            for (a, &w) in a.iter_mut().zip(row) {
+                                *a += xk * w;
+                            }
                         }
                     }
                 }
@@ -478,11 +490,11 @@ mod tests {
     }
 
     /// The grouped kernel, swept a chunk of outputs at a time, is each output's fused
-    /// multiply-adds in input order (inputs every sample of the group has at zero skipped),
-    /// bit for bit, for every group size and for late fusion's input and unit ranges, over
-    /// inputs that take several spans.
+    /// multiply-adds (or multiplies then adds) in input order (inputs every sample of the
+    /// group has at zero skipped), bit for bit, for every group size and for late fusion's
+    /// input and unit ranges, over inputs that take several spans.
     #[test]
-    fn the_grouped_kernel_is_fused_sums_in_input_order() {
+    fn the_grouped_kernel_is_the_sums_in_input_order() {
         let (fan_in, fan_out) = (2 * SPAN + 88, 128);
         let mut state = 0x2545_F491_4F6C_DD1D_u64;
         let mut next = move || {
@@ -502,8 +514,9 @@ mod tests {
                 _ => next(),
             })
             .collect();
-        for rows in 1..=GROUP {
-            for (units, inputs) in [(0..fan_out, 0..fan_in), (64..128, 200..530)] {
+        let ranges = [(0..fan_out, 0..fan_in), (64..128, 200..530)];
+        for (rows, fused) in (1..=GROUP).flat_map(|rows| [(rows, true), (rows, false)]) {
+            for (units, inputs) in ranges.clone() {
                 let mut got = vec![f32::NAN; rows * fan_out];
                 let shape = (units.clone(), inputs.clone());
                 let x = &x[..rows * fan_in];
@@ -513,7 +526,7 @@ mod tests {
                     (x, rows),
                     &mut got,
                     shape,
-                    false,
+                    (false, fused),
                 );
                 for s in 0..rows {
                     for o in units.clone() {
@@ -522,13 +535,18 @@ mod tests {
                             if (0..rows).all(|t| x[t * fan_in + i] == 0.0) {
                                 continue;
                             }
-                            want = x[s * fan_in + i].mul_add(weight[o * fan_in + i], want);
+                            let (xi, w) = (x[s * fan_in + i], weight[o * fan_in + i]);
+                            want = if fused {
+                                xi.mul_add(w, want)
+                            } else {
+                                want + xi * w
+                            };
                         }
                         let got = got[s * fan_out + o];
                         assert_eq!(
                             got.to_bits(),
                             want.to_bits(),
-                            "rows {rows}, sample {s}, output {o}"
+                            "rows {rows}, fused {fused}, sample {s}, output {o}"
                         );
                     }
                 }
