@@ -496,6 +496,8 @@ mod tests {
     #[test]
     fn the_grouped_kernel_is_the_sums_in_input_order() {
         let (fan_in, fan_out) = (2 * SPAN + 88, 128);
+        // Its own xorshift rather than `grouped_tile::tests::floats`: that module is x86-64
+        // only, and this kernel runs on every target.
         let mut state = 0x2545_F491_4F6C_DD1D_u64;
         let mut next = move || {
             state ^= state << 13;
