@@ -92,7 +92,7 @@ pub(crate) unsafe fn tile<const FUSED: bool>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::panels::grouped_forward_portable;
+    use crate::panels::{Sums, grouped_forward_portable};
 
     /// A deterministic stream of floats in [-1, 1), a fraction of them zero.
     pub(crate) fn floats(n: usize, seed: u64, zeros: f32) -> Vec<f32> {
@@ -136,7 +136,7 @@ pub(crate) mod tests {
                     (&x, GROUP),
                     &mut want,
                     shape,
-                    (false, true),
+                    (false, Sums::Fused),
                 );
                 for b in 0..fan_out / BLOCK {
                     let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];

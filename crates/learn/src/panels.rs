@@ -180,7 +180,8 @@ pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
             }
             let (weights, bias) = (&layer.weights[..], &layer.bias[..]);
             let shape = (0..fan_out, 0..fan_in);
-            grouped_forward_portable(weights, bias, (x, GROUP), out, shape, (true, false));
+            let sums = Sums::MultiplyThenAdd;
+            grouped_forward_portable(weights, bias, (x, GROUP), out, shape, (true, sums));
             continue;
         }
         for (x, out) in x.chunks_exact(fan_in).zip(out.chunks_exact_mut(fan_out)) {
@@ -260,7 +261,8 @@ pub(crate) fn grouped_forward(
         }
         return;
     }
-    grouped_forward_portable(weights, bias, (x, rows), out, (units, inputs), (relu, true));
+    let shape = (units, inputs);
+    grouped_forward_portable(weights, bias, (x, rows), out, shape, (relu, Sums::Fused));
 }
 
 /// The outputs `units` (whole blocks) of one whole group of samples (`x`, `GROUP x fan_in`)
@@ -299,9 +301,18 @@ const CHUNK: usize = 16;
 /// per input instead of once per chunk of outputs.
 const SPAN: usize = 256;
 
-/// [`grouped_forward`] in portable code (any group size, any CPU), with fused multiply-adds when
-/// `fused` (training's forward pass) or a multiply then an add (validation's, as
-/// [`dense_forward`]). Each output's sum is the same operations in the same input order as
+/// How [`grouped_forward_portable`] adds each product to its sum: the two forward passes round
+/// differently, and each must keep its own bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Sums {
+    /// One fused multiply-add per product (training's forward pass, as [`grouped_forward`]).
+    Fused,
+    /// The product rounded, then added (validation's, as [`dense_forward`] and `predict_one`).
+    MultiplyThenAdd,
+}
+
+/// [`grouped_forward`] in portable code (any group size, any CPU), each product added to its
+/// sum as `sums` says. Each output's sum is the same operations in the same input order as
 /// [`crate::grouped_tile::tile`]'s, so the same bits: the inputs are taken [`SPAN`] at a time,
 /// the outputs a [`CHUNK`] at a time (so that the sums stay in registers), and a chunk's sums
 /// wait in `out` between spans.
@@ -312,7 +323,7 @@ pub(crate) fn grouped_forward_portable(
     (x, rows): (&[f32], usize),
     out: &mut [f32],
     (units, inputs): (Range<usize>, Range<usize>),
-    (relu, fused): (bool, bool),
+    (relu, sums): (bool, Sums),
 ) {
     let fan_out = bias.len();
     let fan_in = x.len() / rows;
@@ -345,13 +356,16 @@ pub(crate) fn grouped_forward_portable(
                 for (&i, xs) in active[..n].iter().zip(&values[..n]) {
                     let row = &panel[i * BLOCK + within..][..CHUNK];
                     for (a, &xk) in acc.iter_mut().zip(xs) {
-                        if fused {
-                            for (a, &w) in a.iter_mut().zip(row) {
-                                *a = xk.mul_add(w, *a);
+                        match sums {
+                            Sums::Fused => {
+                                for (a, &w) in a.iter_mut().zip(row) {
+                                    *a = xk.mul_add(w, *a);
+                                }
                             }
-                        } else {
-                            for (a, &w) in a.iter_mut().zip(row) {
-                                *a += xk * w;
+                            Sums::MultiplyThenAdd => {
+                                for (a, &w) in a.iter_mut().zip(row) {
+                                    *a += xk * w;
+                                }
                             }
                         }
                     }
@@ -517,7 +531,8 @@ mod tests {
             })
             .collect();
         let ranges = [(0..fan_out, 0..fan_in), (64..128, 200..530)];
-        for (rows, fused) in (1..=GROUP).flat_map(|rows| [(rows, true), (rows, false)]) {
+        let modes = [Sums::Fused, Sums::MultiplyThenAdd];
+        for (rows, sums) in (1..=GROUP).flat_map(|rows| modes.map(|sums| (rows, sums))) {
             for (units, inputs) in ranges.clone() {
                 let mut got = vec![f32::NAN; rows * fan_out];
                 let shape = (units.clone(), inputs.clone());
@@ -528,7 +543,7 @@ mod tests {
                     (x, rows),
                     &mut got,
                     shape,
-                    (false, fused),
+                    (false, sums),
                 );
                 for s in 0..rows {
                     for o in units.clone() {
@@ -538,17 +553,16 @@ mod tests {
                                 continue;
                             }
                             let (xi, w) = (x[s * fan_in + i], weight[o * fan_in + i]);
-                            want = if fused {
-                                xi.mul_add(w, want)
-                            } else {
-                                want + xi * w
+                            want = match sums {
+                                Sums::Fused => xi.mul_add(w, want),
+                                Sums::MultiplyThenAdd => want + xi * w,
                             };
                         }
                         let got = got[s * fan_out + o];
                         assert_eq!(
                             got.to_bits(),
                             want.to_bits(),
-                            "rows {rows}, fused {fused}, sample {s}, output {o}"
+                            "rows {rows}, {sums:?}, sample {s}, output {o}"
                         );
                     }
                 }
