@@ -50,9 +50,6 @@ fn the_example_report_is_what_the_code_makes_of_its_results() {
 }
 
 #[test]
-#[ignore = "docs/report-paper predates the IRB 120 simulator and the sensor's seating per pass \
-            (issue 37): its run must be redone, not its words re-rendered, which would describe \
-            a simulator that run did not use"]
 fn the_paper_scale_report_is_what_the_code_makes_of_its_results() {
     check("report-paper");
 }
