@@ -241,11 +241,8 @@ pub(crate) fn step(
     // Each block of the first layer from its inputs only (late fusion: a branch per frame).
     let blocks = net.architecture.first_layer_blocks();
     if dense {
-        for (x, h) in x.chunks(GROUP * inputs).zip(h1.chunks_mut(GROUP * H1)) {
-            let rows = x.len() / inputs;
-            for block in blocks {
-                panels::grouped_forward(&l0.weights, &l0.bias, (x, rows), h, block.clone(), true);
-            }
+        for block in blocks {
+            panels::grouped_forward(&l0.weights, &l0.bias, (x, n), h1, block.clone(), true);
         }
     } else {
         for (s, h) in h1.chunks_exact_mut(H1).enumerate() {

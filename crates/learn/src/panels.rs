@@ -234,16 +234,18 @@ pub(crate) fn sparse_forward(
 /// Samples that share one pass over a paneled layer's weight rows in [`grouped_forward`].
 pub(crate) const GROUP: usize = 4;
 
-/// `out = relu?(bias + x W)` for up to [`GROUP`] samples at once (`x` their dense rows,
-/// `rows` of them): each weight row is read once for the group rather than once per sample,
-/// which is what bounds the first layer when most inputs are non-zero. Rows that every sample
-/// of the group has at zero are skipped; a zero of one sample where another is not adds
+/// `out = relu?(bias + x W)` for a batch of samples (`x` their dense rows, `rows` of them),
+/// [`GROUP`] samples at a time: each weight row is read once for a group rather than once per
+/// sample, which is what bounds the first layer when most inputs are non-zero. Rows that every
+/// sample of a group has at zero are skipped; a zero of one sample where another is not adds
 /// `0 * w`, a zero. Fused multiply-adds, correctly rounded on every target (`f32::mul_add`).
 /// Only the outputs `units` (whole blocks) are computed, from the inputs `inputs` (late
 /// fusion's branches: see [`crate::architecture`]).
 ///
 /// Whole groups run on [`crate::grouped_tile`] where the CPU has AVX-512F (LLVM spills the
-/// portable kernel's accumulators to the stack; the tile keeps them in registers, same bits).
+/// portable kernel's accumulators to the stack; the tile keeps them in registers, same bits);
+/// elsewhere the whole batch goes to [`grouped_forward_portable`], which takes every group
+/// through one [`SPAN`] of inputs before the next.
 pub(crate) fn grouped_forward(
     weights: &[f32],
     bias: &[f32],
@@ -253,11 +255,23 @@ pub(crate) fn grouped_forward(
     relu: bool,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if rows == GROUP && crate::grouped_tile::available() {
-        let fan_out = bias.len();
-        tile_blocks::<true>((weights, bias), x, out, units.clone(), inputs);
-        if relu {
-            relu_units(&mut out[..rows * fan_out], fan_out, units);
+    if crate::grouped_tile::available() {
+        let (fan_in, fan_out) = (x.len() / rows.max(1), bias.len());
+        let groups = x
+            .chunks(GROUP * fan_in)
+            .zip(out.chunks_mut(GROUP * fan_out));
+        for (x, out) in groups {
+            let group = x.len() / fan_in;
+            if group == GROUP {
+                tile_blocks::<true>((weights, bias), x, out, units.clone(), inputs.clone());
+                if relu {
+                    relu_units(out, fan_out, units.clone());
+                }
+            } else {
+                let shape = (units.clone(), inputs.clone());
+                let how = (relu, Sums::Fused);
+                grouped_forward_portable(weights, bias, (x, group), out, shape, how);
+            }
         }
         return;
     }
@@ -296,9 +310,11 @@ fn tile_blocks<const FUSED: bool>(
 /// tuning on an AVX2-only CPU (AMD Zen 3) put 35 % of a dense run there.
 const CHUNK: usize = 16;
 
-/// Inputs whose group values [`grouped_forward_portable`] gathers at a time (on the stack):
-/// the gathering, and the test of whether every sample has an input at zero, then run once
-/// per input instead of once per chunk of outputs.
+/// Inputs that [`grouped_forward_portable`] takes every group of a batch through before the
+/// next: their weight rows (`SPAN x 256` floats of the first layer, 256 KB) stay in a 512 KB L2
+/// while the batch's groups pass, where the whole 900 x 256 layer (921 KB) streamed from L3
+/// once per group. Each group's values of the span are gathered once (on the stack), with the
+/// test of whether every sample has an input at zero, rather than once per chunk of outputs.
 const SPAN: usize = 256;
 
 /// How [`grouped_forward_portable`] adds each product to its sum: the two forward passes round
@@ -311,11 +327,12 @@ pub(crate) enum Sums {
     MultiplyThenAdd,
 }
 
-/// [`grouped_forward`] in portable code (any group size, any CPU), each product added to its
-/// sum as `sums` says. Each output's sum is the same operations in the same input order as
+/// [`grouped_forward`] in portable code (any number of samples, any CPU), each product added to
+/// its sum as `sums` says. Each output's sum is the same operations in the same input order as
 /// [`crate::grouped_tile::tile`]'s, so the same bits: the inputs are taken [`SPAN`] at a time,
-/// the outputs a [`CHUNK`] at a time (so that the sums stay in registers), and a chunk's sums
-/// wait in `out` between spans.
+/// every group of [`GROUP`] samples through a span before the next span, the outputs a
+/// [`CHUNK`] at a time (so that the sums stay in registers), and a chunk's sums wait in `out`
+/// between spans.
 #[multiversion::multiversion(targets("x86_64+avx512f+fma", "x86_64+avx2+fma"))]
 pub(crate) fn grouped_forward_portable(
     weights: &[f32],
@@ -325,6 +342,9 @@ pub(crate) fn grouped_forward_portable(
     (units, inputs): (Range<usize>, Range<usize>),
     (relu, sums): (bool, Sums),
 ) {
+    if rows == 0 {
+        return;
+    }
     let fan_out = bias.len();
     let fan_in = x.len() / rows;
     for sample in out[..rows * fan_out].chunks_exact_mut(fan_out) {
@@ -333,45 +353,50 @@ pub(crate) fn grouped_forward_portable(
     let mut active = [0_usize; SPAN];
     let mut values = [[0.0_f32; GROUP]; SPAN];
     for start in inputs.clone().step_by(SPAN) {
-        // The span's inputs that some sample of the group has non-zero, with their values.
-        let mut n = 0;
-        for i in start..(start + SPAN).min(inputs.end) {
-            let mut xs = [0.0_f32; GROUP];
-            for (k, v) in xs.iter_mut().enumerate().take(rows) {
-                *v = x[k * fan_in + i];
-            }
-            if xs.iter().any(|&v| v != 0.0) {
-                (active[n], values[n]) = (i, xs);
-                n += 1;
-            }
-        }
-        for b in units.start / BLOCK..units.end / BLOCK {
-            let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];
-            for first in (b * BLOCK..(b + 1) * BLOCK).step_by(CHUNK) {
-                let within = first - b * BLOCK;
-                let mut acc = [[0.0_f32; CHUNK]; GROUP];
-                for (k, a) in acc.iter_mut().enumerate().take(rows) {
-                    a.copy_from_slice(&out[k * fan_out + first..][..CHUNK]);
+        for first_row in (0..rows).step_by(GROUP) {
+            let group = (rows - first_row).min(GROUP);
+            let x = &x[first_row * fan_in..][..group * fan_in];
+            let out = &mut out[first_row * fan_out..][..group * fan_out];
+            // The span's inputs that some sample of the group has non-zero, with their values.
+            let mut n = 0;
+            for i in start..(start + SPAN).min(inputs.end) {
+                let mut xs = [0.0_f32; GROUP];
+                for (k, v) in xs.iter_mut().enumerate().take(group) {
+                    *v = x[k * fan_in + i];
                 }
-                for (&i, xs) in active[..n].iter().zip(&values[..n]) {
-                    let row = &panel[i * BLOCK + within..][..CHUNK];
-                    for (a, &xk) in acc.iter_mut().zip(xs) {
-                        match sums {
-                            Sums::Fused => {
-                                for (a, &w) in a.iter_mut().zip(row) {
-                                    *a = xk.mul_add(w, *a);
+                if xs.iter().any(|&v| v != 0.0) {
+                    (active[n], values[n]) = (i, xs);
+                    n += 1;
+                }
+            }
+            for b in units.start / BLOCK..units.end / BLOCK {
+                let panel = &weights[b * fan_in * BLOCK..][..fan_in * BLOCK];
+                for first in (b * BLOCK..(b + 1) * BLOCK).step_by(CHUNK) {
+                    let within = first - b * BLOCK;
+                    let mut acc = [[0.0_f32; CHUNK]; GROUP];
+                    for (k, a) in acc.iter_mut().enumerate().take(group) {
+                        a.copy_from_slice(&out[k * fan_out + first..][..CHUNK]);
+                    }
+                    for (&i, xs) in active[..n].iter().zip(&values[..n]) {
+                        let row = &panel[i * BLOCK + within..][..CHUNK];
+                        for (a, &xk) in acc.iter_mut().zip(xs) {
+                            match sums {
+                                Sums::Fused => {
+                                    for (a, &w) in a.iter_mut().zip(row) {
+                                        *a = xk.mul_add(w, *a);
+                                    }
                                 }
-                            }
-                            Sums::MultiplyThenAdd => {
-                                for (a, &w) in a.iter_mut().zip(row) {
-                                    *a += xk * w;
+                                Sums::MultiplyThenAdd => {
+                                    for (a, &w) in a.iter_mut().zip(row) {
+                                        *a += xk * w;
+                                    }
                                 }
                             }
                         }
                     }
-                }
-                for (k, a) in acc.iter().enumerate().take(rows) {
-                    out[k * fan_out + first..][..CHUNK].copy_from_slice(a);
+                    for (k, a) in acc.iter().enumerate().take(group) {
+                        out[k * fan_out + first..][..CHUNK].copy_from_slice(a);
+                    }
                 }
             }
         }
@@ -505,8 +530,8 @@ mod tests {
 
     /// The grouped kernel, swept a chunk of outputs at a time, is each output's fused
     /// multiply-adds (or multiplies then adds) in input order (inputs every sample of the
-    /// group has at zero skipped), bit for bit, for every group size and for late fusion's
-    /// input and unit ranges, over inputs that take several spans.
+    /// sample's group has at zero skipped), bit for bit, for every batch size up to three groups
+    /// and for late fusion's input and unit ranges, over inputs that take several spans.
     #[test]
     fn the_grouped_kernel_is_the_sums_in_input_order() {
         let (fan_in, fan_out) = (2 * SPAN + 88, 128);
@@ -522,17 +547,19 @@ mod tests {
         let weight: Vec<f32> = (0..fan_in * fan_out).map(|_| next()).collect();
         let bias: Vec<f32> = (0..fan_out).map(|_| next()).collect();
         let layer = Dense::from_pytorch(&weight, &bias, fan_in, fan_out);
-        // Inputs 3 and 300 are zero in every sample, input 5 in all but the last.
-        let x: Vec<f32> = (0..GROUP * fan_in)
+        // Inputs 3 and 300 are zero in every sample, input 5 in all but the last of the first
+        // group, input 7 in every sample after the first group.
+        let x: Vec<f32> = (0..3 * GROUP * fan_in)
             .map(|k| match (k / fan_in, k % fan_in) {
                 (_, 3 | 300) => 0.0,
                 (s, 5) if s + 1 < GROUP => 0.0,
+                (s, 7) if s >= GROUP => 0.0,
                 _ => next(),
             })
             .collect();
         let ranges = [(0..fan_out, 0..fan_in), (64..128, 200..530)];
         let modes = [Sums::Fused, Sums::MultiplyThenAdd];
-        for (rows, sums) in (1..=GROUP).flat_map(|rows| modes.map(|sums| (rows, sums))) {
+        for (rows, sums) in (1..=3 * GROUP).flat_map(|rows| modes.map(|sums| (rows, sums))) {
             for (units, inputs) in ranges.clone() {
                 let mut got = vec![f32::NAN; rows * fan_out];
                 let shape = (units.clone(), inputs.clone());
@@ -546,10 +573,11 @@ mod tests {
                     (false, sums),
                 );
                 for s in 0..rows {
+                    let group = s / GROUP * GROUP..(s / GROUP * GROUP + GROUP).min(rows);
                     for o in units.clone() {
                         let mut want = bias[o];
                         for i in inputs.clone() {
-                            if (0..rows).all(|t| x[t * fan_in + i] == 0.0) {
+                            if group.clone().all(|t| x[t * fan_in + i] == 0.0) {
                                 continue;
                             }
                             let (xi, w) = (x[s * fan_in + i], weight[o * fan_in + i]);
