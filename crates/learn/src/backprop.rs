@@ -647,6 +647,7 @@ mod tests {
             (mlp, 8, 12, 0.1),
             (stacked, 9, 13, 0.5),
             (late, 10, 14, 0.75),
+            (late, 6, 15, 0.1),
         ] {
             let params = Parameters::init_for(architecture, seed);
             let net = Network::new(&params);
