@@ -284,9 +284,12 @@ pub(crate) fn grouped_forward(
     (units, inputs): (Range<usize>, Range<usize>),
     relu: bool,
 ) {
+    if rows == 0 {
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     if crate::grouped_tile::available() {
-        let (fan_in, fan_out) = (x.len() / rows.max(1), bias.len());
+        let (fan_in, fan_out) = (x.len() / rows, bias.len());
         let groups = x
             .chunks(GROUP * fan_in)
             .zip(out.chunks_mut(GROUP * fan_out));
