@@ -21,7 +21,7 @@
 
 use std::ops::Range;
 
-use crate::model::{LAYER_SIZES, LAYERS, OUTPUTS};
+use crate::model::{LAYER_SIZES, LAYERS, MAX_INPUTS, OUTPUTS};
 
 /// Above this fraction of non-zero features in a batch, the first layer's forward pass reads
 /// each weight row once for a group of samples ([`grouped_forward`]) instead of once
@@ -167,6 +167,9 @@ pub(crate) fn dense_forward(weights: &[f32], bias: &[f32], x: &[f32], out: &mut 
 /// through their non-zeros ([`sparse_relu_forward`]).
 pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
     let (fan_in, fan_out) = (layer.fan_in, layer.fan_out);
+    // Rows that are not grouped: through their non-zeros where the layer is paneled and its
+    // inputs fit [`sparse_relu_forward`]'s buffers.
+    let through_non_zeros = fan_out.is_multiple_of(BLOCK) && fan_in <= MAX_INPUTS;
     let groups = x
         .chunks(GROUP * fan_in)
         .zip(out.chunks_mut(GROUP * fan_out));
@@ -186,7 +189,7 @@ pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
             continue;
         }
         for (x, out) in x.chunks_exact(fan_in).zip(out.chunks_exact_mut(fan_out)) {
-            if fan_out.is_multiple_of(BLOCK) && fan_in <= MAX_SPARSE_INPUTS {
+            if through_non_zeros {
                 sparse_relu_forward(layer, x, out);
             } else {
                 layer.forward(x, out, true);
@@ -195,22 +198,20 @@ pub(crate) fn relu_forward_batch(layer: &Dense, x: &[f32], out: &mut [f32]) {
     }
 }
 
-/// The most inputs [`sparse_relu_forward`] gathers on the stack: two pooled frames.
-const MAX_SPARSE_INPUTS: usize = crate::model::MAX_INPUTS;
-
 /// [`dense_forward`] with ReLU of one sample of a paneled layer, through its non-zero entries
 /// ([`sparse_forward`]: the same products in the same order, so the same bits). Why: on sparse
 /// features [`dense_forward`] tests every input of every block, and at 14 % non-zero (the
 /// static representation) the branch mispredicts about one input in seven; gathered once, the
 /// non-zeros serve all blocks. This is validation's path for sparse groups, 13 % of a sparse
-/// training run on an AVX2-only CPU (AMD Zen 3).
+/// training run on an AVX2-only CPU (AMD Zen 3). At most [`MAX_INPUTS`] inputs (two pooled
+/// frames), gathered on the stack.
 fn sparse_relu_forward(layer: &Dense, x: &[f32], out: &mut [f32]) {
-    let mut index = [0_u16; MAX_SPARSE_INPUTS];
-    let mut value = [0.0_f32; MAX_SPARSE_INPUTS];
+    let mut index = [0_u16; MAX_INPUTS];
+    let mut value = [0.0_f32; MAX_INPUTS];
     // Branch-free compaction: every value is written, the cursor advances past non-zeros only.
     let mut n = 0;
     for (i, &v) in x.iter().enumerate() {
-        // `fan_in <= MAX_SPARSE_INPUTS` (1800) fits in u16; `n <= i`.
+        // `fan_in <= MAX_INPUTS` (1800) fits in u16; `n <= i`.
         index[n] = i as u16;
         value[n] = v;
         n += usize::from(v != 0.0);
