@@ -9,13 +9,16 @@
 //! (`sbatch`, `cargo ...`) are not run. Two changes are made, both printed: `--scale small` and
 //! `--scale paper` become `--scale tiny` (the pipeline is the same; CI has minutes, not hours),
 //! and a few commands are skipped with the reason (a live camera, a Slurm cluster, a job
-//! array's task id), each run elsewhere by a test of its own.
+//! array's task id), each run elsewhere by a test of its own. A command that needs a system
+//! tool ([`NEEDS`]: ffmpeg for MP4) follows the testkit's one rule for external tools: where
+//! the tool is missing it is skipped with the reason outside CI and fails under CI, so the
+//! README's test command passes on a fresh machine with nothing installed by hand.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::common::run_ok;
-use evtac_testkit::{real_fixture, run_python, workspace_root};
+use evtac_testkit::{ffmpeg, real_fixture, run_python, workspace_root};
 
 /// Commands not run here, by a piece of their text, with why.
 const SKIP: &[(&str, &str)] = &[
@@ -41,6 +44,21 @@ const SKIP: &[(&str, &str)] = &[
         "a cluster's shared folder (docs/cluster.md's setting)",
     ),
 ];
+
+/// The testkit's check for a system tool: `false` outside CI when missing, having said so; a
+/// failure under CI.
+type ToolCheck = fn() -> bool;
+
+/// Commands that need a system tool, by a piece of their text: the tool, and its check.
+const NEEDS: &[(&str, &str, ToolCheck)] = &[(".mp4", "ffmpeg", ffmpeg)];
+
+/// Why `command` cannot run on this machine: a tool in [`NEEDS`] that is missing.
+fn missing_tool(command: &str) -> Option<&'static str> {
+    NEEDS
+        .iter()
+        .find(|(text, _, available)| command.contains(text) && !available())
+        .map(|(_, tool, _)| *tool)
+}
 
 /// One shell command of a block: its text (continuation lines included) and its line.
 #[derive(Debug)]
@@ -324,6 +342,10 @@ fn every_documented_evtac_command_runs_as_written() {
                 let at = format!("{doc}:{}", c.line);
                 if let Some((_, why)) = SKIP.iter().find(|(text, _)| c.text.contains(text)) {
                     say(&format!("skipped: {at}: needs {why}\n"));
+                    continue;
+                }
+                if let Some(tool) = missing_tool(&c.text) {
+                    say(&format!("skipped: {at}: needs {tool}, not on the PATH\n"));
                     continue;
                 }
                 let command = as_run(&c.text);
