@@ -143,6 +143,8 @@ mod tests {
             datasets: Some(3),
             repeats: Some(2),
             repeat_split: false,
+            grid: Some(evtac_experiments::plan::Grid::Paper),
+            recheck: false,
         };
         let line = crate::commands::jobs::equivalent_command("evtac", &Job::Reproduce(job.clone()));
         let Command::Reproduce(parsed) = Cli::try_parse_from(&line).unwrap().command else {

@@ -210,7 +210,8 @@ pub fn of_run(
         row(
             "Tuning grids",
             format!(
-                "static tau {} ms x threshold {} ({}); dynamic window {} ms x threshold {} ({})",
+                "static tau {} ms x threshold {} ({}); dynamic window {} ms x threshold {} ({}); \
+                 the {} grid{}",
                 list(&plan.static_taus_ms),
                 list(&plan.static_thresholds),
                 grid(
@@ -223,10 +224,16 @@ pub fn of_run(
                     plan.full_grid,
                     (plan.dynamic_center.0, plan.dynamic_center.1.to_string())
                 ),
+                plan.grid.name(),
+                plan.recheck_text()
+                    .map_or(String::new(), |text| format!("; {text}")),
             ),
             "the paper names only some values it tried (100 and 1000 ms, thresholds 0-2, windows \
-             up to 640 ms); the grids bracket them",
-            "`evtac reproduce --scale`; `crates/experiments/src/plan.rs`",
+             up to 640 ms); the paper grid brackets them; the extended grid adds static decays \
+             of 3, 5 and 10 s, because the paper grid's static optimum sat on its largest decay \
+             with validation MAE still falling; one run per setting ranks settings a seed's \
+             spread apart by chance, hence the recheck",
+            "`evtac reproduce --scale`, `--grid paper` or `extended`; `crates/experiments/src/plan.rs`",
         ),
         row(
             "Trial timeline",

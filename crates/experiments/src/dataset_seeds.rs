@@ -47,6 +47,7 @@ fn points(dataset_seed: u64, results: &[Exp1Repr]) -> Vec<DatasetSeedPoint> {
             name: r.name,
             runs: r.runs.clone(),
             test: r.test,
+            test_truth: r.test_truth,
         })
         .collect()
 }

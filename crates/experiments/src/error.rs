@@ -17,6 +17,9 @@ pub enum Error {
     /// The latency study failed.
     #[error(transparent)]
     Latency(#[from] crate::latency::Error),
+    /// The end-to-end replay at recorded pace failed.
+    #[error(transparent)]
+    PacedLatency(#[from] crate::paced_latency::Error),
     /// The feature cache failed.
     #[error(transparent)]
     Cache(#[from] crate::cache::Error),

@@ -222,20 +222,31 @@ pub(crate) fn run_jobs(
             Sampling::MOTION,
             &[Phase::Motion],
         )?;
+        let truth = crate::truth::of_split(cache, splits, Split::Test, &test)?;
         let mut runs = Vec::new();
+        let mut truth_runs = Vec::new();
         let mut val_runs = Vec::new();
         let seeds = seeds(seed, plan.seeds);
         for &s in &seeds {
             let model = training::load_model(&model_dir(out, kind, s))?;
             let pred = training::predict(&model, &test)?;
             runs.push(training::mae_in(&test, &pred, None));
+            if let Some(truth) = &truth {
+                truth_runs.push(crate::truth::mae_against(&test, &pred, truth, |_| true));
+            }
             val_runs.push(Mae::from(model.bundle.config.metrics.validation));
         }
+        let labels_truth = truth.as_ref().map(|truth| {
+            crate::truth::mae_against(&test, &training::label_rows(&test), truth, |_| true)
+        });
         results.push(Exp1Repr {
             name: kind,
             config,
             seeds,
             test: MaeStats::of(&runs),
+            test_truth: truth.as_ref().map(|_| MaeStats::of(&truth_runs)),
+            truth_runs,
+            labels_truth,
             runs,
             val_runs,
         });

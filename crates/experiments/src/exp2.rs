@@ -89,12 +89,21 @@ pub fn run(
                     .map(|s| training::load_model(&model_dir(out, setting, name, s)))
                     .collect::<Result<_, _>>()?
             };
+            let truth = crate::truth::of_split(cache, splits, Split::Test, &test)?;
             let (mut motion, mut stop) = (Vec::new(), Vec::new());
+            let (mut motion_truth, mut stop_truth) = (Vec::new(), Vec::new());
             for m in &models {
                 let pred = training::predict(m, &test)?;
                 motion.push(training::mae_in(&test, &pred, Some(Phase::Motion)));
                 stop.push(training::mae_in(&test, &pred, Some(Phase::Stop)));
+                if let Some(truth) = &truth {
+                    let against =
+                        |phase| crate::truth::mae_against(&test, &pred, truth, |p| p == phase);
+                    motion_truth.push(against(Phase::Motion));
+                    stop_truth.push(against(Phase::Stop));
+                }
             }
+            let measured = truth.is_some();
             cells.push(Exp2Cell {
                 setting,
                 name,
@@ -102,6 +111,8 @@ pub fn run(
                 stop: MaeStats::of(&stop),
                 motion_runs: motion,
                 stop_runs: stop,
+                motion_truth: measured.then(|| MaeStats::of(&motion_truth)),
+                stop_truth: measured.then(|| MaeStats::of(&stop_truth)),
             });
         }
     }

@@ -89,6 +89,7 @@ pub(crate) fn by_level(
             .map(|m| training::predict(m, &set))
             .collect::<Result<_, _>>()?;
         let labels = training::label_rows(&set);
+        let truth = crate::truth::rows(cache.dataset(), trials, &set)?;
         for (&key, members) in &by_value {
             let value = key as f64 / 1000.0;
             let seen = match trials[members[0]].group.as_deref() {
@@ -102,14 +103,19 @@ pub(crate) fn by_level(
                 .filter(|(_, s)| members.contains(&s.trial))
                 .map(|(i, _)| i)
                 .collect();
-            let runs: Vec<_> = preds
-                .iter()
-                .map(|p| {
-                    let pp: Vec<[f32; 2]> = rows.iter().map(|&i| p[i]).collect();
-                    let ll: Vec<[f32; 2]> = rows.iter().map(|&i| labels[i]).collect();
-                    crate::results::Mae::of(&pp, &ll)
-                })
-                .collect();
+            // Each model's MAE over this level's rows against `reference` (labels or truth).
+            let runs_against = |reference: &[[f32; 2]]| -> Vec<crate::results::Mae> {
+                preds
+                    .iter()
+                    .map(|p| {
+                        let pp: Vec<[f32; 2]> = rows.iter().map(|&i| p[i]).collect();
+                        let rr: Vec<[f32; 2]> = rows.iter().map(|&i| reference[i]).collect();
+                        crate::results::Mae::of(&pp, &rr)
+                    })
+                    .collect()
+            };
+            let runs = runs_against(&labels);
+            let truth_stats = truth.as_deref().map(|t| MaeStats::of(&runs_against(t)));
             out.push(Exp3Point {
                 name: *name,
                 value,
@@ -117,6 +123,7 @@ pub(crate) fn by_level(
                 trials: members.len(),
                 stats: MaeStats::of(&runs),
                 runs,
+                truth: truth_stats,
             });
         }
     }

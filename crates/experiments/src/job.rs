@@ -190,6 +190,13 @@ pub struct ReproduceJob {
     /// the split (when the dataset has repeats). Absent from older jobs files: it was.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub repeat_split: bool,
+    /// The tuning grids (`--grid`), or `None` for the plan's ([`crate::plan::Grid::Extended`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<crate::plan::Grid>,
+    /// Whether the best tuning settings are trained again with more seeds
+    /// ([`crate::plan::Plan::recheck_top`]; `--no-recheck` leaves it out). Absent: it is.
+    #[serde(default = "yes", skip_serializing_if = "is_yes")]
+    pub recheck: bool,
 }
 
 /// The default of a flag that older jobs files do not carry.
@@ -402,6 +409,8 @@ mod tests {
                 datasets: Some(3),
                 repeats: Some(2),
                 repeat_split: false,
+                grid: Some(crate::plan::Grid::Paper),
+                recheck: false,
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

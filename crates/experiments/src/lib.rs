@@ -18,7 +18,9 @@
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA), reported
 //!   through [`progress`]; the crate's `schedule` starts a stage's training runs longest first.
 //! - [`training`]: one training job (`evtac train`), model loading and evaluation.
-//! - [`plan`], [`tuning`], [`exp1`], [`latency`] and the crate's own `noise`, `exp2`, `exp3` and
+//! - [`plan`], [`tuning`], [`exp1`], [`latency`] (processing time per estimate),
+//!   [`paced_latency`] (end to end at recorded pace, queueing included), [`truth`] (errors
+//!   against the simulator's exact truth) and the crate's own `noise`, `exp2`, `exp3` and
 //!   `examples`: the experiments; [`repr_example`] (the paper's Fig. 2 for one sample) and
 //!   [`sensor_view`] (the sensor at rest and in contact) the data of two illustrative figures;
 //!   [`pipeline`] runs them all (or, with [`slurm`], submits them to a Slurm cluster);
@@ -68,6 +70,7 @@ mod label_check;
 pub mod label_noise;
 pub mod latency;
 mod noise;
+pub mod paced_latency;
 pub mod pipeline;
 pub mod plan;
 pub mod progress;
@@ -83,6 +86,7 @@ pub mod splits;
 pub mod stage;
 pub mod stage_log;
 pub mod training;
+pub mod truth;
 pub mod tuning;
 mod variant;
 

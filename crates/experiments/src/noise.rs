@@ -43,6 +43,7 @@ fn points(level: f64, rate: f64, results: &[Exp1Repr]) -> Vec<NoisePoint> {
             no_contact_events_per_s: rate,
             runs: r.runs.clone(),
             test: r.test,
+            test_truth: r.test_truth,
         })
         .collect()
 }

@@ -264,6 +264,13 @@ pub fn reproduce(
             progress.advance(1);
         }
     }
+    // Then end to end, queueing included: a few of these trials replayed at recorded pace,
+    // idle and under load (on the wall clock: its progress is messages, not units).
+    let firsts: Vec<(ReprKind, &Model)> = exp1_models
+        .iter()
+        .filter_map(|(name, ms)| ms.first().map(|m| (*name, m)))
+        .collect();
+    let paced = crate::paced_latency::measure(&ds1, test, &firsts, plan.scale, progress)?;
     stages.done("latency")?;
 
     let mut results = Results {
@@ -298,6 +305,7 @@ pub fn reproduce(
         sensor,
         dataset_seeds,
         repeat_split,
+        paced_latency: paced,
     };
     results.run.stage_seconds = stages.list;
     results.run.stage_history = log.records();
@@ -315,7 +323,8 @@ pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
 }
 
 /// The training jobs that can run now and are not finished: the tuning runs, and once both
-/// tunings are finished, Experiments 1 and 2 and the label-noise ablation. Run them (in any order, in parallel, e.g. with
+/// tunings are finished, the recheck of their best settings, Experiments 1 and 2 and the
+/// label-noise ablation. Run them (in any order, in parallel, e.g. with
 /// `evtac jobs run`), then run the reproduction again: it resumes from the finished jobs.
 /// Makes the splits (and needs the Experiment 1 dataset).
 pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Result<Vec<Job>, Error> {
@@ -324,8 +333,10 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
     ds1.splits(seed)?;
     let mut jobs = Vec::new();
     let mut tuned = Vec::new();
+    let mut rechecks = Vec::new();
     for kind in [Kind::Static, Kind::Dynamic] {
         let mut best: Option<(f64, ReprConfig)> = None;
+        let mut ranked = Vec::new();
         let mut all_done = true;
         for p in tuning::grid(plan, kind) {
             let job = tuning::job(&ds1, kind, p.config, plan, seed, &models);
@@ -335,6 +346,7 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
                     if best.is_none_or(|(bv, _)| v < bv) {
                         best = Some((v, p.config));
                     }
+                    ranked.push((v, p));
                 }
             } else {
                 all_done = false;
@@ -343,8 +355,18 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
         }
         if all_done && let Some((_, c)) = best {
             tuned.push(c);
+            // The recheck of the best settings needs only the grid: it runs beside Experiments
+            // 1 and 2.
+            let top = tuning::top(&ranked, plan);
+            rechecks.extend(tuning::recheck_jobs(&ds1, kind, &top, plan, seed, &models));
         }
     }
+    jobs.extend(
+        rechecks
+            .into_iter()
+            .filter(|j| !exp1::finished(&j.out))
+            .map(Job::Train),
+    );
     if let [s, d] = tuned[..] {
         let reprs = exp1::of_plan(plan, s, d);
         let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);

@@ -96,7 +96,62 @@ pub struct Plan {
     /// from older plans: it was.
     #[serde(default = "repeat_split_by_default")]
     pub repeat_split: bool,
+    /// Which tuning grids the lists above are: the paper's, or evtac's extension of them past
+    /// the edge where the paper's optimum sat. Absent from older plans: the paper's.
+    #[serde(default)]
+    pub grid: Grid,
+    /// How many of each representation's best grid settings are trained again with
+    /// [`Plan::recheck_seeds`] seeds, so the report can say whether the choice stands beyond
+    /// the seeds' spread (`crate::tuning::recheck`). 0: none. Absent from older plans: none.
+    #[serde(default)]
+    pub recheck_top: usize,
+    /// Training seeds per rechecked setting, the grid's own run included.
+    #[serde(default)]
+    pub recheck_seeds: usize,
 }
+
+/// Which tuning grids a plan searches (`evtac reproduce --grid`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Grid {
+    /// The grids that bracket the paper's stated values (every plan before `--grid` existed).
+    #[default]
+    Paper,
+    /// The paper's grids and [`EXTRA_STATIC_TAUS_MS`]: at every scale the paper's static
+    /// optimum sat on the largest decay tried with validation MAE still falling there.
+    Extended,
+}
+
+impl std::str::FromStr for Grid {
+    type Err = String;
+
+    /// `paper` or `extended`.
+    fn from_str(s: &str) -> Result<Grid, String> {
+        match s.trim() {
+            "paper" => Ok(Grid::Paper),
+            "extended" => Ok(Grid::Extended),
+            other => Err(format!("{other:?} is not a grid: paper or extended")),
+        }
+    }
+}
+
+impl Grid {
+    /// The name on the command line and in the report: `paper`, `extended`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Grid::Paper => "paper",
+            Grid::Extended => "extended",
+        }
+    }
+}
+
+/// The static decays [`Grid::Extended`] adds, ms. 10 s is far longer than a trial's motion
+/// (at most 10 s at 2 deg/s): as near to no decay as a finite tau gets within one trial
+/// (`StaticConfig` needs a finite tau > 0).
+pub const EXTRA_STATIC_TAUS_MS: [f64; 3] = [3000.0, 5000.0, 10000.0];
+
+/// Settings [`Plan::recheck_top`] retrains, and seeds each ([`Plan::recheck_seeds`]).
+pub const RECHECK: (usize, usize) = (3, 5);
 
 /// The label-noise ablation's standard deviation: the spread of the paper's label validation at
 /// stops (-0.01 ± 0.04 deg).
@@ -122,9 +177,38 @@ fn repeat_split_by_default() -> bool {
 pub const NOISE_LEVELS: [f64; 3] = [0.0, 1.0, 3.0];
 
 impl Plan {
-    /// The plan of a scale. `small` and `tiny` take the rest (the cross's centers, the latency
-    /// intervals, the noise levels) from `paper`.
+    /// The plan of a scale, with evtac's [`Grid::Extended`] and the recheck of the best
+    /// settings ([`RECHECK`]). `evtac reproduce --grid paper` makes it [`Plan::with_grid`]'s.
     pub fn for_scale(scale: Scale) -> Plan {
+        Plan {
+            recheck_top: RECHECK.0,
+            recheck_seeds: RECHECK.1,
+            ..Plan::paper_grids(scale)
+        }
+        .with_grid(Grid::Extended)
+    }
+
+    /// This plan searching `grid`: the scale's paper lists, and [`EXTRA_STATIC_TAUS_MS`] for
+    /// [`Grid::Extended`].
+    pub fn with_grid(self, grid: Grid) -> Plan {
+        let paper = Plan::paper_grids(self.scale);
+        let mut static_taus_ms = paper.static_taus_ms;
+        if grid == Grid::Extended {
+            static_taus_ms.extend(EXTRA_STATIC_TAUS_MS);
+        }
+        Plan {
+            grid,
+            static_taus_ms,
+            static_thresholds: paper.static_thresholds,
+            dynamic_windows_ms: paper.dynamic_windows_ms,
+            dynamic_thresholds: paper.dynamic_thresholds,
+            ..self
+        }
+    }
+
+    /// The plan of a scale with the paper's grids and no recheck. `small` and `tiny` take the
+    /// rest (the cross's centers, the latency intervals, the noise levels) from `paper`.
+    fn paper_grids(scale: Scale) -> Plan {
         match scale {
             Scale::Paper => Plan {
                 scale,
@@ -145,11 +229,15 @@ impl Plan {
                 noise_levels: NOISE_LEVELS.to_vec(),
                 fusions: true,
                 label_noise_deg: Some(LABEL_NOISE_DEG),
-                // The paper's plan has one dataset; more are `--datasets N` (each adds a
-                // simulation and Experiment 1's runs, about a quarter of the plan's training).
-                datasets: 1,
+                // Three: the fewest that give the paper's scale a spread across datasets beside
+                // the training seeds' (at `small` it exceeds theirs for some representations). Each more adds a
+                // simulation and Experiment 1's runs, about a quarter of the plan's training.
+                datasets: 3,
                 // Runs only on a dataset with repeats (the paper's scale has two passes).
                 repeat_split: true,
+                grid: Grid::Paper,
+                recheck_top: 0,
+                recheck_seeds: 0,
             },
             Scale::Small => Plan {
                 scale,
@@ -166,7 +254,7 @@ impl Plan {
                 // Five simulation seeds: the fewest that give the spread across datasets a
                 // standard deviation worth comparing with the training seeds'.
                 datasets: 5,
-                ..Plan::for_scale(Scale::Paper)
+                ..Plan::paper_grids(Scale::Paper)
             },
             Scale::Tiny => Plan {
                 scale,
@@ -182,9 +270,20 @@ impl Plan {
                 latency_trials: 2,
                 // Two, so that every test of a tiny run goes through a second dataset.
                 datasets: 2,
-                ..Plan::for_scale(Scale::Paper)
+                ..Plan::paper_grids(Scale::Paper)
             },
         }
+    }
+
+    /// The recheck of the best settings in words ("the 3 best settings of each trained again
+    /// with 5 seeds"), or `None` when the plan has none: the report's and the choices' one text.
+    pub fn recheck_text(&self) -> Option<String> {
+        (self.recheck_top > 0).then(|| {
+            format!(
+                "the {} best settings of each trained again with {} seeds",
+                self.recheck_top, self.recheck_seeds
+            )
+        })
     }
 
     /// Representations trained per seed in Experiments 1 and 2 and the noise study: the
@@ -282,17 +381,42 @@ mod tests {
 
     #[test]
     fn paper_and_small_grids_are_full_and_tiny_grid_is_a_cross() {
-        let paper = Plan::for_scale(Scale::Paper);
+        let paper = Plan::for_scale(Scale::Paper).with_grid(Grid::Paper);
         assert_eq!(paper.static_grid().len(), 7 * 5);
         assert_eq!(paper.dynamic_grid().len(), 8 * 5);
-        let small = Plan::for_scale(Scale::Small);
+        let small = Plan::for_scale(Scale::Small).with_grid(Grid::Paper);
         assert_eq!(small.static_grid().len(), 4 * 4);
         assert_eq!(small.dynamic_grid().len(), 4 * 4);
-        let tiny = Plan::for_scale(Scale::Tiny);
+        let tiny = Plan::for_scale(Scale::Tiny).with_grid(Grid::Paper);
         let g = tiny.static_grid();
         // 2 taus at threshold 2, plus the other threshold at tau 1000.
         assert_eq!(g.len(), 2 + 1);
         assert!(g.contains(&(1000.0, 2.0)));
         assert!(g.iter().all(|&(t, th)| t == 1000.0 || th == 2.0));
+    }
+
+    #[test]
+    fn the_default_grid_extends_the_static_decays_past_the_papers_edge() {
+        for scale in [Scale::Tiny, Scale::Small, Scale::Paper] {
+            let plan = Plan::for_scale(scale);
+            assert_eq!(plan.grid, Grid::Extended);
+            assert_eq!((plan.recheck_top, plan.recheck_seeds), RECHECK);
+            let paper = plan.clone().with_grid(Grid::Paper);
+            assert_eq!(paper.grid, Grid::Paper);
+            let largest = |p: &Plan| p.static_taus_ms.iter().copied().fold(0.0, f64::max);
+            assert_eq!(largest(&plan), 10000.0);
+            assert!(largest(&paper) < EXTRA_STATIC_TAUS_MS[0]);
+            // The same dynamic grid: its optimum was inside at every scale.
+            assert_eq!(plan.dynamic_windows_ms, paper.dynamic_windows_ms);
+            // Back and forth gives the same lists.
+            assert_eq!(paper.with_grid(Grid::Extended), plan);
+        }
+        // A plan written before the grid existed reads as the paper's, with no recheck.
+        let mut old = serde_json::to_value(Plan::for_scale(Scale::Small)).unwrap();
+        for field in ["grid", "recheck_top", "recheck_seeds"] {
+            old.as_object_mut().unwrap().remove(field);
+        }
+        let old: Plan = serde_json::from_value(old).unwrap();
+        assert_eq!((old.grid, old.recheck_top), (Grid::Paper, 0));
     }
 }

@@ -134,6 +134,26 @@ pub struct Tuning {
     pub curve_time_ms: f64,
     /// The threshold fixed along the time curve of the figure.
     pub curve_threshold: f64,
+    /// The best settings of the grid trained again with more seeds (`crate::tuning`), best
+    /// first; empty when the plan has no recheck, and in older results.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub recheck: Vec<Recheck>,
+}
+
+/// One of a tuning's best settings trained with several seeds: whether its rank holds beyond
+/// the seeds' spread.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recheck {
+    /// Tau or window, ms.
+    pub time_ms: f64,
+    /// Threshold.
+    pub threshold: f64,
+    /// The seeds (the grid's own run is the first).
+    pub seeds: Vec<u64>,
+    /// Best validation MAE per seed.
+    pub val_runs: Vec<Mae>,
+    /// Statistics over the seeds.
+    pub val: MaeStats,
 }
 
 /// Experiment 1 for one representation: ten seeds with the chosen settings.
@@ -151,6 +171,17 @@ pub struct Exp1Repr {
     pub val_runs: Vec<Mae>,
     /// Test MAE statistics over seeds.
     pub test: MaeStats,
+    /// Test MAE per seed against the simulator's exact truth instead of the labels
+    /// (`crate::truth`); empty on recordings, which have none, and in older results.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub truth_runs: Vec<Mae>,
+    /// Statistics of [`Exp1Repr::truth_runs`], where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_truth: Option<MaeStats>,
+    /// The test labels' own MAE against the truth on the same samples: how far the labels the
+    /// models are scored on are from the pose, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub labels_truth: Option<Mae>,
 }
 
 /// The label-noise ablation: Experiment 1's paper representations trained with noisy labels.
@@ -179,6 +210,9 @@ pub struct NoisePoint {
     pub runs: Vec<Mae>,
     /// Test MAE statistics over seeds.
     pub test: MaeStats,
+    /// Test MAE statistics against the simulator's exact truth, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_truth: Option<MaeStats>,
 }
 
 /// Experiment 2's training settings, in the report's order.
@@ -236,6 +270,12 @@ pub struct Exp2Cell {
     pub motion: MaeStats,
     /// Stop-phase statistics.
     pub stop: MaeStats,
+    /// Motion-phase statistics against the simulator's exact truth, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion_truth: Option<MaeStats>,
+    /// Stop-phase statistics against the simulator's exact truth, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_truth: Option<MaeStats>,
 }
 
 /// Experiment 3: one condition value (a speed or a depth) for one representation.
@@ -253,6 +293,59 @@ pub struct Exp3Point {
     pub runs: Vec<Mae>,
     /// Statistics over the models.
     pub stats: MaeStats,
+    /// Statistics over the models against the simulator's exact truth, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth: Option<MaeStats>,
+}
+
+/// What else runs on the machine during a replay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Load {
+    /// Nothing started by the measurement (the machine as it is).
+    Idle,
+    /// One extra thread spinning on floating-point multiplies and adds for the whole replay.
+    BusyThread,
+}
+
+impl Load {
+    /// Both, in the report's order.
+    pub const ALL: [Load; 2] = [Load::Idle, Load::BusyThread];
+
+    /// A short name for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Load::Idle => "idle",
+            Load::BusyThread => "one busy thread",
+        }
+    }
+}
+
+/// End-to-end latency of one (representation, interval, load), queueing included.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PacedLatencyCell {
+    /// The representation.
+    pub name: ReprKind,
+    /// Interval between estimates (and length of each released slice), ms.
+    pub interval_ms: u32,
+    /// What else ran.
+    pub load: Load,
+    /// Trials replayed.
+    pub trials: usize,
+    /// Event time replayed, summed over the trials, in seconds (as long on the wall clock).
+    pub replayed_s: f64,
+    /// Logical cores of the machine (`std::thread::available_parallelism`), 0 if unknown.
+    pub cores: usize,
+    /// Estimates measured.
+    pub samples: usize,
+    /// Median end-to-end time in microseconds (nearest rank, as `crate::latency::cell`).
+    pub median_us: f64,
+    /// 99th percentile in microseconds.
+    pub p99_us: f64,
+    /// Maximum in microseconds.
+    pub max_us: f64,
+    /// Share of estimates whose end-to-end time exceeded the interval, 0 to 1.
+    pub late_share: f64,
 }
 
 /// Latency of one (representation, sampling interval).
@@ -436,6 +529,11 @@ pub struct LabelCheck {
     /// existed, which were all the IMU's.
     #[serde(default)]
     pub label_source: evtac_labels::LabelSource,
+    /// Per-trial RMS error of the labels against the ground truth over each stop (trials with a
+    /// stop and a truth file), degrees: the labels' own error where the paper checks them,
+    /// without the robot's repeatability the stop check includes. Absent from older results.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_stop_rms_deg: Option<evtac_labels::Summary>,
 }
 
 /// Experiment 1's paper representations on a split that keeps each condition's repeats on one
@@ -462,6 +560,9 @@ pub struct DatasetSeedPoint {
     pub runs: Vec<Mae>,
     /// Test MAE statistics over training seeds.
     pub test: MaeStats,
+    /// Test MAE statistics against the simulator's exact truth, where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_truth: Option<MaeStats>,
 }
 
 /// Everything a reproduction measured.
@@ -517,6 +618,11 @@ pub struct Results {
     /// no condition has two trials, and from older results).
     #[serde(default)]
     pub repeat_split: Option<RepeatSplit>,
+    /// End-to-end latency, queueing included, of a few test trials replayed at recorded pace,
+    /// idle and under load (`crate::paced_latency`); absent from older results, and not written
+    /// when empty so that they re-serialize unchanged.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub paced_latency: Vec<PacedLatencyCell>,
 }
 
 #[cfg(test)]

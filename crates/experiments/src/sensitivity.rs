@@ -189,9 +189,10 @@ pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError
     perturbed(&defaults, &p, factor)
 }
 
-/// The plan every point runs: the scale's, with the paper's three representations only, no
-/// noise study, no label-noise ablation, no other simulation seeds and no repeats-together
-/// split (each point is one Experiment 1).
+/// The plan every point runs: the scale's with the paper's grids (the committed study's), the
+/// paper's three representations only, no noise study, no label-noise ablation, no other
+/// simulation seeds, no repeats-together split and no recheck of the best settings (each point
+/// is one Experiment 1).
 pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
     crate::plan::Plan {
         fusions: false,
@@ -199,7 +200,9 @@ pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
         label_noise_deg: None,
         datasets: 1,
         repeat_split: false,
-        ..crate::plan::Plan::for_scale(scale)
+        recheck_top: 0,
+        recheck_seeds: 0,
+        ..crate::plan::Plan::for_scale(scale).with_grid(crate::plan::Grid::Paper)
     }
 }
 
@@ -709,6 +712,7 @@ mod tests {
             trials: 1,
             stats: MaeStats::of(&runs),
             runs,
+            truth: None,
         }
     }
 

@@ -227,6 +227,8 @@ impl CostModel {
     }
 
     /// Expected seconds of the whole reproduction: every stage it will report.
+    ///
+    /// The latency stage's end-to-end replay runs on the wall clock ([`paced_replay_seconds`]).
     pub fn total_seconds(&self) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
         let reprs = plan.representations();
@@ -239,10 +241,13 @@ impl CostModel {
             )
             + c(
                 Stage::Tuning(Kind::Static),
-                plan.static_grid().len() + plan.dynamic_grid().len(),
+                plan.static_grid().len()
+                    + plan.dynamic_grid().len()
+                    + 2 * plan.recheck_top * plan.recheck_seeds.saturating_sub(1),
             )
             + c(Stage::Exp1Training, reprs * plan.seeds)
-            + c(Stage::Latency, reprs * plan.latency_intervals_ms.len());
+            + c(Stage::Latency, reprs * plan.latency_intervals_ms.len())
+            + paced_replay_seconds(plan, reprs);
         if counts.exp2 > 0 {
             sum += c(
                 Stage::Exp2Training,
@@ -275,6 +280,15 @@ impl CostModel {
         }
         sum
     }
+}
+
+/// Wall time of the latency stage's replay at recorded pace (`crate::paced_latency`): it runs
+/// as long as the events it replays, whatever the machine.
+fn paced_replay_seconds(plan: &Plan, reprs: usize) -> f64 {
+    let extent = crate::paced_latency::extent(plan.scale);
+    let cells =
+        reprs * crate::paced_latency::INTERVALS_MS.len() * crate::paced_latency::Load::ALL.len();
+    cells as f64 * extent.trials as f64 * extent.motion_ms as f64 / 1000.0
 }
 
 #[cfg(test)]
@@ -373,6 +387,7 @@ mod tests {
         let fewer = CostModel::new(&paper_only, counts).total_seconds();
         let per_repr = model.seconds(Stage::Exp1Training, plan.seeds as u64)
             + model.seconds(Stage::Latency, plan.latency_intervals_ms.len() as u64)
+            + paced_replay_seconds(&plan, 1)
             + 2.0 * model.seconds(Stage::NoiseTraining, plan.seeds as u64)
             + (plan.datasets - 1) as f64
                 * model.seconds(Stage::DatasetSeedTraining, plan.seeds as u64);

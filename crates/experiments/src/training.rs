@@ -203,17 +203,12 @@ pub fn label_rows(set: &LoadedSet) -> Vec<[f32; 2]> {
         .collect()
 }
 
-/// MAE of `pred` on the samples of `set` in `phase` (all samples when `None`).
+/// MAE of `pred` against the labels on the samples of `set` in `phase` (all samples when
+/// `None`).
 pub fn mae_in(set: &LoadedSet, pred: &[[f32; 2]], phase: Option<Phase>) -> Mae {
-    let labels = label_rows(set);
-    let (mut p, mut l) = (Vec::new(), Vec::new());
-    for ((s, a), b) in set.samples.iter().zip(pred).zip(&labels) {
-        if phase.is_none_or(|ph| ph == s.phase) {
-            p.push(*a);
-            l.push(*b);
-        }
-    }
-    Mae::of(&p, &l)
+    crate::truth::mae_against(set, pred, &label_rows(set), |p| {
+        phase.is_none_or(|ph| ph == p)
+    })
 }
 
 impl From<evtac_learn::Mae> for Mae {

@@ -1,13 +1,19 @@
 //! Experiment 1's hyperparameter search: one training run per (decay tau x threshold) for the
 //! static representation and per (window x threshold) for the dynamic one, each selected at its
 //! best validation epoch; the setting with the lowest validation MAE is chosen.
+//!
+//! A grid point is one run, so two settings a seed's spread apart are ranked by chance. When
+//! the plan asks for it ([`Plan::recheck_top`]), the best settings are trained again with more
+//! seeds (the grid's run is the first; [`recheck_jobs`]), so the report can say whether the
+//! choice stands beyond the seeds' spread. The choice itself stays the grid's, as the paper's
+//! protocol makes it.
 
 use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::Dataset;
 use crate::job::TrainJob;
 use crate::plan::{self, Plan};
-use crate::results::{Mae, Tuning, TuningRun};
+use crate::results::{Mae, MaeStats, Recheck, Tuning, TuningRun};
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
 use crate::stage::{FeatureSet, Stage};
@@ -86,6 +92,95 @@ pub fn job(
     }
 }
 
+/// The folder of one recheck run: `config` trained with `seed`.
+pub fn recheck_dir(out: &Path, kind: Kind, config: &ReprConfig, seed: u64) -> PathBuf {
+    out.join("tuning-recheck")
+        .join(kind.name())
+        .join(config.cache_key())
+        .join(format!("seed-{seed}"))
+}
+
+/// The [`Plan::recheck_top`] best of `ranked` (each grid point with its validation MAE), best
+/// first; ties keep the grid's order.
+pub fn top(ranked: &[(f64, GridPoint)], plan: &Plan) -> Vec<GridPoint> {
+    let mut sorted: Vec<&(f64, GridPoint)> = ranked.iter().collect();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    sorted
+        .into_iter()
+        .take(plan.recheck_top)
+        .map(|(_, p)| p.clone())
+        .collect()
+}
+
+/// The seeds a rechecked setting is trained with: the grid's own run's first.
+pub fn recheck_seeds(plan: &Plan, seed: u64) -> Vec<u64> {
+    crate::exp1::seeds(seed, plan.recheck_seeds.max(1))
+}
+
+/// The training jobs of the recheck of `points` (from [`top`]): every seed but the grid's own,
+/// whose run is already there.
+pub fn recheck_jobs(
+    ds: &Dataset,
+    kind: Kind,
+    points: &[GridPoint],
+    plan: &Plan,
+    seed: u64,
+    out: &Path,
+) -> Vec<TrainJob> {
+    let mut jobs = Vec::new();
+    for p in points {
+        for &s in recheck_seeds(plan, seed).iter().skip(1) {
+            let mut job = job(ds, kind, p.config, plan, seed, out);
+            job.spec.seed = s;
+            job.out = recheck_dir(out, kind, &p.config, s);
+            jobs.push(job);
+        }
+    }
+    jobs
+}
+
+/// Trains (or resumes) the recheck of the best `ranked` settings and reads back each one's
+/// validation MAE per seed.
+fn recheck(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    kind: Kind,
+    run: &RunContext<'_>,
+    ranked: &[(f64, GridPoint)],
+) -> Result<Vec<Recheck>, Error> {
+    let (plan, seed, out, progress) = (run.plan, run.seed, run.models, run.progress);
+    let points = top(ranked, plan);
+    let jobs = recheck_jobs(cache.dataset(), kind, &points, plan, seed, out);
+    if points.is_empty() {
+        return Ok(Vec::new());
+    }
+    progress.stage(Stage::Tuning(kind), jobs.len() as u64);
+    crate::exp1::train_all(cache, splits, &jobs, progress)?;
+    let mut out_list = Vec::new();
+    for p in &points {
+        let seeds = recheck_seeds(plan, seed);
+        let mut val_runs = Vec::new();
+        for (k, &s) in seeds.iter().enumerate() {
+            let dir = if k == 0 {
+                run_dir(out, kind, &p.config)
+            } else {
+                recheck_dir(out, kind, &p.config, s)
+            };
+            val_runs.push(Mae::from(
+                ModelBundle::load(&dir)?.config.metrics.validation,
+            ));
+        }
+        out_list.push(Recheck {
+            time_ms: p.time_ms,
+            threshold: p.threshold,
+            seeds,
+            val: MaeStats::of(&val_runs),
+            val_runs,
+        });
+    }
+    Ok(out_list)
+}
+
 /// Runs (or resumes) the grid search of `kind` and picks the setting with the lowest validation
 /// MAE. Runs go in parallel; finished runs (with `done`) are read back, not redone.
 pub fn tune(
@@ -127,7 +222,14 @@ pub fn tune(
         .min_by(|a, b| a.0.val.overall.total_cmp(&b.0.val.overall))
         .map(|(_, p)| p.clone())
         .unwrap_or_else(|| points[0].clone());
+    let ranked: Vec<(f64, GridPoint)> = runs
+        .iter()
+        .zip(&points)
+        .map(|(r, p)| (r.val.overall, p.clone()))
+        .collect();
+    let recheck = recheck(cache, splits, kind, run, &ranked)?;
     Ok(Tuning {
+        recheck,
         repr: kind.repr(),
         time_name: match kind {
             Kind::Static => "tau_ms".into(),
@@ -154,4 +256,44 @@ pub fn tune(
             }
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use evtac_sim::Scale;
+
+    #[test]
+    fn the_recheck_takes_the_best_settings_and_adds_seeds_after_the_grids_own() {
+        let plan = Plan::for_scale(Scale::Small);
+        let points = grid(&plan, Kind::Static);
+        let ranked: Vec<(f64, GridPoint)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| ((i as f64 - 5.0).abs(), p.clone()))
+            .collect();
+        let best = top(&ranked, &plan);
+        assert_eq!(best.len(), plan.recheck_top);
+        assert_eq!(best[0], points[5]);
+        // Ties (4 and 6 are both 1 away) keep the grid's order.
+        assert_eq!((&best[1], &best[2]), (&points[4], &points[6]));
+        assert_eq!(recheck_seeds(&plan, 7), [7, 8, 9, 10, 11]);
+        let out = std::path::Path::new("/models");
+        let dirs: Vec<PathBuf> = best
+            .iter()
+            .flat_map(|p| {
+                recheck_seeds(&plan, 7)
+                    .into_iter()
+                    .skip(1)
+                    .map(|s| recheck_dir(out, Kind::Static, &p.config, s))
+            })
+            .collect();
+        assert_eq!(dirs.len(), plan.recheck_top * (plan.recheck_seeds - 1));
+        assert!(dirs[0].ends_with("seed-8"));
+        let none = Plan {
+            recheck_top: 0,
+            ..plan
+        };
+        assert!(top(&ranked, &none).is_empty());
+    }
 }

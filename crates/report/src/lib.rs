@@ -30,5 +30,6 @@ pub mod render;
 pub mod sensitivity;
 
 pub use markdown::{
-    CHOICES_TITLE, Error, FIGURES, PAPER_EXP2_STATIC, PAPER_TABLE, exp1_stats, markdown, write,
+    CHOICES_TITLE, Error, FIGURES, PAPER_EXP2_STATIC, PAPER_TABLE, Verdict, exp1_stats,
+    exp1_verdicts, markdown, write,
 };

@@ -157,6 +157,12 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if !j.repeat_split {
                 args.push("--no-repeat-split".into());
             }
+            if let Some(grid) = j.grid {
+                args.extend(["--grid".into(), grid.name().into()]);
+            }
+            if !j.recheck {
+                args.push("--no-recheck".into());
+            }
         }
         Job::SensitivityPoint(j) => {
             args.push("sensitivity".into());

@@ -1,52 +1,13 @@
-//! The report's "Experiment 1 on other simulated datasets" section, and the rule every claim of a
-//! difference in Experiment 1 follows: it must exceed both the training seeds' spread and, where
-//! the run measured it, the spread across simulated datasets ([`Spread`]).
-//!
-//! The training seeds' spread says how much a result moves when the same data is trained on
-//! again; the datasets' spread, how much it moves on another dataset of the same kind (other
-//! trials, another camera, other noise; `evtac_experiments::dataset_seeds`). A difference
-//! smaller than either could be an accident of the one dataset or of the few seeds.
+//! The report's "Experiment 1 on other simulated datasets" section: each representation's test
+//! MAE on every simulated dataset, and every pair of representations judged by the report's one
+//! rule ([`super::verdict`]) on the numbers every section compares for Experiment 1.
 
 use std::fmt::Write as _;
 
 use evtac_experiments::results::{MeanStd, Results};
 use evtac_repr::ReprKind;
 
-/// What a difference between two representations' MAEs must exceed to be claimed.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Spread {
-    /// The training seeds' spread: the two standard deviations added in quadrature.
-    pub seeds: f64,
-    /// The datasets' spread, the same over each dataset's mean, where measured.
-    pub datasets: Option<f64>,
-}
-
-impl Spread {
-    /// The spread of a difference between `a` and `b` over training seeds, and over datasets
-    /// when both their standard deviations across datasets are given.
-    pub fn of(a: &MeanStd, b: &MeanStd, datasets: Option<(f64, f64)>) -> Spread {
-        Spread {
-            seeds: a.std.hypot(b.std),
-            datasets: datasets.map(|(x, y)| x.hypot(y)),
-        }
-    }
-
-    /// The larger of the two: a difference counts only beyond it.
-    pub fn bound(&self) -> f64 {
-        self.datasets.map_or(self.seeds, |d| d.max(self.seeds))
-    }
-
-    /// How the bound reads in a sentence ("the seeds' spread of 0.012", or both).
-    pub fn describe(&self) -> String {
-        match self.datasets {
-            None => format!("the seeds' spread of {:.3}", self.seeds),
-            Some(d) => format!(
-                "the larger of the seeds' spread ({:.3}) and the datasets' ({d:.3})",
-                self.seeds
-            ),
-        }
-    }
-}
+use super::verdict::{self, Side, Verdict};
 
 /// One representation across the run's datasets.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,6 +20,9 @@ pub(super) struct Across {
     pub over_datasets: MeanStd,
     /// The training seeds' standard deviation, pooled over datasets (root mean square).
     pub seeds_sd: f64,
+    /// The mean over datasets of each one's mean test MAE against the simulator's exact truth,
+    /// where every dataset measured it.
+    pub truth_mean: Option<f64>,
 }
 
 /// Every representation across datasets, in report order; empty when the run simulated fewer
@@ -79,11 +43,18 @@ pub(super) fn across(r: &Results) -> Vec<Across> {
                 .map(|p| p.test.overall.std.powi(2))
                 .sum::<f64>()
                 / points.len().max(1) as f64;
+            let truth: Option<Vec<f64>> = points
+                .iter()
+                .map(|p| p.test_truth.map(|t| t.overall.mean))
+                .collect();
             Across {
                 kind,
                 means,
                 over_datasets: MeanStd::of(&values),
                 seeds_sd: var.sqrt(),
+                truth_mean: truth
+                    .filter(|t| !t.is_empty())
+                    .map(|t| t.iter().sum::<f64>() / t.len() as f64),
             }
         })
         .collect();
@@ -91,13 +62,6 @@ pub(super) fn across(r: &Results) -> Vec<Across> {
         return Vec::new();
     }
     out
-}
-
-/// `kind`'s standard deviation across datasets, or `None` when not measured.
-pub(super) fn datasets_sd(all: &[Across], kind: ReprKind) -> Option<f64> {
-    all.iter()
-        .find(|a| a.kind == kind)
-        .map(|a| a.over_datasets.std)
 }
 
 /// In how many datasets `a`'s mean is below `b`'s.
@@ -108,30 +72,25 @@ fn lower_in(a: &Across, b: &Across) -> usize {
         .count()
 }
 
-/// One sentence on `a` against `b` (MAE over datasets, lower is better): claimed only beyond
-/// both spreads.
+impl Across {
+    /// The side every Experiment 1 comparison takes for this representation.
+    pub fn side(&self) -> Side {
+        Side {
+            mean: self.over_datasets.mean,
+            seeds_sd: self.seeds_sd,
+            datasets_sd: Some(self.over_datasets.std),
+        }
+    }
+}
+
+/// One sentence on `a` against `b` (MAE over datasets, lower is better), judged by the report's
+/// one rule; whether a difference is claimed.
 fn claim(a: &Across, b: &Across) -> (String, bool) {
-    let diff = b.over_datasets.mean - a.over_datasets.mean;
-    let spread = Spread {
-        seeds: a.seeds_sd.hypot(b.seeds_sd),
-        datasets: Some(a.over_datasets.std.hypot(b.over_datasets.std)),
-    };
+    let judged = verdict::judge(&a.side(), &b.side());
     let n = a.means.len().min(b.means.len());
-    let (lower, higher) = if diff >= 0.0 { (a, b) } else { (b, a) };
+    let (lower, higher) = if judged.diff >= 0.0 { (a, b) } else { (b, a) };
     let count = lower_in(lower, higher);
-    if diff.abs() > spread.bound() {
-        (
-            format!(
-                "**{} is lower than {}** by {:.3} deg, beyond {}; lower in {count} of {n} \
-                 datasets.",
-                lower.kind,
-                higher.kind,
-                diff.abs(),
-                spread.describe()
-            ),
-            true,
-        )
-    } else {
+    if judged.verdict == Verdict::Tied {
         (
             format!(
                 "{} and {}: not claimed; {} is lower by {:.3} deg, within {}; lower in {count} \
@@ -139,10 +98,22 @@ fn claim(a: &Across, b: &Across) -> (String, bool) {
                 a.kind,
                 b.kind,
                 lower.kind,
-                diff.abs(),
-                spread.describe()
+                judged.diff.abs(),
+                judged.spread.describe()
             ),
             false,
+        )
+    } else {
+        (
+            format!(
+                "**{} is lower than {}** by {:.3} deg, beyond {}; lower in {count} of {n} \
+                 datasets.",
+                lower.kind,
+                higher.kind,
+                judged.diff.abs(),
+                judged.spread.describe()
+            ),
+            true,
         )
     }
 }
@@ -164,39 +135,53 @@ pub(super) fn section(md: &mut String, r: &Results) {
          first is Experiment 1's own), each trained with the settings tuned on the first and \
          the same {} training seeds. Each cell is a dataset's mean over training seeds. A \
          difference between two representations is claimed only beyond both the training \
-         seeds' spread and the datasets' (each pair's two standard deviations in quadrature).\n",
+         seeds' spread and the datasets' (each pair's two standard deviations in quadrature); \
+         every comparison of Experiment 1's representations in this report is this one, on \
+         these numbers.\n",
         seeds.len(),
         seeds.join(", "),
         r.dataset_seeds.first().map_or(0, |p| p.runs.len()),
     );
     let header: Vec<String> = seeds.iter().map(|s| format!("seed {s}")).collect();
+    let truth = all.iter().all(|a| a.truth_mean.is_some());
     let _ = writeln!(
         md,
         "| Representation | {} | Mean over datasets | SD across datasets | SD across training \
-         seeds |",
-        header.join(" | ")
+         seeds |{}",
+        header.join(" | "),
+        if truth { " Mean vs truth |" } else { "" }
     );
     let _ = writeln!(
         md,
-        "| --- |{} ---: | ---: | ---: |",
-        " ---: |".repeat(header.len())
+        "| --- |{} ---: | ---: | ---: |{}",
+        " ---: |".repeat(header.len()),
+        if truth { " ---: |" } else { "" }
     );
     for a in &all {
         let cells: Vec<String> = a.means.iter().map(|m| format!("{:.3}", m.1)).collect();
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.3} | {:.3} |",
+            "| {} | {} | {:.3} | {:.3} | {:.3} |{}",
             a.kind,
             cells.join(" | "),
             a.over_datasets.mean,
             a.over_datasets.std,
-            a.seeds_sd
+            a.seeds_sd,
+            a.truth_mean
+                .filter(|_| truth)
+                .map_or(String::new(), |t| format!(" {t:.3} |"))
         );
     }
     let _ = writeln!(
         md,
         "\nSD across training seeds: the root mean square of each dataset's standard deviation \
-         over seeds.\n"
+         over seeds.{}\n",
+        if truth {
+            " Mean vs truth: the same mean against the simulator's exact truth instead of the \
+             labels."
+        } else {
+            ""
+        }
     );
     let mut claimed = 0;
     let mut lines = String::new();
@@ -241,33 +226,8 @@ mod tests {
             name,
             test: MaeStats::of(&runs),
             runs,
+            test_truth: None,
         }
-    }
-
-    #[test]
-    fn the_bound_is_the_larger_spread() {
-        let a = MeanStd {
-            mean: 0.2,
-            std: 0.03,
-            n: 5,
-        };
-        let b = MeanStd {
-            mean: 0.3,
-            std: 0.04,
-            n: 5,
-        };
-        let seeds_only = Spread::of(&a, &b, None);
-        assert!((seeds_only.bound() - 0.05).abs() < 1e-12);
-        assert!(
-            seeds_only
-                .describe()
-                .starts_with("the seeds' spread of 0.050")
-        );
-        let both = Spread::of(&a, &b, Some((0.06, 0.08)));
-        assert!((both.bound() - 0.1).abs() < 1e-12);
-        assert!(both.describe().contains("the datasets' (0.100)"));
-        let small = Spread::of(&a, &b, Some((0.0, 0.0)));
-        assert_eq!(small.bound(), seeds_only.bound());
     }
 
     #[test]
@@ -302,7 +262,6 @@ mod tests {
             md.contains("2 of 3 pairs differ beyond both spreads"),
             "{md}"
         );
-        assert_eq!(datasets_sd(&all, ReprKind::Late), None);
         // One dataset: no section.
         r.dataset_seeds.retain(|p| p.dataset_seed == 0);
         assert!(across(&r).is_empty());

@@ -2,39 +2,34 @@
 //! best single representation, by how much, at which scale and noise level, and whether in
 //! Experiment 2 they keep static's stop-phase accuracy and dynamic's motion response.
 //!
-//! Every sentence is computed from the run's numbers. A difference counts only when it is
-//! larger than the seeds' spread (the two standard deviations added in quadrature) and, in
-//! Experiment 1 when the run simulated several datasets, larger than the datasets' spread too
-//! ([`Spread`]); anything smaller is called a tie, so a verdict never rests on the luck of a few
-//! seeds or of one dataset.
+//! Every sentence is computed from the run's numbers and judged by the report's one rule
+//! ([`super::verdict`]): a difference counts only beyond the seeds' spread and, in Experiment 1
+//! when the run simulated several datasets, beyond the datasets' spread too, on the same numbers
+//! the datasets section compares; anything smaller is called a tie, so a verdict never rests on
+//! the luck of a few seeds or of one dataset.
 
 use std::fmt::Write as _;
 
-use evtac_experiments::results::{Exp2Setting, MeanStd, Results};
+use evtac_experiments::results::{Exp2Setting, Results};
 use evtac_repr::ReprKind;
 
-use super::dataset_seeds::{self, Spread};
+use super::verdict::{self, Side, Verdict};
 
-/// Whether `fusion` beats `reference` (test MAE, lower is better) beyond `spread`.
-fn beats(fusion: &MeanStd, reference: &MeanStd, spread: &Spread) -> bool {
-    reference.mean - fusion.mean > spread.bound()
-}
-
-/// How `fusion` compares with `reference` (test MAE, lower is better), beyond `spread`.
-fn compare(fusion: &MeanStd, reference: &MeanStd, spread: &Spread) -> String {
-    let diff = fusion.mean - reference.mean;
+/// How `fusion` compares with `reference` (test MAE, lower is better), by the report's rule.
+fn compare(fusion: &Side, reference: &Side) -> (String, Verdict) {
+    let judged = verdict::judge(fusion, reference);
+    let diff = -judged.diff; // the fusion's mean minus the reference's
     let percent = 100.0 * diff.abs() / reference.mean.max(f64::MIN_POSITIVE);
-    if diff.abs() <= spread.bound() {
-        format!("ties ({diff:+.3} deg, within {})", spread.describe())
-    } else if diff < 0.0 {
-        format!("beats it by {:.3} deg ({percent:.0} %)", -diff)
-    } else {
-        format!("is worse by {diff:.3} deg ({percent:.0} %)")
-    }
+    let text = match judged.verdict {
+        Verdict::Tied => format!("ties ({diff:+.3} deg, within {})", judged.spread.describe()),
+        Verdict::FirstLower => format!("beats it by {:.3} deg ({percent:.0} %)", -diff),
+        Verdict::SecondLower => format!("is worse by {diff:.3} deg ({percent:.0} %)"),
+    };
+    (text, judged.verdict)
 }
 
-/// The lower-MAE one of `Static` and `Dynamic` among `(kind, stats)`.
-fn best_single(cells: &[(ReprKind, MeanStd)]) -> Option<(ReprKind, MeanStd)> {
+/// The lower-MAE one of `Static` and `Dynamic` among `(kind, side)`.
+fn best_single(cells: &[(ReprKind, Side)]) -> Option<(ReprKind, Side)> {
     cells
         .iter()
         .filter(|(n, _)| matches!(n, ReprKind::Static | ReprKind::Dynamic))
@@ -42,37 +37,36 @@ fn best_single(cells: &[(ReprKind, MeanStd)]) -> Option<(ReprKind, MeanStd)> {
         .copied()
 }
 
-/// One line per fusion against the best single representation among `cells`; the wins
-/// (`where_`, fusion, by how many degrees) are added to `wins`. `datasets_sd` gives a
-/// representation's standard deviation across datasets where the run measured it.
+/// One line per fusion against the best single representation among `cells` (each side shown as
+/// over `datasets` datasets where it measured their spread); the wins (`where_`, fusion, by how
+/// many degrees) are added to `wins`.
 fn against_best(
     md: &mut String,
     where_: &str,
-    cells: &[(ReprKind, MeanStd)],
-    datasets_sd: &dyn Fn(ReprKind) -> Option<f64>,
+    cells: &[(ReprKind, Side)],
+    datasets: usize,
     wins: &mut Vec<String>,
 ) {
-    let Some((best, best_stats)) = best_single(cells) else {
+    let Some((best, best_side)) = best_single(cells) else {
         return;
     };
     for fusion in ReprKind::FUSIONS {
         let Some((_, f)) = cells.iter().find(|(n, _)| *n == fusion) else {
             continue;
         };
-        let spread = Spread::of(f, &best_stats, datasets_sd(fusion).zip(datasets_sd(best)));
-        if beats(f, &best_stats, &spread) {
+        let (text, verdict) = compare(f, &best_side);
+        if verdict == Verdict::FirstLower {
             wins.push(format!(
                 "{fusion} at {where_} (by {:.3} deg)",
-                best_stats.mean - f.mean
+                best_side.mean - f.mean
             ));
         }
         let _ = writeln!(
             md,
             "- {where_}: {fusion} ({}) against the best single representation, {best} ({}): \
-             {}.",
-            f.display(),
-            best_stats.display(),
-            compare(f, &best_stats, &spread)
+             {text}.",
+            f.display(datasets),
+            best_side.display(datasets),
         );
     }
 }
@@ -83,7 +77,7 @@ pub(super) fn section(md: &mut String, r: &Results) {
         return;
     }
     let _ = writeln!(md, "## Beyond OR: learned fusion\n");
-    let across = dataset_seeds::across(r);
+    let datasets = verdict::exp1_datasets(r);
     let _ = writeln!(
         md,
         "The paper fuses its two representations with a pixel-wise OR and leaves better fusion \
@@ -93,7 +87,7 @@ pub(super) fn section(md: &mut String, r: &Results) {
          concatenated before the paper's 256-128-64-2 head. Scale `{}`; a difference counts only \
          beyond the seeds' spread{}.\n",
         r.run.scale,
-        if across.is_empty() {
+        if datasets == 1 {
             ""
         } else {
             " and, in Experiment 1, beyond the datasets' too"
@@ -101,26 +95,22 @@ pub(super) fn section(md: &mut String, r: &Results) {
     );
     let mut lines = String::new();
     let mut wins = Vec::new();
-    let exp1: Vec<(ReprKind, MeanStd)> = r.exp1.iter().map(|e| (e.name, e.test.overall)).collect();
-    let exp1_sd = |kind| dataset_seeds::datasets_sd(&across, kind);
-    against_best(&mut lines, "Experiment 1", &exp1, &exp1_sd, &mut wins);
+    let exp1: Vec<(ReprKind, Side)> = ReprKind::in_order(r.exp1.iter().map(|e| e.name))
+        .into_iter()
+        .filter_map(|kind| Some((kind, verdict::exp1_side(r, kind)?)))
+        .collect();
+    against_best(&mut lines, "Experiment 1", &exp1, datasets, &mut wins);
     let mut levels: Vec<f64> = r.noise.iter().map(|p| p.level).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
     for level in levels.into_iter().filter(|&l| l != 1.0) {
-        let cells: Vec<(ReprKind, MeanStd)> = r
+        let cells: Vec<(ReprKind, Side)> = r
             .noise
             .iter()
             .filter(|p| p.level == level)
-            .map(|p| (p.name, p.test.overall))
+            .map(|p| (p.name, Side::of(&p.test.overall)))
             .collect();
-        against_best(
-            &mut lines,
-            &format!("noise x{level}"),
-            &cells,
-            &|_| None,
-            &mut wins,
-        );
+        against_best(&mut lines, &format!("noise x{level}"), &cells, 1, &mut wins);
     }
     // Experiment 2 under the pause-inclusive setting: static's stop, dynamic's motion.
     let (setting, label) = (
@@ -141,18 +131,10 @@ pub(super) fn section(md: &mut String, r: &Results) {
                  {}; its motion phase ({}) against dynamic's ({}): {}.",
                 f.stop.overall.display(),
                 st.stop.overall.display(),
-                compare(
-                    &f.stop.overall,
-                    &st.stop.overall,
-                    &Spread::of(&f.stop.overall, &st.stop.overall, None)
-                ),
+                compare(&Side::of(&f.stop.overall), &Side::of(&st.stop.overall)).0,
                 f.motion.overall.display(),
                 dy.motion.overall.display(),
-                compare(
-                    &f.motion.overall,
-                    &dy.motion.overall,
-                    &Spread::of(&f.motion.overall, &dy.motion.overall, None)
-                )
+                compare(&Side::of(&f.motion.overall), &Side::of(&dy.motion.overall)).0
             );
         }
     }
@@ -184,34 +166,42 @@ pub(super) fn section(md: &mut String, r: &Results) {
 mod tests {
     use super::*;
 
-    fn ms(mean: f64, std: f64) -> MeanStd {
-        MeanStd { mean, std, n: 3 }
-    }
-
-    fn seeds(a: &MeanStd, b: &MeanStd) -> String {
-        compare(a, b, &Spread::of(a, b, None))
+    fn side(mean: f64, std: f64) -> Side {
+        Side {
+            mean,
+            seeds_sd: std,
+            datasets_sd: None,
+        }
     }
 
     #[test]
     fn a_difference_counts_only_beyond_the_seeds_spread() {
+        let text = |a: Side, b: Side| compare(&a, &b).0;
         assert!(
-            seeds(&ms(0.10, 0.01), &ms(0.20, 0.01)).starts_with("beats it by 0.100 deg (50 %)")
+            text(side(0.10, 0.01), side(0.20, 0.01)).starts_with("beats it by 0.100 deg (50 %)")
         );
-        assert!(seeds(&ms(0.30, 0.01), &ms(0.20, 0.01)).starts_with("is worse by 0.100 deg"));
-        assert!(seeds(&ms(0.21, 0.01), &ms(0.20, 0.01)).starts_with("ties (+0.010 deg"));
+        assert!(text(side(0.30, 0.01), side(0.20, 0.01)).starts_with("is worse by 0.100 deg"));
+        assert!(text(side(0.21, 0.01), side(0.20, 0.01)).starts_with("ties (+0.010 deg"));
         // Beyond the seeds' spread but within the datasets': a tie.
-        let (f, s) = (ms(0.10, 0.01), ms(0.20, 0.01));
-        let wide = Spread::of(&f, &s, Some((0.1, 0.1)));
-        assert!(compare(&f, &s, &wide).starts_with("ties (-0.100 deg, within the larger"));
-        assert!(!beats(&f, &s, &wide));
+        let wide = |mean| Side {
+            mean,
+            seeds_sd: 0.01,
+            datasets_sd: Some(0.1),
+        };
+        let (text_wide, verdict) = compare(&wide(0.10), &wide(0.20));
+        assert!(
+            text_wide.starts_with("ties (-0.100 deg, within the larger"),
+            "{text_wide}"
+        );
+        assert_eq!(verdict, Verdict::Tied);
         let cells = [
-            (ReprKind::Static, ms(0.2, 0.0)),
-            (ReprKind::Dynamic, ms(0.1, 0.0)),
-            (ReprKind::Late, ms(0.05, 0.0)),
+            (ReprKind::Static, side(0.2, 0.0)),
+            (ReprKind::Dynamic, side(0.1, 0.0)),
+            (ReprKind::Late, side(0.05, 0.0)),
         ];
         assert_eq!(best_single(&cells).map(|b| b.0), Some(ReprKind::Dynamic));
         let (mut md, mut wins) = (String::new(), Vec::new());
-        against_best(&mut md, "Experiment 1", &cells, &|_| None, &mut wins);
+        against_best(&mut md, "Experiment 1", &cells, 1, &mut wins);
         assert_eq!(wins, ["Late at Experiment 1 (by 0.050 deg)"]);
         assert!(
             md.contains("Late (0.050 ± 0.000) against the best single representation, Dynamic"),

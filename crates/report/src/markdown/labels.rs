@@ -49,6 +49,14 @@ pub fn section(check: Option<&LabelCheck>) -> String {
             r.mean, r.max, r.n
         ));
     }
+    if let Some(r) = &check.truth_stop_rms_deg {
+        md.push_str(&format!(
+            " Over each stop (inside the stop check's margins), the labels' RMS error against \
+             the truth is {:.3} deg per trial on average (at most {:.3}, {} trials): their own \
+             error where the paper checks them, without the robot's repeatability.",
+            r.mean, r.max, r.n
+        ));
+    }
     md.push_str("\n\n");
     md
 }
@@ -64,12 +72,17 @@ mod tests {
             stop_error_deg: Summary::of(&[-0.05, 0.01, 0.02]),
             truth_rms_deg: Summary::of(&[0.01, 0.03]),
             label_source: LabelSource::Imu,
+            truth_stop_rms_deg: Summary::of(&[0.002, 0.004]),
         };
         let md = section(Some(&check));
         assert!(md.contains("-0.007 ± 0.038 deg over 3 stops"), "{md}");
         assert!(md.contains("the paper: -0.01 ± 0.04 deg"), "{md}");
         assert!(
             md.contains("0.020 deg per trial on average (at most 0.030, 2 trials)"),
+            "{md}"
+        );
+        assert!(
+            md.contains("against the truth is 0.003 deg per trial on average (at most 0.004, 2"),
             "{md}"
         );
         assert!(section(None).contains("Not checked"));
@@ -81,6 +94,7 @@ mod tests {
             stop_error_deg: None,
             truth_rms_deg: None,
             label_source: LabelSource::Commanded,
+            truth_stop_rms_deg: None,
         };
         let md = section(Some(&check));
         assert!(md.contains("the robot's commanded motion"), "{md}");

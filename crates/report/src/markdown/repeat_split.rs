@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use evtac_experiments::results::RepeatSplit;
 
-use super::dataset_seeds::Spread;
+use super::verdict::{self, Side, Verdict};
 
 /// The section, or nothing when no condition of Experiment 1 has two trials.
 pub(super) fn section(md: &mut String, split: Option<&RepeatSplit>) {
@@ -42,23 +42,23 @@ pub(super) fn section(md: &mut String, split: Option<&RepeatSplit>) {
             md,
             "| {} | {} | {} | {change:+.3} |",
             together.name.title(),
-            a.display(),
-            b.display()
+            super::cell_with_truth(a, paper.test_truth.as_ref()),
+            super::cell_with_truth(b, together.test_truth.as_ref())
         );
-        let spread = Spread::of(a, b, None);
-        verdicts.push(if change.abs() > spread.bound() {
+        let judged = verdict::judge(&Side::of(a), &Side::of(b));
+        verdicts.push(if judged.verdict == Verdict::Tied {
+            format!(
+                "{}: {change:+.3} deg, within {}",
+                together.name.title(),
+                judged.spread.describe()
+            )
+        } else {
             format!(
                 "{}: {} by {:.3} deg with the repeats kept together, beyond {}",
                 together.name.title(),
                 if change > 0.0 { "worse" } else { "better" },
                 change.abs(),
-                spread.describe()
-            )
-        } else {
-            format!(
-                "{}: {change:+.3} deg, within {}",
-                together.name.title(),
-                spread.describe()
+                judged.spread.describe()
             )
         });
     }
