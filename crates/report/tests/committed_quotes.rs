@@ -51,3 +51,51 @@ fn the_simulator_doc_quotes_the_reports_label_error_against_the_truth() {
         );
     }
 }
+
+/// The mean over datasets of `kind`'s per-dataset test MAE in `r`.
+fn over_datasets(r: &Results, kind: evtac_repr::ReprKind) -> f64 {
+    let means: Vec<f64> = r
+        .dataset_seeds
+        .iter()
+        .filter(|p| p.name == kind)
+        .map(|p| p.test.overall.mean)
+        .collect();
+    assert!(!means.is_empty(), "no datasets of {kind}");
+    means.iter().sum::<f64>() / means.len() as f64
+}
+
+#[test]
+fn the_guide_quotes_the_example_reports_choice_and_fusion_margins() {
+    use evtac_repr::ReprKind::{Late, Stacked, Static};
+    let doc = doc("guide.md");
+    let r = results("report-example");
+    let tuned = r
+        .tuning
+        .iter()
+        .find(|t| t.repr == Static)
+        .expect("static was tuned");
+    let static_mean = over_datasets(&r, Static);
+    let quotes = [
+        format!("the static decay chosen is {} ms", tuned.chosen_time_ms),
+        format!(
+            "Static and Stacked differ by {:.3} deg",
+            (over_datasets(&r, Stacked) - static_mean).abs()
+        ),
+        format!(
+            "Static and Late by {:.3} deg",
+            (over_datasets(&r, Late) - static_mean).abs()
+        ),
+    ];
+    for quote in &quotes {
+        assert!(
+            doc.contains(quote.as_str()),
+            "docs/guide.md does not say {quote:?} (from docs/report-example/results.json)"
+        );
+    }
+    // Both quoted as not claimed: the report's rule must agree.
+    for (a, b, v) in evtac_report::exp1_verdicts(&r) {
+        if a == Static && matches!(b, Stacked | Late) {
+            assert_eq!(v, evtac_report::Verdict::Tied, "{a} and {b}");
+        }
+    }
+}
