@@ -323,8 +323,9 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
     let a = args(&fresh);
     run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let jobs = evtac_experiments::job::read(&list).unwrap();
-    // The tiny cross: 3 static and 3 dynamic settings.
-    assert_eq!(jobs.len(), 6, "{jobs:?}");
+    // The tiny cross: 6 static settings (the paper grid's 3 and the extended grid's 3 longer
+    // decays at the cross's threshold) and 3 dynamic ones.
+    assert_eq!(jobs.len(), 9, "{jobs:?}");
     let train: Vec<&TrainJob> = jobs
         .iter()
         .filter_map(|j| match j {
@@ -332,9 +333,9 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
             _ => None,
         })
         .collect();
-    assert_eq!(train.len(), 6);
+    assert_eq!(train.len(), 9);
     let kinds = |k: ReprKind| train.iter().filter(|t| t.spec.repr.kind() == k).count();
-    assert_eq!((kinds(ReprKind::Static), kinds(ReprKind::Dynamic)), (3, 3));
+    assert_eq!((kinds(ReprKind::Static), kinds(ReprKind::Dynamic)), (6, 3));
     // Run one as a Slurm task would: it trains what a local run trains (the same bytes as the
     // tiny run's model of that setting), and it is no longer listed.
     let list_s = list.display().to_string();
@@ -347,7 +348,7 @@ fn finished_run_exports_no_jobs_and_a_fresh_one_exports_the_tuning_grid() {
     );
     let a = args(&fresh);
     run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(evtac_experiments::job::read(&list).unwrap().len(), 5);
+    assert_eq!(evtac_experiments::job::read(&list).unwrap().len(), 8);
 }
 
 #[test]

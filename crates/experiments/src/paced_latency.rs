@@ -630,7 +630,8 @@ mod tests {
         );
         let text = include_str!("../../../docs/report-example/results.json");
         let mut r: crate::results::Results = serde_json::from_str(text).unwrap();
-        assert!(r.paced_latency.is_empty());
+        // Results without the replay (older runs) write no key for it.
+        r.paced_latency.clear();
         assert!(!serde_json::to_string(&r).unwrap().contains("paced_latency"));
         r.paced_latency.push(cell);
         let again: crate::results::Results =
