@@ -1,0 +1,199 @@
+//! `k-noise=DURATION`: dv-processing's `dv::noise::KNoiseFilter`
+//! (`include/dv-processing/noise/k_noise_filter.hpp`), the O(N)-memory filter of Khodamoradi
+//! and Kastner: one slot per column and one per row instead of one per pixel.
+//!
+//! A column's slot holds the last event in that column (its timestamp, row and polarity), a
+//! row's slot the last event in that row (timestamp, column, polarity). An event at `(x, y)` is
+//! kept when a slot of column `x - 1`, `x` or `x + 1` holds an event of the same polarity at a
+//! row within 1 of `y`, or a slot of row `y - 1`, `y` or `y + 1` one at a column within 1 of `x`,
+//! with `t - slot.t <= DURATION` (inclusive, unlike the background-activity filter's strict
+//! comparison). Columns and rows beyond the sensor's edges are not looked at. Then, kept or not,
+//! the event takes the slots of its column and its row.
+//!
+//! No copy of this filter's C++ source was at hand, so these rules were read off dv-processing
+//! 2.0.4's binary (its Python `retain`, event by event on probing streams) and are checked
+//! against it on random streams and a real recording (`tests/dv_processing.rs`). Among them:
+//! slots start as (timestamp 0, coordinate 0, OFF), so an OFF event at `t <= DURATION` within
+//! one pixel of row 0 or column 0 is kept; the difference is signed (a timestamp earlier than
+//! the slot's counts as recent); the 3x3 neighbourhood includes the pixel itself.
+
+use evtac_events::{Event, Resolution};
+
+use crate::{Filter, Micros};
+
+/// The last event of one column (`at` its row) or of one row (`at` its column).
+#[derive(Debug, Clone, Copy, Default)]
+struct Slot {
+    t: i64,
+    at: u16,
+    polarity: bool,
+}
+
+/// Keeps events supported by a recent event of the same polarity in the neighbouring columns'
+/// or rows' slots.
+#[derive(Debug, Clone)]
+pub struct KNoise {
+    columns: Vec<Slot>,
+    rows: Vec<Slot>,
+    duration: i64,
+    removed: u64,
+}
+
+impl KNoise {
+    /// The filter for `sensor`, with slots counted for `duration`.
+    pub fn new(sensor: Resolution, duration: Micros) -> Self {
+        Self {
+            // Default slots are dv-processing's starting ones: (0, 0, OFF).
+            columns: vec![Slot::default(); usize::from(sensor.width)],
+            rows: vec![Slot::default(); usize::from(sensor.height)],
+            duration: duration.get(),
+            removed: 0,
+        }
+    }
+
+    /// Whether a neighbouring column's or row's slot supports `event`.
+    fn supported(&self, event: &Event) -> bool {
+        let near = |slot: &Slot, coordinate: u16| {
+            slot.polarity == event.polarity
+                && slot.at.abs_diff(coordinate) <= 1
+                // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
+                && event.t.wrapping_sub(slot.t) <= self.duration
+        };
+        neighbours(&self.columns, event.x).any(|slot| near(slot, event.y))
+            || neighbours(&self.rows, event.y).any(|slot| near(slot, event.x))
+    }
+}
+
+/// The slots at `i - 1`, `i` and `i + 1` that exist.
+fn neighbours(slots: &[Slot], i: u16) -> impl Iterator<Item = &Slot> {
+    let i = usize::from(i);
+    slots[i.saturating_sub(1)..(i + 2).min(slots.len())].iter()
+}
+
+impl Filter for KNoise {
+    fn name(&self) -> &'static str {
+        "k-noise"
+    }
+
+    fn keep(&mut self, event: &Event) -> bool {
+        let (x, y) = (usize::from(event.x), usize::from(event.y));
+        // Off the sensor dv-processing would index past its slots: removed here.
+        if x >= self.columns.len() || y >= self.rows.len() {
+            self.removed += 1;
+            return false;
+        }
+        let keep = self.supported(event);
+        self.columns[x] = Slot {
+            t: event.t,
+            at: event.y,
+            polarity: event.polarity,
+        };
+        self.rows[y] = Slot {
+            t: event.t,
+            at: event.x,
+            polarity: event.polarity,
+        };
+        self.removed += u64::from(!keep);
+        keep
+    }
+
+    fn removed(&self) -> u64 {
+        self.removed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: i64 = 1_000_000;
+
+    fn run(events: &[(i64, u16, u16, bool)]) -> Vec<bool> {
+        let mut f = KNoise::new(Resolution::new(20, 20), Micros::new(1_000).unwrap());
+        events
+            .iter()
+            .map(|&(t, x, y, polarity)| f.keep(&Event { t, x, y, polarity }))
+            .collect()
+    }
+
+    #[test]
+    fn the_three_by_three_neighbourhood_supports_inclusively() {
+        for dy in -2i32..=2 {
+            for dx in -2i32..=2 {
+                let (x, y) = ((5 + dx) as u16, (5 + dy) as u16);
+                let near = dx.abs() <= 1 && dy.abs() <= 1;
+                assert_eq!(run(&[(T, 5, 5, true), (T + 10, x, y, true)])[1], near);
+            }
+        }
+        assert_eq!(
+            run(&[(T, 5, 5, true), (T + 1_000, 6, 6, true)]),
+            [false, true]
+        );
+        assert_eq!(
+            run(&[(T, 5, 5, true), (T + 1_001, 6, 6, true)]),
+            [false, false]
+        );
+    }
+
+    #[test]
+    fn polarity_must_match() {
+        assert_eq!(
+            run(&[(T, 5, 5, true), (T + 10, 6, 5, false)]),
+            [false, false]
+        );
+    }
+
+    #[test]
+    fn one_slot_per_column_and_per_row() {
+        // (5, 15) takes column 5's slot; row 5's still supports (6, 6).
+        assert_eq!(
+            run(&[(T, 5, 5, true), (T + 1, 5, 15, true), (T + 10, 6, 6, true)]),
+            [false, false, true]
+        );
+        // With (15, 5) taking row 5's slot as well, nothing is left.
+        assert_eq!(
+            run(&[
+                (T, 5, 5, true),
+                (T + 1, 5, 15, true),
+                (T + 2, 15, 5, true),
+                (T + 10, 6, 6, true)
+            ]),
+            [false, false, false, false]
+        );
+        // An OFF event takes the slots too.
+        assert_eq!(
+            run(&[
+                (T, 5, 5, true),
+                (T + 1, 5, 15, false),
+                (T + 2, 15, 5, false),
+                (T + 10, 6, 6, true)
+            ]),
+            [false, false, false, false]
+        );
+    }
+
+    #[test]
+    fn slots_start_as_an_off_event_at_zero_in_row_and_column_zero() {
+        assert_eq!(run(&[(1_000, 5, 1, false)]), [true]);
+        assert_eq!(run(&[(1_000, 1, 7, false)]), [true]);
+        assert_eq!(run(&[(1_001, 5, 1, false)]), [false]);
+        assert_eq!(run(&[(1_000, 5, 1, true)]), [false]);
+        assert_eq!(run(&[(1_000, 5, 5, false)]), [false]);
+    }
+
+    #[test]
+    fn edges_do_not_wrap_and_earlier_timestamps_count_as_recent() {
+        assert_eq!(
+            run(&[(T, 19, 5, true), (T + 1, 0, 5, true)]),
+            [false, false]
+        );
+        assert_eq!(
+            run(&[(T, 19, 19, true), (T + 1, 18, 18, true)]),
+            [false, true]
+        );
+        assert_eq!(
+            run(&[(T, 5, 5, true), (T - 5_000, 5, 5, true)]),
+            [false, true]
+        );
+    }
+}
