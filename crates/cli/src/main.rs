@@ -40,6 +40,9 @@ enum Command {
     Info(commands::info::Args),
     /// Convert an event recording to AEDAT4, CSV or NPY (chosen by the output's extension).
     Convert(commands::convert::Args),
+    /// Filter an event recording (dv-processing's noise, polarity and region filters exactly, a
+    /// refractory period, the dome's disc) into AEDAT4, CSV or NPY.
+    Filter(commands::filter::Args),
     /// Simulate NeuroTac trials of one of the paper's experiments (with evtac's sensor model and
     /// timing) into a dataset folder.
     Simulate(commands::simulate::Args),
@@ -83,6 +86,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
+        Command::Filter(args) => commands::filter::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
         Command::Stats(args) => commands::stats::run(args),
         Command::Import(args) => commands::import::run(args),

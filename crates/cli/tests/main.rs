@@ -6,6 +6,7 @@ mod convert;
 mod data_loss;
 mod doc_examples;
 mod evaluate;
+mod filter;
 mod import;
 mod info;
 mod jobs;

@@ -3,6 +3,7 @@
 pub mod check;
 pub mod convert;
 pub mod evaluate;
+pub mod filter;
 pub mod import;
 pub mod info;
 pub mod jobs;

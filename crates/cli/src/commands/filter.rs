@@ -1,0 +1,106 @@
+//! `evtac filter`: a recording through event filters (`evtac_filters`: dv-processing's noise,
+//! polarity and region filters exactly, a refractory period and the dome's disc), in the order
+//! given, from any format evtac reads to any it writes. IMU samples and triggers pass untouched;
+//! each filter's removed events are printed.
+//!
+//! The filters are built for the recording's sensor before anything is written, so a SPEC that
+//! does not fit (a region outside the sensor) leaves no output; outputs appear only once
+//! complete ([`evtac_events::output`]), and an output that is the input is refused.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use evtac_events::EventWriter;
+use evtac_events::output::refuse_input;
+use evtac_filters::{Chain, Filter, FilterSpec};
+
+/// Arguments of `evtac filter`.
+#[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Examples:\n  evtac filter raw.aedat4 clean.aedat4 --filter background-activity=10ms\n  \
+                        evtac filter raw.aedat4 clean.npy --filter refractory=1ms --filter \
+                        circle=120,120,110"
+)]
+pub struct Args {
+    /// The recording to read (any format `evtac info` reads).
+    pub input: PathBuf,
+    /// The file to write; its extension picks the format: .aedat4 (with the IMU and triggers),
+    /// .csv or .npy.
+    pub output: PathBuf,
+    /// A filter, applied in the order given (repeat the flag for a chain):
+    /// `background-activity=DURATION`, `fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]`,
+    /// `k-noise=DURATION`, `polarity=on|off`, `region=X,Y,W,H`, `refractory=DURATION`,
+    /// `circle=CX,CY,R`. Durations take `us`, `ms` or `s`.
+    #[arg(long = "filter", value_name = "SPEC", required = true)]
+    pub filters: Vec<FilterSpec>,
+    #[command(flatten)]
+    pub sensor: crate::sensor::SensorArgs,
+    #[command(flatten)]
+    pub streams: crate::streams::StreamArgs,
+}
+
+/// What a filtering did: events read and written, and each filter's removed count in order.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Counts {
+    /// Events read.
+    pub events_in: u64,
+    /// Events written.
+    pub events_out: u64,
+    /// Each filter's name and the events it removed.
+    pub removed: Vec<(&'static str, u64)>,
+}
+
+/// Runs `evtac filter`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let counts = filter(&args)?;
+    for ((name, removed), spec) in counts.removed.iter().zip(&args.filters) {
+        eprintln!("{spec}: removed {removed} events ({name})");
+    }
+    eprintln!(
+        "wrote {} of {} events to {}",
+        counts.events_out,
+        counts.events_in,
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Filters `args.input` into `args.output` as `evtac filter` does.
+pub fn filter(args: &Args) -> anyhow::Result<Counts> {
+    refuse_input(&args.output, &[&args.input])?;
+    let mut reader = evtac_events::open_with(&args.input, &args.streams.selection())?;
+    if let Some(resolution) = args.sensor.sensor {
+        reader.set_resolution(resolution)?;
+    }
+    let Some(sensor) = reader.resolution() else {
+        bail!(
+            "{} is {} and does not store the sensor size: pass --sensor WIDTHxHEIGHT",
+            args.input.display(),
+            reader.format()
+        );
+    };
+    let mut chain = Chain::build(&args.filters, sensor)
+        .with_context(|| format!("{}: the {sensor} sensor", args.input.display()))?;
+    let mut writer = EventWriter::create(&args.output, Some(sensor), reader.source())?;
+    let bar = crate::progress::bytes(reader.file_len(), "filtering");
+    let mut kept = Vec::new();
+    let mut counts = Counts::default();
+    while let Some(chunk) = reader.next_chunk()? {
+        kept.clear();
+        chain.retain(chunk.events, &mut kept);
+        writer.write_events(&kept)?;
+        writer.write_imu(chunk.imu)?;
+        writer.write_triggers(chunk.triggers)?;
+        counts.events_in += chunk.events.len() as u64;
+        counts.events_out += kept.len() as u64;
+        bar.set_position(reader.position());
+    }
+    bar.finish_and_clear();
+    writer.finish()?;
+    counts.removed = chain
+        .filters()
+        .iter()
+        .map(|f| (f.name(), f.removed()))
+        .collect();
+    Ok(counts)
+}
