@@ -355,19 +355,19 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
         }
         if all_done && let Some((_, c)) = best {
             tuned.push(c);
-            // The recheck of the best settings needs only the grid: it runs beside Experiments
-            // 1 and 2.
             let top = tuning::top(&ranked, plan);
             rechecks.extend(tuning::recheck_jobs(&ds1, kind, &top, plan, seed, &models));
         }
     }
-    jobs.extend(
-        rechecks
-            .into_iter()
-            .filter(|j| !exp1::finished(&j.out))
-            .map(Job::Train),
-    );
     if let [s, d] = tuned[..] {
+        // The recheck of the best settings runs in the same round as Experiments 1 and 2, once
+        // both grids are done, so a round never mixes the grids with what follows them.
+        jobs.extend(
+            rechecks
+                .into_iter()
+                .filter(|j| !exp1::finished(&j.out))
+                .map(Job::Train),
+        );
         let reprs = exp1::of_plan(plan, s, d);
         let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);
         train.extend(label_noise::jobs(&ds1, &reprs, plan, seed, &models));
