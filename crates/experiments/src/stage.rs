@@ -228,7 +228,8 @@ impl CostModel {
 
     /// Expected seconds of the whole reproduction: every stage it will report.
     ///
-    /// The latency stage's end-to-end replay runs on the wall clock ([`paced_replay_seconds`]).
+    /// The latency stage's end-to-end replay runs on the wall clock, as long as the events it
+    /// replays (`crate::paced_latency::extent`).
     pub fn total_seconds(&self) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
         let reprs = plan.representations();
