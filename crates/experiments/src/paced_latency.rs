@@ -112,17 +112,10 @@ pub use crate::results::{Load, PacedLatencyCell};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// A recording could not be read.
+    /// A recording could not be read, or the estimator could not be made or failed on the
+    /// events before motion onset: the same failures as the processing-time study's.
     #[error(transparent)]
-    Dataset(#[from] dataset::Error),
-    /// The estimator could not be made, or failed on the events before motion onset.
-    #[error("trial `{trial}`: {source}")]
-    Estimator {
-        /// The trial.
-        trial: String,
-        /// The cause.
-        source: evtac_online::EstimatorError,
-    },
+    Latency(#[from] latency::Error),
     /// The replay's pipeline failed.
     #[error("trial `{trial}`, replay at recorded pace: {source}")]
     Replay {
@@ -168,7 +161,8 @@ pub fn measure(
     let trials = chosen(test, extent.trials);
     let mut recordings = Vec::with_capacity(trials.len());
     for meta in &trials {
-        let (sensor, mut events) = dataset::read_full(&ds.dir.join(&meta.file))?;
+        let (sensor, mut events) =
+            dataset::read_full(&ds.dir.join(&meta.file)).map_err(latency::Error::Dataset)?;
         let end = meta
             .motion_end_us
             .min(meta.motion_start_us.saturating_add(extent.motion_ms * 1000));
@@ -205,9 +199,11 @@ pub fn measure(
                         .map(shifted)
                         .take_while(|e| e.t <= last)
                         .collect();
-                    let failed = |source| Error::Estimator {
-                        trial: trial(),
-                        source,
+                    let failed = |source| {
+                        Error::Latency(latency::Error::Estimator {
+                            trial: trial(),
+                            source,
+                        })
                     };
                     let mut estimator =
                         Estimator::for_model(model, *sensor, step).map_err(failed)?;
