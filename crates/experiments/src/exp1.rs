@@ -212,6 +212,7 @@ pub(crate) fn run_jobs(
         progress,
     )?;
     let mut results = Vec::new();
+    let mut truth_memo = None;
     for &config in reprs {
         let kind = config.kind();
         let test = training::load_split(
@@ -222,7 +223,12 @@ pub(crate) fn run_jobs(
             Sampling::MOTION,
             &[Phase::Motion],
         )?;
-        let truth = crate::truth::of_split(cache, splits, Split::Test, &test)?;
+        // The test samples are the same trials at the same times for every representation:
+        // their truth is read once.
+        if truth_memo.is_none() {
+            truth_memo = Some(crate::truth::of_split(cache, splits, Split::Test, &test)?);
+        }
+        let truth = truth_memo.as_ref().and_then(Option::as_ref);
         let mut runs = Vec::new();
         let mut truth_runs = Vec::new();
         let mut val_runs = Vec::new();

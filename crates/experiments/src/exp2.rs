@@ -70,6 +70,7 @@ pub fn run(
     let sampling = Sampling::WITH_STOP;
     exp1::features_then_training(cache, splits, reprs, sampling, stages, &jobs, progress)?;
     let mut cells = Vec::new();
+    let mut truth_memo = None;
     for setting in Exp2Setting::ALL {
         for &config in reprs {
             let name = config.kind();
@@ -89,7 +90,12 @@ pub fn run(
                     .map(|s| training::load_model(&model_dir(out, setting, name, s)))
                     .collect::<Result<_, _>>()?
             };
-            let truth = crate::truth::of_split(cache, splits, Split::Test, &test)?;
+            // The test samples are the same trials at the same times for every representation:
+            // their truth is read once.
+            if truth_memo.is_none() {
+                truth_memo = Some(crate::truth::of_split(cache, splits, Split::Test, &test)?);
+            }
+            let truth = truth_memo.as_ref().and_then(Option::as_ref);
             let (mut motion, mut stop) = (Vec::new(), Vec::new());
             let (mut motion_truth, mut stop_truth) = (Vec::new(), Vec::new());
             for m in &models {
