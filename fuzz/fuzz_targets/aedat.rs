@@ -8,5 +8,5 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    evtac_events::aedat::fuzz_decode(data);
+    evtac_formats::aedat::fuzz_decode(data);
 });

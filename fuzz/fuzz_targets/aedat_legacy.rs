@@ -7,13 +7,13 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = evtac_events::aedat_legacy::decode_all(data);
+    let _ = evtac_formats::aedat_legacy::decode_all(data);
     for header in [
         &b"#!AER-DAT2.0\r\n# AEChip: DAVIS346B\r\n"[..],
         &b"#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS240C\r\n#!END-HEADER\r\n"[..],
     ] {
         let mut file = header.to_vec();
         file.extend_from_slice(data);
-        let _ = evtac_events::aedat_legacy::decode_all(&file);
+        let _ = evtac_formats::aedat_legacy::decode_all(&file);
     }
 });

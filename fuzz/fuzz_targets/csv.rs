@@ -4,7 +4,7 @@
 #![no_main]
 
 use evtac_events::Resolution;
-use evtac_events::csv::CsvReader;
+use evtac_formats::csv::CsvReader;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -7,8 +7,8 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = evtac_events::evt::decode_all(data);
+    let _ = evtac_formats::evt::decode_all(data);
     let mut file = b"% evt 2.0\n% geometry 1280x720\n% end\n".to_vec();
     file.extend_from_slice(data);
-    let _ = evtac_events::evt::decode_all(&file);
+    let _ = evtac_formats::evt::decode_all(&file);
 });

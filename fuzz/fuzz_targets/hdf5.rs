@@ -5,7 +5,7 @@
 
 #![no_main]
 
-use evtac_events::hdf5::fuzz_decode;
+use evtac_formats::hdf5::fuzz_decode;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

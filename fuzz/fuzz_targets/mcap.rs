@@ -5,7 +5,7 @@
 
 #![no_main]
 
-use evtac_events::ros::fuzz_decode_mcap;
+use evtac_formats::ros::fuzz_decode_mcap;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -4,7 +4,7 @@
 
 #![no_main]
 
-use evtac_events::neurotac::fuzz_decode;
+use evtac_formats::neurotac::fuzz_decode;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

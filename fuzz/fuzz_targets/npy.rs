@@ -3,7 +3,7 @@
 
 #![no_main]
 
-use evtac_events::npy::NpyReader;
+use evtac_formats::npy::NpyReader;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

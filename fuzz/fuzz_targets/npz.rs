@@ -4,7 +4,7 @@
 
 #![no_main]
 
-use evtac_events::npz::fuzz_decode;
+use evtac_formats::npy::npz::fuzz_decode;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use crate::common::{evtac, run_ok};
-use evtac_events::{Event, read_recording};
+use evtac_events::Event;
+use evtac_formats::read_recording;
 use evtac_testkit::real_fixture;
 
 fn s(p: &Path) -> &str {
@@ -111,9 +112,9 @@ fn missing_or_wrong_resolution_is_a_clear_error() {
 
 /// An AEDAT4 file with events, IMU and triggers over 2 s; with a data table unless `table` is
 /// false.
-fn with_triggers(path: &Path, table: bool) -> evtac_events::Recording {
-    use evtac_events::aedat::{AedatWriter, WriterConfig};
+fn with_triggers(path: &Path, table: bool) -> evtac_formats::Recording {
     use evtac_events::{ImuSample, Resolution, Trigger};
+    use evtac_formats::aedat::{AedatWriter, WriterConfig};
     let t0 = 1_700_000_000_000_000i64;
     let events: Vec<Event> = (0..200_000i64)
         .map(|i| Event {
@@ -195,9 +196,9 @@ fn convert_range(src: &Path, out: &Path, from: i64, to: i64, extra: &[&str]) -> 
 }
 
 /// `rec` cut to `[from, to)` by filtering what was read whole.
-fn filtered(rec: &evtac_events::Recording, from: i64, to: i64) -> evtac_events::Recording {
+fn filtered(rec: &evtac_formats::Recording, from: i64, to: i64) -> evtac_formats::Recording {
     let inside = |t: i64| from <= t && t < to;
-    evtac_events::Recording {
+    evtac_formats::Recording {
         events: rec.events.iter().copied().filter(|e| inside(e.t)).collect(),
         imu: rec.imu.iter().copied().filter(|s| inside(s.t)).collect(),
         triggers: rec
@@ -269,7 +270,7 @@ fn time_range_without_a_usable_data_table_warns_once_and_gives_the_same_result()
     // The same data with a table, whose LZ4 frame is then broken.
     with_triggers(&damaged, true);
     let mut bytes = std::fs::read(&damaged).unwrap();
-    let table = evtac_events::aedat::AedatReader::from_slice(&bytes)
+    let table = evtac_formats::aedat::AedatReader::from_slice(&bytes)
         .unwrap()
         .header()
         .data_table_position

@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::common::{run_err, run_ok};
-use evtac_events::{Event, EventWriter, ImuSample, Resolution, read_recording};
+use evtac_events::{Event, ImuSample, Resolution};
+use evtac_formats::{EventWriter, read_recording};
 use evtac_testkit::{real_fixture, run_python};
 
 fn s(p: &Path) -> &str {
@@ -145,7 +146,7 @@ fn a_failed_convert_leaves_no_output_and_an_earlier_one_untouched() {
     assert_eq!(std::fs::read(&out).unwrap(), b"earlier");
     run_ok(&["convert", s(&fixture), s(&out)]);
     assert_eq!(
-        evtac_events::read_recording(&out)
+        evtac_formats::read_recording(&out)
             .map(|r| r.events.len())
             .ok(),
         read_recording(&fixture).map(|r| r.events.len()).ok()

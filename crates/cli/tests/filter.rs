@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use crate::common::{run_err, run_ok};
-use evtac_events::read_recording;
 use evtac_filters::{Chain, Filter, FilterSpec};
+use evtac_formats::read_recording;
 use evtac_testkit::real_fixture;
 
 fn s(p: &Path) -> &str {

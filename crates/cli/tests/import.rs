@@ -4,7 +4,7 @@
 
 use crate::common::{evtac, run_err, run_ok, simulate_session_tiny, simulate_tiny};
 use evtac_events::manifest::Manifest;
-use evtac_events::read_recording;
+use evtac_formats::read_recording;
 
 #[test]
 fn imports_a_session_and_refuses_bad_logs() {

@@ -60,8 +60,8 @@ fn broken_file_is_an_error_naming_it() {
 
 #[test]
 fn triggers_are_counted() {
-    use evtac_events::aedat::{AedatWriter, WriterConfig};
     use evtac_events::{Resolution, Trigger};
+    use evtac_formats::aedat::{AedatWriter, WriterConfig};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sync.aedat4");
     let mut w =

@@ -118,7 +118,7 @@ fn as_refs(v: &[String]) -> Vec<&str> {
 /// A 320x240 recording with events all over the sensor, and sample times in it.
 fn recording(dir: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
     let path = dir.join("trial.aedat4");
-    let mut w = evtac_events::EventWriter::create(
+    let mut w = evtac_formats::EventWriter::create(
         &path,
         Some(evtac_events::Resolution::new(320, 240)),
         None,

@@ -23,7 +23,7 @@ fn close(what: &str, got: f64, want: f64, relative: f64) {
 
 /// Events in the recording at `path`.
 fn events(path: &std::path::Path) -> usize {
-    evtac_events::read_recording(path).unwrap().events.len()
+    evtac_formats::read_recording(path).unwrap().events.len()
 }
 
 #[test]

@@ -55,7 +55,7 @@ impl CheckError {
 /// it. A reader may gather it while decoding (see [`EventCheck::check_summarized`]) to spare a
 /// second pass over the events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct ChunkSummary {
+pub struct ChunkSummary {
     /// Whether every event lies inside the resolution (`true` when there is none).
     pub in_bounds: bool,
     /// Whether every timestamp is at least the one before it (within the chunk).
@@ -129,7 +129,7 @@ impl EventCheck {
 
     /// Validates the next chunk given its `summary`, which the caller computed from exactly
     /// these events and against [`resolution`](Self::resolution).
-    pub(crate) fn check_summarized(
+    pub fn check_summarized(
         &mut self,
         events: &[Event],
         summary: ChunkSummary,

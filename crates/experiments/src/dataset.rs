@@ -46,7 +46,7 @@ pub enum Error {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: evtac_events::Error,
+        source: evtac_formats::Error,
     },
     /// A recording is smaller than the 240 x 240 crop.
     #[error("{path}: sensor {sensor} is smaller than the {CROP} crop")]
@@ -143,7 +143,7 @@ fn io_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
 /// Reads a recording's events (any format evtac reads) on the full sensor, with the sensor's resolution (the
 /// crop size when the header has none, i.e. the recording is taken as already cropped).
 pub fn read_full(path: &Path) -> Result<(Resolution, Vec<Event>), Error> {
-    let rec = evtac_events::read_recording(path).map_err(|source| Error::Recording {
+    let rec = evtac_formats::read_recording(path).map_err(|source| Error::Recording {
         path: path.to_path_buf(),
         source,
     })?;

@@ -293,7 +293,7 @@ fn the_dvxplorer_recording_filters_as_in_dv_processing() {
     let Some(path) = evtac_testkit::real_fixture("dvxplorer_320x240_imu.aedat4") else {
         return;
     };
-    let recording = evtac_events::read_recording(&path).unwrap();
+    let recording = evtac_formats::read_recording(&path).unwrap();
     let sensor = recording.resolution.expect("the recording's resolution");
     let events = recording.events;
     let mut cases = Vec::new();

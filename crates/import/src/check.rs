@@ -8,7 +8,7 @@
 //!   below zero, a motion window that ends after it starts, stop columns all set or all empty
 //!   with the stop inside the motion and its angle between zero and the total;
 //! - every trial recording (and truth file) present and readable to its end
-//!   ([`evtac_events::Summary`]), on a sensor no smaller than the crop;
+//!   ([`evtac_formats::Summary`]), on a sensor no smaller than the crop;
 //! - each recording's event and IMU time spans cover its motion window and the still lead-in
 //!   the labels need before it ([`LabelConfig::still_lead_in_us`]), with IMU samples at the rate
 //!   the labels' bias needs ([`LabelConfig::min_imu_rate_hz`]) unless the dataset is labelled
@@ -19,9 +19,9 @@
 //!   depth.
 
 use crate::inputs::{IDENTITY_CALIBRATION_FLAG, Inputs, MaskSource, NO_MASK_FLAG};
-use evtac_events::Summary;
 use evtac_events::layout::{MANIFEST_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{COLUMNS, Manifest, ManifestError, TrialMeta};
+use evtac_formats::Summary;
 use evtac_labels::{CalibrationSource, LabelConfig, LabelSource};
 use evtac_repr::CROP;
 use evtac_sim::Protocol;

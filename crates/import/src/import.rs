@@ -23,7 +23,7 @@ use crate::robot_log::RobotLog;
 use evtac_events::IoError;
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
-use evtac_events::{EventWriter, RangeIndex};
+use evtac_formats::{EventWriter, RangeIndex};
 use evtac_labels::{CalibrationSource, LabelSource};
 use std::path::{Path, PathBuf};
 
@@ -74,7 +74,7 @@ pub enum ImportError {
     Io(#[from] IoError),
     /// The session or the no-contact recording could not be read, or a trial not written.
     #[error(transparent)]
-    Recording(#[from] evtac_events::Error),
+    Recording(#[from] evtac_formats::Error),
     /// The calibration file is not a calibration.
     #[error("--calibration: {0}")]
     Calibration(evtac_labels::Error),
@@ -196,7 +196,7 @@ fn copy_range(
     range: Option<(i64, i64)>,
     dest: &Path,
 ) -> Result<Copied, ImportError> {
-    let mut reader = evtac_events::open(source)?;
+    let mut reader = evtac_formats::open(source)?;
     let index = match range {
         Some((from, to)) => Some(reader.select_range(from, to)?),
         None => None,
@@ -261,7 +261,7 @@ fn cut_session(
     }
     let mut order: Vec<usize> = (0..cuts.len()).collect();
     order.sort_by_key(|&k| (cuts[k].from, k));
-    let mut reader = evtac_events::open(source)?;
+    let mut reader = evtac_formats::open(source)?;
     let (resolution, name) = (reader.resolution(), reader.source().map(str::to_owned));
     let create = |k: usize| EventWriter::create(&cuts[k].dest, resolution, name.as_deref());
     // Cuts open for writing (in `order`), the next one to open, the closed ones, and the latest

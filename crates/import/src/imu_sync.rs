@@ -63,7 +63,7 @@ pub const FINEST_STEP_US: i64 = 5;
 pub enum ImuSyncError {
     /// The session could not be read.
     #[error(transparent)]
-    Recording(#[from] evtac_events::Error),
+    Recording(#[from] evtac_formats::Error),
     /// The session has too few IMU samples to align anything.
     #[error(
         "{}: {samples} IMU sample(s): --sync imu aligns the gyroscope with the log (record the \
@@ -180,8 +180,8 @@ fn scan(steps: &[i64], i: usize, best: i64, (lo, hi): (i64, i64)) -> (i64, i64, 
 
 /// Every IMU sample of the recording at `path`, in time order, one per timestamp (a sample
 /// repeated across packets counted once).
-pub fn read_imu(path: &Path) -> Result<Vec<evtac_events::ImuSample>, evtac_events::Error> {
-    let mut reader = evtac_events::open(path)?;
+pub fn read_imu(path: &Path) -> Result<Vec<evtac_events::ImuSample>, evtac_formats::Error> {
+    let mut reader = evtac_formats::open(path)?;
     let mut samples = Vec::new();
     while let Some(chunk) = reader.next_chunk()? {
         samples.extend_from_slice(chunk.imu);
@@ -314,7 +314,7 @@ trait Sink {
 /// One pass over the IMU of `session` (decoding nothing else where the format allows),
 /// handing every sample to every sink, then finishing them.
 fn pass(session: &Path, sinks: &mut [&mut dyn Sink]) -> Result<(), Stop> {
-    let mut reader = evtac_events::open(session)?;
+    let mut reader = evtac_formats::open(session)?;
     reader.imu_only();
     let mut last_t = None;
     while let Some(chunk) = reader.next_chunk()? {
@@ -884,7 +884,8 @@ fn no_imu(session: &Path, samples: usize) -> ImuSyncError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use evtac_events::{EventWriter, Resolution};
+    use evtac_events::Resolution;
+    use evtac_formats::EventWriter;
 
     /// A deterministic pseudo-random stream in [0, 1).
     fn uniform(state: &mut u64) -> f64 {

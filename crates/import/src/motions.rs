@@ -376,8 +376,8 @@ pub fn find_motions_in(
     path: &Path,
     calibration: &Calibration,
     config: &FindConfig,
-) -> Result<Streamed, evtac_events::Error> {
-    let mut reader = evtac_events::open(path)?;
+) -> Result<Streamed, evtac_formats::Error> {
+    let mut reader = evtac_formats::open(path)?;
     let mut error = None;
     let mut unordered = false;
     let mut last_t = i64::MIN;

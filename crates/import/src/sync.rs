@@ -53,7 +53,7 @@ pub enum Sync {
 pub enum SyncError {
     /// The session could not be read.
     #[error(transparent)]
-    Recording(#[from] evtac_events::Error),
+    Recording(#[from] evtac_formats::Error),
     /// The gyroscope could not be aligned with the log.
     #[error(transparent)]
     Imu(#[from] ImuSyncError),
@@ -150,7 +150,7 @@ pub fn synchronise(session: &Path, log: RobotLog, sync: Sync) -> Result<Synced, 
 fn trigger_offsets(session: &Path, log: &RobotLog, kind: i8) -> Result<Vec<i64>, SyncError> {
     // A pass of its own before the cuts (which depend on it; see the module docs for why not
     // one pass), decoding the triggers only.
-    let mut reader = evtac_events::open(session)?;
+    let mut reader = evtac_formats::open(session)?;
     reader.triggers_only();
     let mut triggers = Vec::new();
     while let Some(chunk) = reader.next_chunk()? {

@@ -3,7 +3,7 @@
 
 use crate::simulate;
 use evtac_events::manifest::Manifest;
-use evtac_events::{EventWriter, read_recording};
+use evtac_formats::{EventWriter, read_recording};
 use evtac_import::check::{CheckReport, check};
 use evtac_import::inputs::Inputs;
 use evtac_sim::Protocol;

@@ -5,7 +5,8 @@
 
 use crate::simulate;
 use evtac_events::manifest::Manifest;
-use evtac_events::{Event, EventWriter, ImuSample, Recording, Trigger, read_recording};
+use evtac_events::{Event, ImuSample, Trigger};
+use evtac_formats::{EventWriter, Recording, read_recording};
 use evtac_import::check::check;
 use evtac_import::import::{ImportConfig, ImportError, NoContact, import_session};
 use evtac_import::inputs::Inputs;

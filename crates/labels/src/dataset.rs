@@ -128,8 +128,8 @@ pub fn label_trial(
 
 /// Reads only the IMU stream of the recording at `path`: the events, which can run to hundreds
 /// of megabytes, are decoded chunk by chunk and dropped.
-pub fn read_imu(path: &Path) -> Result<Vec<ImuSample>, evtac_events::Error> {
-    let mut reader = evtac_events::open(path)?;
+pub fn read_imu(path: &Path) -> Result<Vec<ImuSample>, evtac_formats::Error> {
+    let mut reader = evtac_formats::open(path)?;
     let mut imu = Vec::new();
     while let Some(chunk) = reader.next_chunk()? {
         imu.extend_from_slice(chunk.imu);

@@ -4,7 +4,7 @@
 
 use crate::support::{self, SENSOR, Synthetic};
 use evtac_events::Event;
-use evtac_events::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
+use evtac_formats::aedat::{AedatReader, AedatWriter, Compression, WriterConfig};
 use evtac_learn::Model;
 use evtac_online::input::{
     self, EventSource, MemorySource, NetworkOptions, OpenOptions, SourceSpec,
@@ -48,7 +48,7 @@ fn network_stream(events: &[Event]) -> Stream {
         offsets.push(chunk.offset as usize);
     }
     offsets.push(reader.offset() as usize);
-    let magic = evtac_events::aedat::MAGIC.len();
+    let magic = evtac_formats::aedat::MAGIC.len();
     Stream {
         header: bytes[magic..offsets[0]].to_vec(),
         packets: offsets

@@ -2,8 +2,8 @@
 //! pipeline (cropped events, `extract_features` at the same times, `Predictor::predict_one`).
 
 use crate::support::{self, SENSOR};
-use evtac_events::aedat::Compression;
 use evtac_events::{Event, Resolution, Roi};
+use evtac_formats::aedat::Compression;
 use evtac_learn::Model;
 use evtac_online::input::{self, MemorySource, OpenOptions, SourceSpec};
 use evtac_online::pipeline::{self, Output, PipelineConfig};

@@ -8,7 +8,7 @@
 
 use crate::support::dds::{CYCLONE_LOOPBACK, loopback_options, random_domain};
 use crate::support::{self, SENSOR, Synthetic};
-use evtac_events::ros::EventMessage;
+use evtac_formats::ros::EventMessage;
 use evtac_learn::Model;
 use evtac_online::input::{
     self, MemorySource, NetworkOptions, OpenOptions, Paced, Ros2InputOptions, SourceSpec,

@@ -2,12 +2,13 @@
 //! chunks, what `evtac.open` returns) and `write`, through `evtac_events` as `evtac convert`
 //! uses it: every format the CLI reads, AEDAT4 / CSV / NPY written by the output's extension.
 
-use evtac_events::aedat::{StreamChoice, StreamSelection};
+use evtac_formats::aedat::{StreamChoice, StreamSelection};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
 use evtac_events::check::EventCheck;
-use evtac_events::{Event, EventReader, EventWriter, ImuSample, Resolution, Roi, Trigger};
+use evtac_events::{Event, ImuSample, Resolution, Roi, Trigger};
+use evtac_formats::{EventReader, EventWriter};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 
@@ -15,13 +16,13 @@ use crate::error;
 use crate::records::{self, Layout};
 
 /// Maps an `evtac_events` error: a file's fault is an `OSError`, a caller's is a `ValueError`.
-pub fn events_error(err: evtac_events::Error) -> PyErr {
+pub fn events_error(err: evtac_formats::Error) -> PyErr {
     match err {
-        evtac_events::Error::NotWritable { .. }
-        | evtac_events::Error::MissingResolution { .. }
-        | evtac_events::Error::ResolutionMismatch { .. }
-        | evtac_events::Error::Streams { .. } => error::value(err),
-        evtac_events::Error::Io { ref error, .. } => error::io(&err, error),
+        evtac_formats::Error::NotWritable { .. }
+        | evtac_formats::Error::MissingResolution { .. }
+        | evtac_formats::Error::ResolutionMismatch { .. }
+        | evtac_formats::Error::Streams { .. } => error::value(err),
+        evtac_formats::Error::Io { ref error, .. } => error::io(&err, error),
         _ => error::file(err),
     }
 }
@@ -121,7 +122,7 @@ fn open_cropped(
             .map_err(|e| error::value(format!("stream: {e}")))?,
         ..StreamSelection::default()
     };
-    let mut reader = evtac_events::open_with(path, &selection).map_err(events_error)?;
+    let mut reader = evtac_formats::open_with(path, &selection).map_err(events_error)?;
     if let Some((w, h)) = resolution {
         reader
             .set_resolution(Resolution::new(w, h))
@@ -306,7 +307,7 @@ pub fn write(
             .unwrap_or_default();
         let resolution = resolution.map(|(w, h)| Resolution::new(w, h));
         // An extension evtac cannot write is the caller's mistake, not the file system's.
-        evtac_events::Format::for_writing(&path).map_err(error::value)?;
+        evtac_formats::Format::for_writing(&path).map_err(error::value)?;
         EventCheck::new(resolution)
             .check(&events)
             .map_err(|e| error::value(format!("events to write: {e}")))?;

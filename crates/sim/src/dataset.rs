@@ -19,9 +19,9 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use evtac_events::aedat::{AedatError, AedatWriter, Compression, WriterConfig};
 use evtac_events::manifest::{Manifest, ManifestError, TrialMeta};
 use evtac_events::{Event, ImuSample, Resolution};
+use evtac_formats::aedat::{AedatError, AedatWriter, Compression, WriterConfig};
 use rayon::prelude::*;
 use serde::Serialize;
 

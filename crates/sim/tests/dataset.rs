@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use crate::{config, three_runs};
-use evtac_events::aedat::AedatReader;
 use evtac_events::manifest::Manifest;
+use evtac_formats::aedat::AedatReader;
 use evtac_labels::geometry::{Calibration, axial_rate};
 use evtac_sim::{Protocol, simulate_dataset};
 

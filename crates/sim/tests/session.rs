@@ -2,7 +2,8 @@
 //! between them and a trigger at each onset, and a log on the robot's clock.
 
 use crate::{config, three_runs};
-use evtac_events::{Event, read_recording};
+use evtac_events::Event;
+use evtac_formats::read_recording;
 use evtac_sim::{
     DatasetConfig, Protocol, Scale, SessionConfig, simulate_dataset, simulate_session,
 };

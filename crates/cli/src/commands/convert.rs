@@ -13,9 +13,10 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use evtac_events::csv::ImuCsvWriter;
 use evtac_events::output::{OutputFile, refuse_input};
-use evtac_events::{EventWriter, Resolution, Roi};
+use evtac_events::{Resolution, Roi};
+use evtac_formats::EventWriter;
+use evtac_formats::csv::ImuCsvWriter;
 
 /// Arguments of `evtac convert`.
 #[derive(Debug, clap::Args)]
@@ -77,7 +78,7 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
     if let Some(imu) = &args.imu {
         refuse_input(imu, &[&args.input, &args.output])?;
     }
-    let mut reader = evtac_events::open_with(&args.input, &args.streams.selection())?;
+    let mut reader = evtac_formats::open_with(&args.input, &args.streams.selection())?;
     if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }
@@ -170,5 +171,5 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
 }
 
 fn writer_format_name(path: &std::path::Path) -> &'static str {
-    evtac_events::Format::for_writing(path).map_or("these", |f| f.name())
+    evtac_formats::Format::for_writing(path).map_or("these", |f| f.name())
 }

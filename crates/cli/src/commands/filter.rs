@@ -10,9 +10,9 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use evtac_events::EventWriter;
 use evtac_events::output::refuse_input;
 use evtac_filters::{Chain, Filter, FilterSpec};
+use evtac_formats::EventWriter;
 
 /// Arguments of `evtac filter`.
 #[derive(Debug, clap::Args)]
@@ -68,7 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// Filters `args.input` into `args.output` as `evtac filter` does.
 pub fn filter(args: &Args) -> anyhow::Result<Counts> {
     refuse_input(&args.output, &[&args.input])?;
-    let mut reader = evtac_events::open_with(&args.input, &args.streams.selection())?;
+    let mut reader = evtac_formats::open_with(&args.input, &args.streams.selection())?;
     if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }

@@ -401,7 +401,7 @@ fn parse_range(s: &str) -> Result<TimeRange, String> {
 
 /// The time of the first event of `session`.
 fn first_event_us(session: &std::path::Path) -> anyhow::Result<i64> {
-    let mut reader = evtac_events::open(session)?;
+    let mut reader = evtac_formats::open(session)?;
     while let Some(chunk) = reader.next_chunk()? {
         if let Some(e) = chunk.events.first() {
             return Ok(e.t);

@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use evtac_events::aedat::StreamSelection;
-use evtac_events::{Format, Resolution, Summary};
+use evtac_events::Resolution;
+use evtac_formats::aedat::StreamSelection;
+use evtac_formats::{Format, Summary};
 
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
@@ -37,11 +38,11 @@ pub fn summarise(
     let summary = match sensor {
         // AEDAT4's summary lists every stream; the declared size is checked against the chosen.
         Some(sensor) if Format::detect(path)? == Format::Aedat4 => {
-            evtac_events::open_with(path, streams)?.set_resolution(sensor)?;
+            evtac_formats::open_with(path, streams)?.set_resolution(sensor)?;
             Summary::of_file_with(path, streams, on_position)?
         }
         Some(sensor) => {
-            let mut reader = evtac_events::open_with(path, streams)?;
+            let mut reader = evtac_formats::open_with(path, streams)?;
             reader.set_resolution(sensor)?;
             Summary::read(&mut reader, on_position)?
         }

@@ -15,7 +15,7 @@
 
 use anyhow::Context;
 use evtac_events::output::{OutputFile, refuse_input};
-use evtac_events::ros::EventMessage;
+use evtac_formats::ros::EventMessage;
 use evtac_learn::Model;
 use evtac_online::input::{self, NetworkOptions, OpenOptions, Ros2InputOptions, SourceSpec};
 use evtac_online::mcap_log::{self, McapLog};

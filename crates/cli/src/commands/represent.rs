@@ -312,8 +312,8 @@ fn read_events(
     resolution: Option<Resolution>,
     streams: &crate::streams::StreamArgs,
 ) -> anyhow::Result<(Resolution, Vec<Event>)> {
-    let rec = evtac_events::open_with(path, &streams.selection())
-        .and_then(evtac_events::EventReader::into_recording)
+    let rec = evtac_formats::open_with(path, &streams.selection())
+        .and_then(evtac_formats::EventReader::into_recording)
         .with_context(|| format!("reading events from {}", path.display()))?;
     if let (Some(given), Some(found)) = (resolution, rec.resolution) {
         ensure!(

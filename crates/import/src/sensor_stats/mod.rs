@@ -20,7 +20,7 @@ pub mod imu;
 pub mod pixels;
 pub mod rest;
 
-use evtac_events::aedat::StreamSelection;
+use evtac_formats::aedat::StreamSelection;
 use std::path::{Path, PathBuf};
 
 use evtac_events::Resolution;
@@ -36,7 +36,7 @@ use rest::{BIN_US, RateBin};
 pub enum StatsError {
     /// The recording could not be read.
     #[error(transparent)]
-    Recording(#[from] evtac_events::Error),
+    Recording(#[from] evtac_formats::Error),
     /// The file does not state the sensor's size, which the per-pixel rates divide by.
     #[error(
         "{}: the file does not state the sensor's size (the per-pixel rates need it; convert \
@@ -108,7 +108,7 @@ pub fn measure_streams(
     streams: &StreamSelection,
     mut on_bytes: impl FnMut(u64),
 ) -> Result<SensorStats, StatsError> {
-    let mut reader = evtac_events::open_with(path, streams)?;
+    let mut reader = evtac_formats::open_with(path, streams)?;
     let resolution = reader
         .resolution()
         .ok_or_else(|| StatsError::NoResolution(path.to_path_buf()))?;
@@ -143,7 +143,7 @@ pub fn measure_streams(
                 .is_some_and(|b| b.rest)
     };
 
-    let mut reader = evtac_events::open_with(path, streams)?;
+    let mut reader = evtac_formats::open_with(path, streams)?;
     let mut counts = PixelCounts::new(resolution);
     let mut imu = ImuAccumulator::default();
     while let Some(chunk) = reader.next_chunk()? {

@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use evtac_events::manifest::{Manifest, TrialMeta};
-use evtac_events::{Event, EventWriter, ImuSample, Resolution};
+use evtac_events::{Event, ImuSample, Resolution};
+use evtac_formats::EventWriter;
 use evtac_labels::dataset::{label_and_write, labels_path};
 use evtac_labels::geometry::Calibration;
 use evtac_labels::{

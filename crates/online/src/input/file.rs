@@ -1,9 +1,10 @@
-//! A recording on disk, streamed in the chunks its reader decodes (`evtac_events::open`).
+//! A recording on disk, streamed in the chunks its reader decodes (`evtac_formats::open`).
 
 use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
-use evtac_events::aedat::StreamSelection;
-use evtac_events::{Event, EventReader, Resolution};
+use evtac_events::{Event, Resolution};
+use evtac_formats::EventReader;
+use evtac_formats::aedat::StreamSelection;
 use std::path::Path;
 
 /// Streams the events of an AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0, CSV or NPY file (IMU samples and
@@ -28,7 +29,7 @@ impl FileSource {
             input: name.clone(),
             source,
         };
-        let mut reader = evtac_events::open_with(path, streams).map_err(events)?;
+        let mut reader = evtac_formats::open_with(path, streams).map_err(events)?;
         if let Some(sensor) = sensor {
             reader.set_resolution(sensor).map_err(events)?;
         }

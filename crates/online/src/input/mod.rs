@@ -65,7 +65,7 @@ pub enum InputError {
         input: String,
         /// What failed.
         #[source]
-        source: evtac_events::Error,
+        source: evtac_formats::Error,
     },
     /// An I/O error outside the event decoders (standard input, sockets).
     #[error("reading {input}: {source}")]
@@ -109,7 +109,7 @@ pub struct OpenOptions {
     /// Domain, interfaces and message type of a ROS 2 input.
     pub ros2: Ros2InputOptions,
     /// Which streams of an AEDAT4 file with several (two cameras) to replay.
-    pub streams: evtac_events::aedat::StreamSelection,
+    pub streams: evtac_formats::aedat::StreamSelection,
 }
 
 /// An opened input: the source and the sensor size it announced.

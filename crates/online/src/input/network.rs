@@ -1,5 +1,5 @@
 //! A live DV network stream (`tcp://HOST:PORT`): what DV software's network output and
-//! dv-processing's `dv.io.NetworkWriter` serve, decoded by `evtac_events::aedat::AedatReader`'s
+//! dv-processing's `dv.io.NetworkWriter` serve, decoded by `evtac_formats::aedat::AedatReader`'s
 //! network mode, with reconnection.
 //!
 //! A connection that closes, fails, or stays silent for longer than the stall timeout is
@@ -10,8 +10,8 @@
 
 use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::{Backoff, Notice};
-use evtac_events::aedat::{AedatError, AedatReader};
 use evtac_events::{Event, Resolution};
+use evtac_formats::aedat::{AedatError, AedatReader};
 use std::io::{BufReader, ErrorKind};
 use std::net::{TcpStream, ToSocketAddrs};
 use std::time::Duration;

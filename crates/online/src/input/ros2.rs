@@ -19,7 +19,7 @@
 //!
 //! # Decoding
 //! Each sample's bytes (CDR, with its encapsulation header, as rosbag2 would store them) go
-//! through [`evtac_events::ros::MessageDecoder`], the decoder the bag readers use for each
+//! through [`evtac_formats::ros::MessageDecoder`], the decoder the bag readers use for each
 //! message, with one decoder for the topic whose EVT 3.0 state carries from packet to packet.
 //! So the events of a live stream are those of a bag of the same messages, bit for bit, times
 //! included. One sample is one chunk for the pipeline, stamped on arrival when it is taken.
@@ -57,8 +57,8 @@
 use super::{ChunkInfo, EventSource, InputError, NetworkOptions, Next};
 use crate::Notice;
 use crate::ros2::{MAX_DOMAIN_ID, dds_topic_name};
-use evtac_events::ros::{EventMessage, MessageDecoder, MessageError};
 use evtac_events::{Event, Resolution, Trigger};
+use evtac_formats::ros::{EventMessage, MessageDecoder, MessageError};
 use rustdds::mio1::{Events, Interest, Poll, Token};
 use rustdds::no_key::{DataReader, Decode, DefaultDecoder, DeserializerAdapter};
 use rustdds::policy::{Durability, History, Reliability};

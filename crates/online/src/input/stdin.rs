@@ -6,9 +6,9 @@
 
 use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
-use evtac_events::aedat::{AedatReader, MAGIC};
-use evtac_events::csv::CsvReader;
 use evtac_events::{Event, Resolution};
+use evtac_formats::aedat::{AedatReader, MAGIC};
+use evtac_formats::csv::CsvReader;
 use std::io::{BufReader, Cursor, Read};
 
 /// Bytes looked at to recognise the format.
