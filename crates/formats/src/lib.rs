@@ -30,24 +30,30 @@ mod columns;
 pub mod csv;
 mod error;
 pub mod evt;
+mod family;
+mod format;
 pub mod hdf5;
 pub mod neurotac;
 pub mod npy;
 mod range;
-mod recording;
+mod reader;
+mod registry;
 pub mod ros;
 mod summary;
 mod text_header;
+mod writer;
 
 // The ground types, under the paths this crate's modules have always used (`crate::Event`,
 // `crate::check::EventCheck`): one owner, `evtac-events`, and no second public path to them.
 use evtac_events::{Event, ImuSample, Resolution, Trigger, check};
 
 pub use error::Error;
+pub use family::{FormatReader, FormatWriter, Ranged};
+pub use format::Format;
 pub use range::{RangeIndex, ScanReason};
-pub use recording::{
-    Chunk, EventReader, EventWriter, Events, Format, Recording, open, open_with, read_recording,
-    read_recording_range,
+pub use reader::{
+    Chunk, EventReader, Events, Recording, open, open_with, read_recording, read_recording_range,
 };
 pub use ros::{TopicInfo, topics};
 pub use summary::Summary;
+pub use writer::EventWriter;

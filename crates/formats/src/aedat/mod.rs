@@ -47,6 +47,7 @@
 
 mod compression;
 mod error;
+pub(crate) mod family;
 mod header;
 mod index;
 mod packet;

@@ -28,6 +28,7 @@
 //! # Ok::<(), evtac_formats::aedat_legacy::LegacyError>(())
 //! ```
 
+pub(crate) mod family;
 mod header;
 pub mod v2;
 pub mod v3;

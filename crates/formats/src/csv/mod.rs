@@ -23,6 +23,8 @@
 //! # Ok::<(), evtac_formats::csv::CsvError>(())
 //! ```
 
+pub(crate) mod family;
+
 use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::Path;

@@ -22,6 +22,7 @@
 mod evt2;
 mod evt21;
 mod evt3;
+pub(crate) mod family;
 mod header;
 
 use std::fs::File;

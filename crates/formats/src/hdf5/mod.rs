@@ -36,6 +36,7 @@
 //! for why), and an attribute is used only when it holds a handful of values.
 
 mod column;
+pub(crate) mod family;
 mod fused;
 mod stored;
 

@@ -20,6 +20,7 @@
 
 use std::path::{Path, PathBuf};
 
+pub(crate) mod family;
 pub mod pickle;
 
 use crate::{Event, Resolution};

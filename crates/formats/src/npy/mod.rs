@@ -23,6 +23,7 @@
 //! # Ok::<(), evtac_formats::npy::NpyError>(())
 //! ```
 
+pub(crate) mod family;
 mod header;
 pub mod npz;
 

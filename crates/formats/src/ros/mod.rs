@@ -51,6 +51,7 @@
 //! and decompression grows with the data actually produced.
 
 mod bag1;
+pub(crate) mod family;
 mod mcap2;
 mod message;
 mod msg;

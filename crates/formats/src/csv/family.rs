@@ -1,0 +1,134 @@
+//! `t,x,y,p` CSV behind the format traits: recognised by its `.csv` extension (text has no
+//! signature), read and written.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use crate::aedat::StreamSelection;
+use crate::csv::{CsvError, CsvReader, CsvWriter};
+use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Sunk};
+use crate::{Chunk, Error, Event, Format, Resolution};
+
+/// The CSV family.
+pub(crate) struct Csv;
+
+impl Family for Csv {
+    fn formats(&self) -> &'static [Format] {
+        &[Format::Csv]
+    }
+
+    fn extensions(&self) -> &'static [Extension] {
+        &[Extension {
+            extension: "csv",
+            format: Format::Csv,
+            signature: None,
+        }]
+    }
+
+    /// By the extension alone, so it is tried after every format with a signature.
+    fn sniff(&self, path: &Path, _head: &[u8]) -> Option<Result<Format, Error>> {
+        (crate::registry::extension(path) == "csv").then_some(Ok(Format::Csv))
+    }
+
+    fn open(
+        &self,
+        path: &Path,
+        _format: Format,
+        _selection: &StreamSelection,
+        _len: u64,
+    ) -> Result<Opened, Error> {
+        let r = CsvReader::from_path(path).map_err(csv_error(path))?;
+        let note = r.headerless().then(|| {
+            "no header line: the columns were read as t,x,y,p (microseconds, column, row, \
+             polarity)"
+                .to_string()
+        });
+        Ok(Opened {
+            note,
+            ..Opened::plain(Reader {
+                path: path.to_path_buf(),
+                inner: r,
+            })
+        })
+    }
+
+    fn writes(&self, format: Format) -> bool {
+        format == Format::Csv
+    }
+
+    fn create(
+        &self,
+        path: &Path,
+        _format: Format,
+        file: Sunk,
+        _resolution: Option<Resolution>,
+        _source_name: Option<&str>,
+    ) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+        Some(
+            CsvWriter::new(file)
+                .map(|inner| {
+                    Box::new(Writer {
+                        path: path.to_path_buf(),
+                        inner,
+                    }) as Box<dyn FormatWriter>
+                })
+                .map_err(csv_error(path)),
+        )
+    }
+}
+
+fn csv_error(path: &Path) -> impl Fn(CsvError) -> Error + '_ {
+    |error| Error::Csv {
+        path: path.to_path_buf(),
+        error,
+    }
+}
+
+struct Reader {
+    path: PathBuf,
+    inner: CsvReader<BufReader<File>>,
+}
+
+impl FormatReader for Reader {
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
+        let chunk = self.inner.next_chunk().map_err(csv_error(&self.path))?;
+        Ok(chunk.map(|events| Chunk {
+            events,
+            ..Chunk::default()
+        }))
+    }
+
+    fn resolution(&self) -> Option<Resolution> {
+        self.inner.resolution()
+    }
+
+    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
+        self.inner.set_resolution(resolution);
+        Ok(())
+    }
+
+    fn position(&self) -> u64 {
+        self.inner.position()
+    }
+}
+
+/// A CSV event file being written (events only: a CSV event file has no place for IMU samples
+/// or triggers).
+struct Writer {
+    path: PathBuf,
+    inner: CsvWriter<Sunk>,
+}
+
+impl FormatWriter for Writer {
+    fn write_events(&mut self, events: &[Event]) -> Result<(), Error> {
+        self.inner
+            .write_events(events)
+            .map_err(csv_error(&self.path))
+    }
+
+    fn finish(self: Box<Self>) -> Result<Sunk, Error> {
+        let path = self.path;
+        self.inner.finish().map_err(csv_error(&path))
+    }
+}

@@ -1,0 +1,98 @@
+//! Prophesee EVT 2.0, 2.1 and 3.0 behind the format traits: recognised by their `%` text
+//! header, whose `evt` line gives the version, read only.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use crate::aedat::StreamSelection;
+use crate::evt::{EvtError, EvtReader, EvtVersion};
+use crate::family::{Extension, Family, FormatReader, Opened};
+use crate::{Chunk, Error, Format, Resolution};
+
+/// The EVT family.
+pub(crate) struct Evt;
+
+impl Family for Evt {
+    fn formats(&self) -> &'static [Format] {
+        &[Format::Evt2, Format::Evt21, Format::Evt3]
+    }
+
+    fn extensions(&self) -> &'static [Extension] {
+        &[Extension {
+            extension: "raw",
+            format: Format::Evt3,
+            signature: Some("a `%` EVT text header line"),
+        }]
+    }
+
+    fn sniff(&self, path: &Path, head: &[u8]) -> Option<Result<Format, Error>> {
+        if !head.starts_with(b"%") {
+            return None;
+        }
+        // The version needs the whole header, which the EVT reader parses.
+        let opened = File::open(path)
+            .map_err(|error| Error::Io {
+                path: path.to_path_buf(),
+                error,
+            })
+            .and_then(|file| EvtReader::new(file).map_err(evt_error(path)));
+        Some(opened.map(|r| match r.header().version {
+            EvtVersion::Evt2 => Format::Evt2,
+            EvtVersion::Evt21 => Format::Evt21,
+            EvtVersion::Evt3 => Format::Evt3,
+        }))
+    }
+
+    fn open(
+        &self,
+        path: &Path,
+        _format: Format,
+        _selection: &StreamSelection,
+        _len: u64,
+    ) -> Result<Opened, Error> {
+        let r = EvtReader::from_path(path).map_err(evt_error(path))?;
+        Ok(Opened {
+            source: r.header().source(),
+            ..Opened::plain(Reader {
+                path: path.to_path_buf(),
+                inner: r,
+            })
+        })
+    }
+}
+
+fn evt_error(path: &Path) -> impl Fn(EvtError) -> Error + '_ {
+    |error| Error::Evt {
+        path: path.to_path_buf(),
+        error,
+    }
+}
+
+struct Reader {
+    path: PathBuf,
+    inner: EvtReader<File>,
+}
+
+impl FormatReader for Reader {
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
+        let chunk = self.inner.next_chunk().map_err(evt_error(&self.path))?;
+        Ok(chunk.map(|c| Chunk {
+            events: c.events,
+            imu: &[],
+            triggers: c.triggers,
+        }))
+    }
+
+    fn resolution(&self) -> Option<Resolution> {
+        self.inner.resolution()
+    }
+
+    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
+        self.inner.set_resolution(resolution);
+        Ok(())
+    }
+
+    fn position(&self) -> u64 {
+        self.inner.position()
+    }
+}
