@@ -1,10 +1,10 @@
 //! `--stream`, `--imu-stream`, `--trigger-stream`: which streams of an AEDAT4 file with several
 //! (two cameras, say) a command reads, and which topics of a ROS bag (`--topic` and
 //! `--imu-topic` are the same flags under the names ROS users look for), flattened into each
-//! command that reads a recording (`evtac_formats::aedat::StreamSelection` has the rule when they
+//! command that reads a recording (`evtac_formats::StreamSelection` has the rule when they
 //! are not given).
 
-use evtac_formats::aedat::{StreamChoice, StreamSelection};
+use evtac_formats::{StreamChoice, StreamSelection};
 
 /// The stream flags.
 #[derive(Debug, Clone, Default, clap::Args)]

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use evtac_events::output::OutputFile;
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::ros::TopicInfo;
 use crate::{Chunk, Error, Event, Format, ImuSample, RangeIndex, Resolution, Trigger};
 

@@ -39,6 +39,7 @@ mod range;
 mod reader;
 mod registry;
 pub mod ros;
+mod selection;
 mod summary;
 mod text_header;
 mod writer;
@@ -55,5 +56,6 @@ pub use reader::{
     Chunk, EventReader, Events, Recording, open, open_with, read_recording, read_recording_range,
 };
 pub use ros::{TopicInfo, topics};
+pub use selection::{StreamChoice, StreamSelection};
 pub use summary::Summary;
 pub use writer::EventWriter;

@@ -14,7 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::family::{FormatReader, Ranged};
 use crate::range::{RangeIndex, ScanReason, within};
 use crate::registry;
@@ -97,7 +97,16 @@ pub fn open_with(
     selection: &StreamSelection,
 ) -> Result<EventReader, Error> {
     let path = path.as_ref();
-    let format = registry::detect(path)?;
+    open_as(path, registry::detect(path)?, selection)
+}
+
+/// Opens the file at `path` as [`open_with`] does, its format already recognised (so that a
+/// caller which needed the format first detects it once).
+pub(crate) fn open_as(
+    path: &Path,
+    format: Format,
+    selection: &StreamSelection,
+) -> Result<EventReader, Error> {
     let family = registry::family(format);
     let len = family.len(path)?;
     if !family.has_streams() && *selection != StreamSelection::default() {

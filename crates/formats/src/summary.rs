@@ -13,9 +13,10 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::aedat::{AedatReader, StreamSelection};
+use crate::StreamSelection;
+use crate::aedat::AedatReader;
 use crate::check::EventCheck;
-use crate::{Error, EventReader, Format};
+use crate::{Error, EventReader, Format, Resolution};
 
 /// One stream of an AEDAT4 file (`evtac info` lists them all).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -159,24 +160,32 @@ impl Summary {
 
     /// Opens the recording at `path` (any format evtac reads) and summarises it.
     pub fn of_file(path: impl AsRef<Path>) -> Result<Self, Error> {
-        Self::of_file_with(path, &StreamSelection::default(), |_| {})
+        Self::of_file_with(path, &StreamSelection::default(), None, |_| {})
     }
 
     /// Summarises the recording at `path`, every stream of an AEDAT4 file on its own and the
     /// streams `selection` picks at the top level; `on_position` sees the byte position as the
-    /// read goes.
+    /// read goes. A declared `sensor` is checked against the size the file states (for AEDAT4,
+    /// the chosen event stream's), and the events against it where the file states none. The
+    /// file is recognised once and opened once.
     pub fn of_file_with(
         path: impl AsRef<Path>,
         selection: &StreamSelection,
+        sensor: Option<Resolution>,
         on_position: impl FnMut(u64),
     ) -> Result<Self, Error> {
         let path = path.as_ref();
         let format = Format::detect(path)?;
         if format == Format::Aedat4 {
-            return Self::of_aedat(path, selection, on_position);
+            return Self::of_aedat(path, selection, sensor, on_position);
         }
-        match crate::open_with(path, selection) {
-            Ok(mut reader) => Self::read(&mut reader, on_position),
+        match crate::reader::open_as(path, format, selection) {
+            Ok(mut reader) => {
+                if let Some(sensor) = sensor {
+                    reader.set_resolution(sensor)?;
+                }
+                Self::read(&mut reader, on_position)
+            }
             // A bag with several event topics and none chosen: the summary lists its topics
             // and says why it counts nothing (naming a topic it lacks stays an error).
             Err(Error::Streams { error, .. })
@@ -196,6 +205,7 @@ impl Summary {
     fn of_aedat(
         path: &Path,
         selection: &StreamSelection,
+        sensor: Option<Resolution>,
         mut on_position: impl FnMut(u64),
     ) -> Result<Self, Error> {
         let aedat = |error| Error::Aedat {
@@ -232,11 +242,29 @@ impl Summary {
                 last_t_us: None,
             })
             .collect();
+        // A declared sensor must be the chosen event stream's, and checks its events when the
+        // stream states no size.
+        let chosen_events = chosen.as_ref().ok().and_then(|c| c.events);
+        if let Some(declared) = sensor
+            && let Some(found) = chosen_events
+                .and_then(|id| header.stream(id))
+                .and_then(|s| s.resolution)
+            && found != declared
+        {
+            return Err(Error::ResolutionMismatch {
+                path: path.to_path_buf(),
+                declared,
+                found,
+            });
+        }
         // Each event stream's events checked against its own sensor.
         let mut checks: Vec<EventCheck> = header
             .streams
             .iter()
-            .map(|i| EventCheck::new(i.resolution))
+            .map(|i| {
+                let declared = sensor.filter(|_| chosen_events == Some(i.id));
+                EventCheck::new(i.resolution.or(declared))
+            })
             .collect();
         while let Some(chunk) = reader.next_chunk().map_err(aedat)? {
             let Some(k) = header.streams.iter().position(|i| i.id == chunk.stream_id) else {

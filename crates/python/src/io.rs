@@ -2,7 +2,7 @@
 //! chunks, what `evtac.open` returns) and `write`, through `evtac_events` as `evtac convert`
 //! uses it: every format the CLI reads, AEDAT4 / CSV / NPY written by the output's extension.
 
-use evtac_formats::aedat::{StreamChoice, StreamSelection};
+use evtac_formats::{StreamChoice, StreamSelection};
 use std::path::PathBuf;
 use std::sync::Mutex;
 

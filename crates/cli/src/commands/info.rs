@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use evtac_events::Resolution;
-use evtac_formats::aedat::StreamSelection;
-use evtac_formats::{Format, Summary};
+use evtac_formats::StreamSelection;
+use evtac_formats::Summary;
 
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
@@ -35,19 +35,7 @@ pub fn summarise(
         .len();
     let bar = crate::progress::bytes(len, "reading");
     let on_position = |position| bar.set_position(position);
-    let summary = match sensor {
-        // AEDAT4's summary lists every stream; the declared size is checked against the chosen.
-        Some(sensor) if Format::detect(path)? == Format::Aedat4 => {
-            evtac_formats::open_with(path, streams)?.set_resolution(sensor)?;
-            Summary::of_file_with(path, streams, on_position)?
-        }
-        Some(sensor) => {
-            let mut reader = evtac_formats::open_with(path, streams)?;
-            reader.set_resolution(sensor)?;
-            Summary::read(&mut reader, on_position)?
-        }
-        None => Summary::of_file_with(path, streams, on_position)?,
-    };
+    let summary = Summary::of_file_with(path, streams, sensor, on_position)?;
     bar.finish_and_clear();
     Ok(summary)
 }

@@ -6,7 +6,8 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use crate::aedat::{AedatError, AedatReader, AedatWriter, MAGIC, StreamSelection, WriterConfig};
+use crate::StreamSelection;
+use crate::aedat::{AedatError, AedatReader, AedatWriter, MAGIC, WriterConfig};
 use crate::check::EventCheck;
 use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Ranged, Sunk};
 use crate::{Chunk, Error, Event, Format, ImuSample, Resolution, Trigger};

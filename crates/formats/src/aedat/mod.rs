@@ -62,7 +62,7 @@ pub use compression::MAX_PACKET_BYTES;
 pub use error::{AedatError, Result};
 pub use header::{AedatHeader, Compression, MAGIC, StreamInfo, StreamKind, parse_description};
 pub use reader::{AedatChunk, AedatReader, Events};
-pub use selection::{ChosenStreams, SelectionError, StreamChoice, StreamSelection, list_streams};
+pub use selection::{ChosenStreams, SelectionError, list_streams};
 pub use writer::{
     AedatWriter, EVENTS_PER_PACKET, IMU_PER_PACKET, PACKET_SPAN_US, TRIGGERS_PER_PACKET,
     WriterConfig,
@@ -88,7 +88,7 @@ pub fn fuzz_decode(data: &[u8]) {
     }
     // The streams a default selection picks (several cameras: an error listing them).
     if let Ok(mut reader) = AedatReader::from_slice(data)
-        && let Ok(chosen) = StreamSelection::default().resolve(reader.header())
+        && let Ok(chosen) = crate::StreamSelection::default().resolve(reader.header())
     {
         reader.select_streams(&chosen);
         while let Ok(Some(_)) = reader.next_chunk() {}

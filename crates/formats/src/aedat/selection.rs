@@ -8,42 +8,8 @@
 //! one, else an error listing the streams. With several cameras, the IMU and trigger streams
 //! default to those of the chosen event stream's camera (the same `source`).
 
-use std::fmt;
-use std::str::FromStr;
-
 use super::header::{AedatHeader, StreamInfo, StreamKind};
-
-/// A stream named by the user: its id, or a name matched against the stream's output name
-/// (`events`), its camera (`source`, e.g. `DVXplorer_DXA00093`) or both as `SOURCE/NAME`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum StreamChoice {
-    /// The stream id that packets carry.
-    Id(i32),
-    /// An output name, a camera name, or `SOURCE/NAME`.
-    Name(String),
-}
-
-impl FromStr for StreamChoice {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let s = s.trim();
-        if s.is_empty() {
-            return Err("a stream is named by its id or its name, not by nothing".into());
-        }
-        Ok(s.parse::<i32>()
-            .map_or_else(|_| Self::Name(s.to_string()), Self::Id))
-    }
-}
-
-impl fmt::Display for StreamChoice {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Id(id) => write!(f, "{id}"),
-            Self::Name(name) => f.write_str(name),
-        }
-    }
-}
+use crate::selection::{StreamChoice, StreamSelection};
 
 impl StreamChoice {
     fn matches(&self, s: &StreamInfo) -> bool {
@@ -57,17 +23,6 @@ impl StreamChoice {
             }
         }
     }
-}
-
-/// The user's picks, one per decoded kind (`None`: the default rule).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct StreamSelection {
-    /// The event stream (`--stream`).
-    pub events: Option<StreamChoice>,
-    /// The IMU stream (`--imu-stream`).
-    pub imu: Option<StreamChoice>,
-    /// The trigger stream (`--trigger-stream`).
-    pub triggers: Option<StreamChoice>,
 }
 
 /// The stream ids a selection resolved to (`None`: the file has no stream of that kind, or none

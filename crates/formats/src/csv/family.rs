@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::csv::{CsvError, CsvReader, CsvWriter};
 use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Sunk};
 use crate::{Chunk, Error, Event, Format, Resolution};

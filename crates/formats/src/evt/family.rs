@@ -4,7 +4,7 @@
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::evt::{EvtError, EvtReader, EvtVersion};
 use crate::family::{Extension, Family, FormatReader, Opened};
 use crate::{Chunk, Error, Format, Resolution};

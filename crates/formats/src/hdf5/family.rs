@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::family::{Extension, Family, FormatReader, Opened, Ranged};
 use crate::hdf5::{Hdf5Error, Hdf5Reader};
 use crate::{Chunk, Error, Format, RangeIndex, Resolution, ScanReason};

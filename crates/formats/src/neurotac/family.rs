@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::check::{CheckError, EventCheck};
 use crate::family::{Extension, Family, FormatReader, Opened};
 use crate::{Chunk, Error, Event, Format, ImuSample, Resolution, Trigger};

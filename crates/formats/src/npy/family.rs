@@ -4,7 +4,7 @@
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Sunk};
 use crate::npy::npz::{NpzError, NpzReader};
 use crate::npy::{MAGIC, NpyError, NpyReader, NpyWriter};

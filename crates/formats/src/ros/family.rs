@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::aedat::StreamSelection;
+use crate::StreamSelection;
 use crate::family::{Extension, Family, FormatReader, Opened};
 use crate::ros::{BagEvents, MCAP_MAGIC};
 use crate::{Chunk, Error, Format, Resolution};

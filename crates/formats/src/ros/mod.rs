@@ -64,8 +64,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::aedat::{SelectionError, StreamChoice, StreamSelection};
+use crate::aedat::SelectionError;
 use crate::{Error, Format, ImuSample, Resolution};
+use crate::{StreamChoice, StreamSelection};
 pub(crate) use stream::BagEvents;
 use stream::Decoder;
 

@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use evtac_events::{Event, ImuSample, Resolution};
-use evtac_formats::aedat::StreamSelection;
+use evtac_formats::StreamSelection;
 use evtac_formats::{Error, Format, Summary};
 use evtac_testkit::{real_fixture, run_python};
 

@@ -20,7 +20,7 @@ pub mod imu;
 pub mod pixels;
 pub mod rest;
 
-use evtac_formats::aedat::StreamSelection;
+use evtac_formats::StreamSelection;
 use std::path::{Path, PathBuf};
 
 use evtac_events::Resolution;

@@ -4,7 +4,7 @@ use super::{ChunkInfo, EventSource, InputError, Next};
 use crate::Notice;
 use evtac_events::{Event, Resolution};
 use evtac_formats::EventReader;
-use evtac_formats::aedat::StreamSelection;
+use evtac_formats::StreamSelection;
 use std::path::Path;
 
 /// Streams the events of an AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0, CSV or NPY file (IMU samples and

@@ -109,7 +109,7 @@ pub struct OpenOptions {
     /// Domain, interfaces and message type of a ROS 2 input.
     pub ros2: Ros2InputOptions,
     /// Which streams of an AEDAT4 file with several (two cameras) to replay.
-    pub streams: evtac_formats::aedat::StreamSelection,
+    pub streams: evtac_formats::StreamSelection,
 }
 
 /// An opened input: the source and the sensor size it announced.
