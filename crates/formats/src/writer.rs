@@ -41,10 +41,8 @@ impl EventWriter {
         let path = path.as_ref().to_path_buf();
         let format = registry::for_writing(&path)?;
         let family = registry::family(format);
-        // Refused before the temporary file is made (AEDAT4 states its sensor size).
-        if format == Format::Aedat4 && resolution.is_none() {
-            return Err(Error::MissingResolution { path });
-        }
+        // A family that refuses (AEDAT4 without a sensor size) drops the temporary file, which
+        // removes it: nothing is written.
         let file = OutputFile::buffered(&path).map_err(|error| Error::Io {
             path: path.clone(),
             error,
