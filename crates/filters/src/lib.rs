@@ -14,6 +14,8 @@
 //! | `region=X,Y,W,H` | [`Region`] | `dv.EventRegionFilter` |
 //! | `refractory=DURATION` | [`Refractory`] | C++ `dv::RefractoryPeriodFilter` (not in the Python bindings) |
 //! | `circle=CX,CY,R` | [`Circle`] | none |
+//! | `mask=FILE` | [`Mask`] | `dv.EventMaskFilter` |
+//! | `hot-pixels=FILE` | [`Mask::removing`] | none (`dv.EventMaskFilter` with the mask inverted) |
 //!
 //! A [`FilterSpec`] is parsed from a SPEC and built for a sensor; a [`Chain`] applies several in
 //! order, as `dv.EventFilterChain` does.
@@ -48,6 +50,8 @@ mod circle;
 mod duration;
 mod fast_decay;
 mod k_noise;
+mod mask;
+pub mod mask_file;
 mod polarity;
 mod refractory;
 mod region;
@@ -60,6 +64,7 @@ pub use circle::Circle;
 pub use duration::{Micros, ParseDurationError};
 pub use fast_decay::FastDecay;
 pub use k_noise::KNoise;
+pub use mask::Mask;
 pub use polarity::PolarityFilter;
 pub use refractory::Refractory;
 pub use region::Region;

@@ -10,22 +10,26 @@
 //! | `region=X,Y,W,H` | keep the rectangle `X <= x < X+W`, `Y <= y < Y+H` |
 //! | `refractory=DURATION` | remove events less than DURATION after their pixel's previous one |
 //! | `circle=CX,CY,R` | keep the disc `(x-CX)^2 + (y-CY)^2 <= R^2` |
+//! | `mask=FILE` | keep the pixels a uint8 `H x W` mask (NPY or 8-bit greyscale PNG) marks non-zero |
+//! | `hot-pixels=FILE` | remove the pixels such a mask marks non-zero (a mask of hot pixels) |
 //!
 //! DURATIONs take a unit: `us`, `ms` or `s` (`500us`, `2ms`, `1.5ms`). A SPEC written back
 //! ([`std::fmt::Display`]) parses to the same filter.
 
 use std::fmt;
+use std::path::PathBuf;
 use std::str::FromStr;
 
 use evtac_events::Resolution;
 
 use crate::duration::{Micros, ParseDurationError};
 use crate::{
-    BackgroundActivity, Circle, FastDecay, Filter, KNoise, PolarityFilter, Refractory, Region,
+    BackgroundActivity, Circle, FastDecay, Filter, KNoise, Mask, PolarityFilter, Refractory,
+    Region, mask_file,
 };
 
 /// The filters' names, as SPECs begin.
-pub const NAMES: [&str; 7] = [
+pub const NAMES: [&str; 9] = [
     "background-activity",
     "fast-decay",
     "k-noise",
@@ -33,10 +37,12 @@ pub const NAMES: [&str; 7] = [
     "region",
     "refractory",
     "circle",
+    "mask",
+    "hot-pixels",
 ];
 
 /// One filter and its settings, as a SPEC gives them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum FilterSpec {
     /// `background-activity=DURATION`: [`BackgroundActivity`].
     BackgroundActivity {
@@ -87,6 +93,16 @@ pub enum FilterSpec {
         /// Radius, in pixels (positive).
         radius: f64,
     },
+    /// `mask=FILE`: [`Mask`], keeping the pixels the file marks.
+    Mask {
+        /// The mask: a uint8 `H x W` NPY array or an 8-bit greyscale PNG.
+        path: PathBuf,
+    },
+    /// `hot-pixels=FILE`: [`Mask::removing`], removing the pixels the file marks.
+    HotPixels {
+        /// The mask of hot pixels, as for `mask=`.
+        path: PathBuf,
+    },
 }
 
 /// A SPEC that does not parse, or a filter that does not fit the sensor.
@@ -96,7 +112,7 @@ pub enum Error {
     /// The name before `=` is none of [`NAMES`].
     #[error(
         "unknown filter `{spec}`: expected one of background-activity, fast-decay, k-noise, \
-         polarity, region, refractory, circle"
+         polarity, region, refractory, circle, mask, hot-pixels"
     )]
     UnknownFilter {
         /// The SPEC as given.
@@ -178,6 +194,26 @@ pub enum Error {
         /// The sensor.
         sensor: Resolution,
     },
+    /// A mask file that cannot be read as a mask.
+    #[error("filter `{spec}`: the mask {path} {reason}")]
+    MaskFile {
+        /// The SPEC, written back.
+        spec: String,
+        /// The file.
+        path: String,
+        /// Why it is no mask.
+        reason: String,
+    },
+    /// A mask of another size than the sensor.
+    #[error("filter `{spec}`: the mask is {found} (columns x rows), the sensor {sensor}")]
+    MaskSize {
+        /// The SPEC, written back.
+        spec: String,
+        /// The mask's size.
+        found: Resolution,
+        /// The sensor.
+        sensor: Resolution,
+    },
 }
 
 /// Each filter's SPEC form, for the errors.
@@ -189,6 +225,8 @@ const USAGE_POLARITY: &str = "polarity=on or polarity=off";
 const USAGE_REGION: &str = "region=X,Y,W,H, e.g. region=40,0,240,240";
 const USAGE_REFRACTORY: &str = "refractory=DURATION, e.g. refractory=250us";
 const USAGE_CIRCLE: &str = "circle=CX,CY,R, e.g. circle=120,120,110";
+const USAGE_MASK: &str = "mask=FILE, a uint8 H x W NPY array or 8-bit greyscale PNG";
+const USAGE_HOT_PIXELS: &str = "hot-pixels=FILE, a uint8 H x W NPY array or 8-bit greyscale PNG";
 
 impl FromStr for FilterSpec {
     type Err = Error;
@@ -206,6 +244,8 @@ impl FromStr for FilterSpec {
             "region" => USAGE_REGION,
             "refractory" => USAGE_REFRACTORY,
             "circle" => USAGE_CIRCLE,
+            "mask" => USAGE_MASK,
+            "hot-pixels" => USAGE_HOT_PIXELS,
             _ => {
                 return Err(Error::UnknownFilter {
                     spec: spec.to_string(),
@@ -225,6 +265,18 @@ impl FromStr for FilterSpec {
                 _ => Err(p.values()),
             };
         };
+        // A file's name is taken whole (it may hold commas), only an empty one refused.
+        if matches!(name, "mask" | "hot-pixels") {
+            let path = PathBuf::from(value.trim());
+            if path.as_os_str().is_empty() {
+                return Err(p.values());
+            }
+            return Ok(if name == "mask" {
+                Self::Mask { path }
+            } else {
+                Self::HotPixels { path }
+            });
+        }
         let fields: Vec<&str> = value.split(',').map(str::trim).collect();
         match name {
             "background-activity" => Ok(Self::BackgroundActivity {
@@ -373,13 +425,33 @@ impl FilterSpec {
             Self::Region { .. } => NAMES[4],
             Self::Refractory { .. } => NAMES[5],
             Self::Circle { .. } => NAMES[6],
+            Self::Mask { .. } => NAMES[7],
+            Self::HotPixels { .. } => NAMES[8],
         }
     }
 
     /// The filter for `sensor`, or why it does not fit: a region must lie wholly on the sensor,
-    /// a circle's centre on it.
+    /// a circle's centre on it, a mask be the sensor's size (its file is read here).
     pub fn build(&self, sensor: Resolution) -> Result<Box<dyn Filter>, Error> {
         Ok(match *self {
+            Self::Mask { ref path } | Self::HotPixels { ref path } => {
+                let image = mask_file::read(path).map_err(|reason| Error::MaskFile {
+                    spec: self.to_string(),
+                    path: path.display().to_string(),
+                    reason,
+                })?;
+                if image.size != sensor {
+                    return Err(Error::MaskSize {
+                        spec: self.to_string(),
+                        found: image.size,
+                        sensor,
+                    });
+                }
+                match self {
+                    Self::Mask { .. } => Box::new(Mask::new(sensor, &image.values)),
+                    _ => Box::new(Mask::removing(sensor, &image.values)),
+                }
+            }
             Self::BackgroundActivity { duration } => {
                 Box::new(BackgroundActivity::new(sensor, duration))
             }
@@ -450,6 +522,9 @@ impl fmt::Display for FilterSpec {
                 height,
             } => write!(f, "{name}={x},{y},{width},{height}"),
             Self::Circle { cx, cy, radius } => write!(f, "{name}={cx},{cy},{radius}"),
+            Self::Mask { path } | Self::HotPixels { path } => {
+                write!(f, "{name}={}", path.display())
+            }
         }
     }
 }
@@ -566,7 +641,7 @@ mod tests {
         assert_eq!(
             message("hot-pixel=3"),
             "unknown filter `hot-pixel=3`: expected one of background-activity, fast-decay, \
-             k-noise, polarity, region, refractory, circle"
+             k-noise, polarity, region, refractory, circle, mask, hot-pixels"
         );
         assert_eq!(
             message("k-noise"),
@@ -631,7 +706,11 @@ mod tests {
              (columns 0 to 63, rows 0 to 47)"
         );
         assert!(build("circle=10,-1,5").is_err());
-        for s in NAMES {
+        // The mask filters read files: `tests/masks.rs` builds them.
+        for s in NAMES
+            .into_iter()
+            .filter(|s| !matches!(*s, "mask" | "hot-pixels"))
+        {
             let spec = match s {
                 "polarity" => "polarity=on".to_string(),
                 "region" => "region=0,0,1,1".to_string(),

@@ -35,6 +35,11 @@ def make(f, res):
         return dv.EventPolarityFilter(f["on"])
     if kind == "region":
         return dv.EventRegionFilter((f["x"], f["y"], f["w"], f["h"]))
+    if kind == "mask":
+        return dv.EventMaskFilter(np.load(f["path"]))
+    if kind == "hot-pixels":
+        # No dv-processing class: its mask filter with the mask inverted.
+        return dv.EventMaskFilter((np.load(f["path"]) == 0).astype(np.uint8))
     raise ValueError(kind)
 
 stores = {}
@@ -55,17 +60,23 @@ for case in json.load(open(sys.argv[1])):
     store = load(case["events"], case["n"])
     res = (case["w"], case["h"])
     filters = [make(f, res) for f in case["filters"]]
-    if len(filters) == 1:
-        flt = filters[0]
+    # The bindings' EventFilterChain takes no EventMaskFilter: a chain with one runs its
+    # filters one after the other on each batch, which is what a chain does.
+    masked = any(f["kind"] in ("mask", "hot-pixels") for f in case["filters"])
+    if len(filters) == 1 or masked:
+        stages = filters
     else:
-        flt = dv.EventFilterChain()
+        chain = dv.EventFilterChain()
         for f in filters:
-            flt.addFilter(f)
+            chain.addFilter(f)
+        stages = [chain]
     parts = []
     start = 0
     for end in case["cuts"]:
-        flt.accept(store.slice(start, end - start))
-        out = flt.generateEvents()
+        out = store.slice(start, end - start)
+        for f in stages:
+            f.accept(out)
+            out = f.generateEvents()
         if out.size() > 0:
             parts.append(out.numpy())
         start = end
@@ -75,7 +86,7 @@ for case in json.load(open(sys.argv[1])):
         f.write(kept["x"].astype("<u2").tobytes())
         f.write(kept["y"].astype("<u2").tobytes())
         f.write(kept["polarity"].astype("u1").tobytes())
-    print(flt.getNumberOfIncomingEvents(), flt.getNumberOfOutgoingEvents())
+    print(stages[0].getNumberOfIncomingEvents(), stages[-1].getNumberOfOutgoingEvents())
 "#;
 
 /// One stream through one filter or chain.
@@ -144,6 +155,11 @@ fn dv_json(spec: &FilterSpec) -> String {
             width,
             height,
         } => format!(r#"{{"kind": "region", "x": {x}, "y": {y}, "w": {width}, "h": {height}}}"#),
+        FilterSpec::Mask { ref path } | FilterSpec::HotPixels { ref path } => format!(
+            r#"{{"kind": "{}", "path": {:?}}}"#,
+            spec.name(),
+            path.to_str().unwrap()
+        ),
         FilterSpec::Refractory { .. } | FilterSpec::Circle { .. } => {
             panic!("{spec} has no dv-processing class")
         }
@@ -225,6 +241,24 @@ fn compare(streams: &[Vec<Event>], cases: &[Case], dir: &Path) {
     }
 }
 
+/// A seeded random uint8 mask for `sensor` (about one pixel in four zero, the others 1 to 255)
+/// saved as NPY under `dir`; its path.
+fn write_mask(dir: &Path, name: &str, sensor: Resolution, seed: u64) -> String {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (w, h) = (usize::from(sensor.width), usize::from(sensor.height));
+    let mask = ndarray::Array2::from_shape_fn((h, w), |_| {
+        if rng.random_bool(0.25) {
+            0u8
+        } else {
+            rng.random_range(1..=255)
+        }
+    });
+    let path = dir.join(name);
+    ndarray_npy::write_npy(&path, &mask).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
 fn specs(s: &str) -> Vec<FilterSpec> {
     s.split(' ').map(|s| s.parse().unwrap()).collect()
 }
@@ -238,6 +272,9 @@ fn random_streams_filter_as_in_dv_processing() {
     // t < DURATION is supported by pixels or slots that never fired); stream 1 and 2 are on a
     // camera's clock; stream 3 on a sensor whose sides the cell sizes below do not divide.
     let odd = Resolution::new(37, 23);
+    let dir = tempfile::tempdir().unwrap();
+    let mask = write_mask(dir.path(), "mask.npy", SENSOR, 5);
+    let odd_mask = write_mask(dir.path(), "odd_mask.npy", odd, 6);
     let streams = vec![
         stream(1, SENSOR, 6_000, 0),
         stream(2, SENSOR, 6_000, CAMERA_T0),
@@ -281,7 +318,10 @@ fn random_streams_filter_as_in_dv_processing() {
     add("polarity=on background-activity=2ms", 1, 20, true);
     add("k-noise=1ms region=0,0,20,48", 0, 17, true);
     add("fast-decay background-activity=2ms", 3, 8, true);
-    let dir = tempfile::tempdir().unwrap();
+    add(&format!("mask={mask}"), 1, 13, true);
+    add(&format!("mask={odd_mask}"), 3, 5, true);
+    add(&format!("hot-pixels={mask}"), 0, 9, true);
+    add(&format!("polarity=off mask={mask}"), 2, 21, true);
     compare(&streams, &cases, dir.path());
 }
 
@@ -296,6 +336,8 @@ fn the_dvxplorer_recording_filters_as_in_dv_processing() {
     let recording = evtac_formats::read_recording(&path).unwrap();
     let sensor = recording.resolution.expect("the recording's resolution");
     let events = recording.events;
+    let dir = tempfile::tempdir().unwrap();
+    let hot = write_mask(dir.path(), "hot.npy", sensor, 7);
     let mut cases = Vec::new();
     let mut add = |spec: &str, batches: usize| {
         let seed = cases.len() as u64 + 77;
@@ -315,7 +357,7 @@ fn the_dvxplorer_recording_filters_as_in_dv_processing() {
     add("polarity=off", 10);
     add("region=40,0,240,240", 10);
     add("fast-decay=5ms,2,3 k-noise=2ms", 30);
-    let dir = tempfile::tempdir().unwrap();
+    add(&format!("background-activity=10ms hot-pixels={hot}"), 20);
     compare(&[events], &cases, dir.path());
 }
 

@@ -3,4 +3,5 @@
 mod chunks;
 mod common;
 mod dv_processing;
+mod masks;
 mod references;

@@ -1,5 +1,6 @@
 //! `evtac filter`: a recording through event filters (`evtac_filters`: dv-processing's noise,
-//! polarity and region filters exactly, a refractory period and the dome's disc), in the order
+//! polarity, region and mask filters exactly, a refractory period, hot pixels and the dome's
+//! disc), in the order
 //! given, from any format evtac reads to any it writes. IMU samples and triggers pass untouched;
 //! each filter's removed events are printed.
 //!
@@ -30,7 +31,8 @@ pub struct Args {
     /// A filter, applied in the order given (repeat the flag for a chain):
     /// `background-activity=DURATION`, `fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]`,
     /// `k-noise=DURATION`, `polarity=on|off`, `region=X,Y,W,H`, `refractory=DURATION`,
-    /// `circle=CX,CY,R`. Durations take `us`, `ms` or `s`.
+    /// `circle=CX,CY,R`, `mask=FILE` (keeps the pixels a uint8 H x W NPY or 8-bit greyscale
+    /// PNG marks non-zero), `hot-pixels=FILE` (removes them). Durations take `us`, `ms` or `s`.
     #[arg(long = "filter", value_name = "SPEC", required = true)]
     pub filters: Vec<FilterSpec>,
     #[command(flatten)]
