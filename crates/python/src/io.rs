@@ -65,6 +65,35 @@ impl Recording {
             self.triggers.bind(py).len()?,
         ))
     }
+
+    /// The recording with its events through the filters `specs` (the command line's SPECs, in
+    /// order), IMU samples and triggers untouched; and each filter's SPEC with the events it
+    /// removed. The recording must state its sensor size.
+    fn filter(
+        &self,
+        py: Python<'_>,
+        specs: Vec<String>,
+    ) -> PyResult<(Recording, Vec<(String, u64)>)> {
+        let Some((w, h)) = self.resolution else {
+            return Err(error::value(
+                "the recording does not state its sensor size: read it with resolution=(width, height) to filter it",
+            ));
+        };
+        let view = self.events.bind(py).call_method1("view", ("u1",))?;
+        let bytes: PyReadonlyArray1<'_, u8> = view.extract()?;
+        let bytes = bytes.as_slice().map_err(error::value)?;
+        let (kept, removed) =
+            py.detach(|| crate::filter::run(bytes, Resolution::new(w, h), &specs))?;
+        let recording = Recording {
+            events: Layout::Event.to_numpy(py, kept)?.unbind(),
+            imu: self.imu.clone_ref(py),
+            triggers: self.triggers.clone_ref(py),
+            resolution: self.resolution,
+            format: self.format,
+            source: self.source.clone(),
+        };
+        Ok((recording, removed))
+    }
 }
 
 /// What a read produced, packed, before it reaches numpy.

@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 
 pub mod dataset;
 pub mod error;
+pub mod filter;
 pub mod io;
 pub mod model;
 pub mod records;
@@ -26,6 +27,7 @@ fn _evtac(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(io::read, m)?)?;
     m.add_function(wrap_pyfunction!(io::write, m)?)?;
+    m.add_function(wrap_pyfunction!(filter::filter, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::labels, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::label_trial, m)?)?;

@@ -29,7 +29,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -47,6 +47,7 @@ __all__ = [
     "read",
     "open",
     "write",
+    "filter",
     "Representation",
     "Features",
     "Model",
@@ -209,6 +210,35 @@ def write(
         _size(resolution, "resolution"),
         source,
     )
+
+
+def filter(
+    events: Any,
+    resolution: Size,
+    specs: Union[str, Sequence[str]],
+    counts: bool = False,
+) -> Union[np.ndarray, Tuple[np.ndarray, List[Tuple[str, int]]]]:
+    """The events kept by the filters ``specs``, applied in order, as ``evtac filter --filter
+    SPEC`` applies them (the same events: dv-processing 2.0.4's where it has the filter).
+
+    ``specs`` are the command line's SPECs: ``background-activity=10ms`` (the NeuroTac lab's
+    capture filter), ``fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]``, ``k-noise=DURATION``,
+    ``polarity=on|off``, ``region=X,Y,W,H``, ``refractory=DURATION``, ``circle=CX,CY,R``,
+    ``mask=FILE`` and ``hot-pixels=FILE``. ``events`` (an :data:`EVENT_DTYPE` array, in time
+    order) lie on a ``resolution=(w, h)`` sensor. With ``counts=True`` also returns each
+    filter's SPEC with the events it removed, ``[(spec, removed), ...]`` in order.
+
+    >>> kept = evtac.filter(rec.events, rec.resolution, ["background-activity=10ms"])  # doctest: +SKIP
+
+    A :class:`Recording` filters itself, IMU and triggers kept:
+    ``filtered, removed = rec.filter(["background-activity=10ms"])``.
+    """
+    size = _size(resolution, "resolution")
+    if size is None:
+        raise ValueError("resolution=(width, height) is needed: the filters keep state per pixel")
+    specs = [specs] if isinstance(specs, str) else list(specs)
+    kept, removed = _evtac.filter(_event_bytes(events), size, specs)
+    return (kept, removed) if counts else kept
 
 
 class Representation:

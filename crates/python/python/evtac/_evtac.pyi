@@ -5,7 +5,7 @@ Events, IMU samples and estimates cross as packed records viewed as ``uint8`` (s
 """
 
 import os
-from typing import Iterator, Optional, Tuple, Union, final
+from typing import Iterator, List, Optional, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -14,6 +14,7 @@ __all__ = [
     "__version__",
     "read",
     "write",
+    "filter",
     "simulate",
     "labels",
     "label_trial",
@@ -41,6 +42,7 @@ class Recording:
     resolution: Optional[_Size]
     format: str
     source: Optional[str]
+    def filter(self, specs: List[str]) -> Tuple[Recording, List[Tuple[str, int]]]: ...
 
 @final
 class Reader:
@@ -66,6 +68,9 @@ def read(
     resolution: Optional[_Size] = None,
     stream: Optional[str] = None,
 ) -> Recording: ...
+def filter(
+    events: _Bytes, resolution: _Size, specs: List[str]
+) -> Tuple[np.ndarray, List[Tuple[str, int]]]: ...
 def write(
     path: _Path,
     events: _Bytes,

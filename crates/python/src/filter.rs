@@ -1,0 +1,53 @@
+//! `evtac.filter` and `Recording.filter`: events through a chain of filters given as the
+//! command line's SPECs (`evtac_filters`), with the events each filter removed.
+
+use evtac_events::Resolution;
+use evtac_events::check::EventCheck;
+use evtac_filters::{Chain, Filter, FilterSpec};
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+
+use crate::error;
+use crate::records::{self, Layout};
+
+/// Filters `events` (packed event records) of a `resolution` sensor through `specs` in order;
+/// the kept events (packed) and each filter's SPEC (written out) with the events it removed.
+pub fn run(
+    events: &[u8],
+    resolution: Resolution,
+    specs: &[String],
+) -> PyResult<(Vec<u8>, Vec<(String, u64)>)> {
+    let specs: Vec<FilterSpec> = specs
+        .iter()
+        .map(|s| s.parse::<FilterSpec>().map_err(error::value))
+        .collect::<PyResult<_>>()?;
+    let events = records::decode_events(events)?;
+    // The filters index per-pixel state by the event's pixel and assume time order.
+    EventCheck::new(Some(resolution))
+        .check(&events)
+        .map_err(|e| error::value(format!("events to filter: {e}")))?;
+    let mut chain = Chain::build(&specs, resolution).map_err(error::value)?;
+    let mut kept = Vec::new();
+    chain.retain(&events, &mut kept);
+    let removed = specs
+        .iter()
+        .zip(chain.filters())
+        .map(|(spec, f)| (spec.to_string(), f.removed()))
+        .collect();
+    Ok((records::encode_events(&kept)?, removed))
+}
+
+/// `evtac.filter`: `events` (packed records) of a `(width, height)` sensor through the filters
+/// `specs`; the kept events and `[(spec, removed)]`.
+#[pyfunction]
+pub fn filter<'py>(
+    py: Python<'py>,
+    events: PyReadonlyArray1<'_, u8>,
+    resolution: (u16, u16),
+    specs: Vec<String>,
+) -> PyResult<(Bound<'py, PyAny>, Vec<(String, u64)>)> {
+    let bytes = events.as_slice().map_err(error::value)?;
+    let resolution = Resolution::new(resolution.0, resolution.1);
+    let (kept, removed) = py.detach(|| run(bytes, resolution, &specs))?;
+    Ok((Layout::Event.to_numpy(py, kept)?, removed))
+}
