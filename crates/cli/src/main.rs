@@ -10,6 +10,7 @@ mod inputs;
 mod kinds;
 mod outputs;
 mod progress;
+mod scale_seed;
 mod sensor;
 mod streams;
 mod trial_references;
