@@ -6,10 +6,12 @@
 
 mod cluster;
 mod commands;
+mod formats;
 mod inputs;
 mod kinds;
 mod outputs;
 mod progress;
+mod rewrite;
 mod scale_seed;
 mod sensor;
 mod streams;

@@ -36,12 +36,13 @@ pub struct Args {
     /// Model bundle folder (from `evtac train`): weights, representation settings, mask.
     #[arg(long)]
     pub model: PathBuf,
-    /// Event source: a recording (any format evtac reads: AEDAT, EVT, CSV, NPY, NPZ, HDF5, ROS
-    /// bags, the NeuroTac pickles), a live DV network stream `tcp://HOST:PORT`, a ROS 2 topic
-    /// `ros2:///TOPIC` (event_camera_msgs/msg/EventPacket or dvs_msgs/msg/EventArray, over DDS,
-    /// no ROS installation needed; see docs/online.md), or `-` for standard input (AEDAT4 or
-    /// CSV).
-    #[arg(long)]
+    // The help is built from the one phrase of readable formats (see `crate::formats`).
+    #[arg(long, help = concat!(
+        "Event source: a recording (any format evtac reads: ", crate::formats::readable_formats!(),
+        "), a live DV network stream `tcp://HOST:PORT`, a ROS 2 topic `ros2:///TOPIC` \
+         (event_camera_msgs/msg/EventPacket or dvs_msgs/msg/EventArray, over DDS, no ROS \
+         installation needed; see docs/online.md), or `-` for standard input (AEDAT4 or CSV)"
+    ))]
     pub input: String,
     /// Interval between estimates, in milliseconds of event time.
     #[arg(long, default_value_t = 1.0)]
