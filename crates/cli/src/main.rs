@@ -115,17 +115,32 @@ fn main() {
 /// The error and its causes, joined by `: ` as `{:#}` does, but leaving out a cause whose
 /// message the text before it already holds: the library errors embed their inner error's
 /// message (`model.safetensors: No such file or directory`) and some also keep it as their
-/// `source()`, which `{:#}` would print a second time.
+/// `source()`, which `{:#}` would print a second time. A cause that starts by naming again what
+/// the text ends with (`reading X` and then `X: X: No such file`, a context and two layers of
+/// errors that each name the path) is joined without those repeated names.
 fn report(err: &anyhow::Error) -> String {
     let mut text = err.to_string();
     for cause in err.chain().skip(1) {
         let cause = cause.to_string();
-        if !text.contains(&cause) {
-            text.push_str(": ");
-            text.push_str(&cause);
+        if text.contains(&cause) {
+            continue;
         }
+        let mut rest = cause.as_str();
+        while let Some((head, tail)) = rest.split_once(": ")
+            && ends_with_name(&text, head)
+        {
+            rest = tail;
+        }
+        text.push_str(": ");
+        text.push_str(rest);
     }
     text
+}
+
+/// Whether `text` ends with `name` as a whole word (after a space or a `: `, or all of it).
+fn ends_with_name(text: &str, name: &str) -> bool {
+    text.strip_suffix(name)
+        .is_some_and(|before| before.is_empty() || before.ends_with(' '))
 }
 
 #[cfg(test)]
@@ -159,5 +174,26 @@ mod tests {
         };
         let expected = crate::commands::reproduce::Args::for_job(&job);
         assert_eq!(format!("{parsed:?}"), format!("{expected:?}"));
+    }
+
+    /// An error chain whose layers each name the path (as `evtac render` of a missing file
+    /// had: `reading X: X: X: No such file`) says the path once, and its cause once.
+    #[test]
+    fn a_path_named_by_every_layer_is_said_once() {
+        use anyhow::Context;
+        let missing = || std::io::Error::new(std::io::ErrorKind::NotFound, "No such file");
+        // Each layer's message embeds the one below, as the library errors' do.
+        let err = Err::<(), _>(missing())
+            .context("a.aedat4: No such file")
+            .context("a.aedat4: a.aedat4: No such file")
+            .context("reading a.aedat4")
+            .unwrap_err();
+        assert_eq!(super::report(&err), "reading a.aedat4: No such file");
+        // A cause that names something else than the text's end is kept whole.
+        let err = Err::<(), _>(missing())
+            .context("b.csv: No such file")
+            .context("reading a.aedat4")
+            .unwrap_err();
+        assert_eq!(super::report(&err), "reading a.aedat4: b.csv: No such file");
     }
 }

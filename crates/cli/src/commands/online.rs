@@ -347,7 +347,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(f) => f,
         None => stdout.insert(std::io::BufWriter::new(std::io::stdout().lock())),
     };
-    writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
+    // Where the estimates go, for the errors of writing them.
+    let destination = args.output.as_ref().map_or_else(
+        || "standard output".to_string(),
+        |p| p.display().to_string(),
+    );
+    writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")
+        .with_context(|| format!("writing the estimates to {destination}"))?;
     let stop = stop_on_interrupt()?;
     let started = Instant::now();
     let mut write_error = None;
@@ -430,9 +436,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     eprintln!("{summary}");
     if let Some(e) = write_error {
-        return Err(e).context("writing the estimates");
+        return Err(e).with_context(|| format!("writing the estimates to {destination}"));
     }
-    flushed.context("writing the estimates")?;
+    flushed.with_context(|| format!("writing the estimates to {destination}"))?;
     if let Some(e) = log_error {
         return Err(e.into());
     }
