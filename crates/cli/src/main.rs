@@ -115,32 +115,36 @@ fn main() {
 /// The error and its causes, joined by `: ` as `{:#}` does, but leaving out a cause whose
 /// message the text before it already holds: the library errors embed their inner error's
 /// message (`model.safetensors: No such file or directory`) and some also keep it as their
-/// `source()`, which `{:#}` would print a second time. A cause that starts by naming again what
-/// the text ends with (`reading X` and then `X: X: No such file`, a context and two layers of
-/// errors that each name the path) is joined without those repeated names.
+/// `source()`, which `{:#}` would print a second time. A part that only names again what the
+/// part before it ends with (`reading X: X: No such file`, two layers of errors that each name
+/// the path) is said once.
 fn report(err: &anyhow::Error) -> String {
     let mut text = err.to_string();
     for cause in err.chain().skip(1) {
         let cause = cause.to_string();
-        if text.contains(&cause) {
+        if !text.contains(&cause) {
+            text.push_str(": ");
+            text.push_str(&cause);
+        }
+    }
+    let mut parts: Vec<&str> = Vec::new();
+    for part in text.split(": ") {
+        if let Some(before) = parts.last()
+            && ends_with_name(before, part)
+        {
             continue;
         }
-        let mut rest = cause.as_str();
-        while let Some((head, tail)) = rest.split_once(": ")
-            && ends_with_name(&text, head)
-        {
-            rest = tail;
-        }
-        text.push_str(": ");
-        text.push_str(rest);
+        parts.push(part);
     }
-    text
+    parts.join(": ")
 }
 
-/// Whether `text` ends with `name` as a whole word (after a space or a `: `, or all of it).
+/// Whether `text` ends with `name` as a whole word (after a space, or all of it).
 fn ends_with_name(text: &str, name: &str) -> bool {
-    text.strip_suffix(name)
-        .is_some_and(|before| before.is_empty() || before.ends_with(' '))
+    !name.is_empty()
+        && text
+            .strip_suffix(name)
+            .is_some_and(|before| before.is_empty() || before.ends_with(' '))
 }
 
 #[cfg(test)]
@@ -177,7 +181,8 @@ mod tests {
     }
 
     /// An error chain whose layers each name the path (as `evtac render` of a missing file
-    /// had: `reading X: X: X: No such file`) says the path once, and its cause once.
+    /// had: `reading X: X: X: No such file`) says the path once, and its cause once; so does
+    /// one error whose message names the path its inner error names again.
     #[test]
     fn a_path_named_by_every_layer_is_said_once() {
         use anyhow::Context;
@@ -195,5 +200,7 @@ mod tests {
             .context("reading a.aedat4")
             .unwrap_err();
         assert_eq!(super::report(&err), "reading a.aedat4: b.csv: No such file");
+        let err = anyhow::anyhow!("reading a.aedat4: a.aedat4: No such file");
+        assert_eq!(super::report(&err), "reading a.aedat4: No such file");
     }
 }

@@ -289,8 +289,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(topic) => Some(ros2_publisher(&args, topic, &say)?),
         None => None,
     };
-    let opened = input::open(&spec, &options, &mut |n| say(&n))
-        .with_context(|| format!("opening {spec}"))?;
+    // Every input error names the input (`reading X: ...`, `could not connect to X: ...`).
+    let opened = input::open(&spec, &options, &mut |n| say(&n))?;
     let sensor = opened.resolution.with_context(|| {
         format!("{spec} does not state the sensor size: give it with --sensor WIDTHxHEIGHT")
     })?;
