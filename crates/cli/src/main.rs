@@ -6,10 +6,13 @@
 
 mod cluster;
 mod commands;
+mod formats;
 mod inputs;
 mod kinds;
 mod outputs;
 mod progress;
+mod rewrite;
+mod scale_seed;
 mod sensor;
 mod streams;
 mod trial_references;
@@ -112,7 +115,9 @@ fn main() {
 /// The error and its causes, joined by `: ` as `{:#}` does, but leaving out a cause whose
 /// message the text before it already holds: the library errors embed their inner error's
 /// message (`model.safetensors: No such file or directory`) and some also keep it as their
-/// `source()`, which `{:#}` would print a second time.
+/// `source()`, which `{:#}` would print a second time. A part that only names again what the
+/// part before it ends with (`reading X: X: No such file`, two layers of errors that each name
+/// the path) is said once.
 fn report(err: &anyhow::Error) -> String {
     let mut text = err.to_string();
     for cause in err.chain().skip(1) {
@@ -122,7 +127,24 @@ fn report(err: &anyhow::Error) -> String {
             text.push_str(&cause);
         }
     }
-    text
+    let mut parts: Vec<&str> = Vec::new();
+    for part in text.split(": ") {
+        if let Some(before) = parts.last()
+            && ends_with_name(before, part)
+        {
+            continue;
+        }
+        parts.push(part);
+    }
+    parts.join(": ")
+}
+
+/// Whether `text` ends with `name` as a whole word (after a space, or all of it).
+fn ends_with_name(text: &str, name: &str) -> bool {
+    !name.is_empty()
+        && text
+            .strip_suffix(name)
+            .is_some_and(|before| before.is_empty() || before.ends_with(' '))
 }
 
 #[cfg(test)]
@@ -156,5 +178,29 @@ mod tests {
         };
         let expected = crate::commands::reproduce::Args::for_job(&job);
         assert_eq!(format!("{parsed:?}"), format!("{expected:?}"));
+    }
+
+    /// An error chain whose layers each name the path (as `evtac render` of a missing file
+    /// had: `reading X: X: X: No such file`) says the path once, and its cause once; so does
+    /// one error whose message names the path its inner error names again.
+    #[test]
+    fn a_path_named_by_every_layer_is_said_once() {
+        use anyhow::Context;
+        let missing = || std::io::Error::new(std::io::ErrorKind::NotFound, "No such file");
+        // Each layer's message embeds the one below, as the library errors' do.
+        let err = Err::<(), _>(missing())
+            .context("a.aedat4: No such file")
+            .context("a.aedat4: a.aedat4: No such file")
+            .context("reading a.aedat4")
+            .unwrap_err();
+        assert_eq!(super::report(&err), "reading a.aedat4: No such file");
+        // A cause that names something else than the text's end is kept whole.
+        let err = Err::<(), _>(missing())
+            .context("b.csv: No such file")
+            .context("reading a.aedat4")
+            .unwrap_err();
+        assert_eq!(super::report(&err), "reading a.aedat4: b.csv: No such file");
+        let err = anyhow::anyhow!("reading a.aedat4: a.aedat4: No such file");
+        assert_eq!(super::report(&err), "reading a.aedat4: No such file");
     }
 }

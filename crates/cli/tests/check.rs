@@ -78,3 +78,19 @@ fn an_error_says_its_cause_once() {
     assert!(!o.status.success());
     assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
 }
+
+#[test]
+fn a_missing_folder_is_named_in_its_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no-such-folder");
+    let o = evtac().arg("check").arg(&missing).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let row = out.lines().nth(1).unwrap_or_default();
+    // The file column holds the folder as given (not the empty path relative to itself).
+    assert!(
+        row.starts_with(&format!("{}  ", missing.display())),
+        "{out}"
+    );
+    assert!(row.contains("the folder does not exist"), "{out}");
+}

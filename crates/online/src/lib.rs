@@ -58,9 +58,11 @@ mod notice;
 pub mod pipeline;
 pub mod ros2;
 mod schedule;
+mod summary;
 
 pub use backoff::Backoff;
 pub use estimator::{Counters, Error as EstimatorError, Estimate, Estimator};
-pub use latency::{LatencyStats, Summary};
+pub use latency::LatencyStats;
 pub use notice::Notice;
 pub use schedule::{Error as ScheduleError, Schedule};
+pub use summary::Summary;

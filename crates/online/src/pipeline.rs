@@ -15,8 +15,8 @@
 use crate::estimator::{Error as EstimatorError, Estimate, Estimator};
 use crate::frames::FrameSet;
 use crate::input::{EventSource, InputError};
-use crate::latency::Summary;
 use crate::notice::Notice;
+use crate::summary::Summary;
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TryRecvError, TrySendError, bounded};
 use evtac_events::Event;
 use std::ops::ControlFlow;

@@ -10,13 +10,16 @@ use pyo3::prelude::*;
 use crate::error;
 use crate::records::{self, Layout};
 
+/// Each filter's SPEC (written out) with the events it removed, in the chain's order.
+pub type Removed = Vec<(String, u64)>;
+
 /// Filters `events` (packed event records) of a `resolution` sensor through `specs` in order;
 /// the kept events (packed) and each filter's SPEC (written out) with the events it removed.
 pub fn run(
     events: &[u8],
     resolution: Resolution,
     specs: &[String],
-) -> PyResult<(Vec<u8>, Vec<(String, u64)>)> {
+) -> PyResult<(Vec<u8>, Removed)> {
     let specs: Vec<FilterSpec> = specs
         .iter()
         .map(|s| s.parse::<FilterSpec>().map_err(error::value))
@@ -45,7 +48,7 @@ pub fn filter<'py>(
     events: PyReadonlyArray1<'_, u8>,
     resolution: (u16, u16),
     specs: Vec<String>,
-) -> PyResult<(Bound<'py, PyAny>, Vec<(String, u64)>)> {
+) -> PyResult<(Bound<'py, PyAny>, Removed)> {
     let bytes = events.as_slice().map_err(error::value)?;
     let resolution = Resolution::new(resolution.0, resolution.1);
     let (kept, removed) = py.detach(|| run(bytes, resolution, &specs))?;

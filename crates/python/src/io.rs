@@ -73,7 +73,7 @@ impl Recording {
         &self,
         py: Python<'_>,
         specs: Vec<String>,
-    ) -> PyResult<(Recording, Vec<(String, u64)>)> {
+    ) -> PyResult<(Recording, crate::filter::Removed)> {
         let Some((w, h)) = self.resolution else {
             return Err(error::value(
                 "the recording does not state its sensor size: read it with resolution=(width, height) to filter it",

@@ -45,9 +45,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `path` relative to `dir` when it is inside it (shorter rows).
+/// `path` relative to `dir` when it is inside it (shorter rows); `dir` itself (a folder that
+/// is missing, unreadable or empty) as given, not as the empty path relative to itself.
 fn short(dir: &Path, path: &Path) -> String {
-    path.strip_prefix(dir).unwrap_or(path).display().to_string()
+    match path.strip_prefix(dir) {
+        Ok(rel) if rel.as_os_str().is_empty() => dir.display().to_string(),
+        Ok(rel) => rel.display().to_string(),
+        Err(_) => path.display().to_string(),
+    }
 }
 
 /// The table of problems, or the summary when there is none.

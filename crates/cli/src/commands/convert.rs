@@ -21,10 +21,8 @@ use evtac_formats::csv::ImuCsvWriter;
 /// Arguments of `evtac convert`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording to read (AEDAT 4.0, 3.1 or 2.0, EVT 2.0/2.1/3.0 raw, CSV or NPY).
-    pub input: PathBuf,
-    /// The file to write; its extension picks the format: .aedat4 (LZ4), .csv or .npy.
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub files: crate::rewrite::RewriteArgs,
     /// Also write the IMU samples to this CSV file (t,ax,ay,az,gx,gy,gz,temperature).
     #[arg(long, value_name = "IMU_OUT.csv")]
     pub imu: Option<PathBuf>,
@@ -63,22 +61,17 @@ pub struct Counts {
 /// Runs `evtac convert`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let counts = convert(&args)?;
-    eprintln!(
-        "wrote {} of {} events to {}",
-        counts.events_out,
-        counts.events_in,
-        args.output.display()
-    );
+    args.files.say_written(counts.events_out, counts.events_in);
     Ok(())
 }
 
-/// Converts `args.input` to `args.output` as `evtac convert` does.
+/// Converts `args.files.input` to `args.files.output` as `evtac convert` does.
 pub fn convert(args: &Args) -> anyhow::Result<Counts> {
-    refuse_input(&args.output, &[&args.input])?;
+    refuse_input(&args.files.output, &[&args.files.input])?;
     if let Some(imu) = &args.imu {
-        refuse_input(imu, &[&args.input, &args.output])?;
+        refuse_input(imu, &[&args.files.input, &args.files.output])?;
     }
-    let mut reader = evtac_formats::open_with(&args.input, &args.streams.selection())?;
+    let mut reader = evtac_formats::open_with(&args.files.input, &args.streams.selection())?;
     if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }
@@ -90,21 +83,21 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         if from >= to {
             bail!(
                 "{}: --from-us {from} is not before --to-us {to}: the time range [from, to) is empty",
-                args.input.display()
+                args.files.input.display()
             );
         }
         let index = reader.select_range(from, to)?;
         if let Some(reason) = index.fallback() {
             eprintln!(
                 "warning: {}: {reason}; reading the whole file to find the range",
-                args.input.display()
+                args.files.input.display()
             );
         }
     }
     let Some(sensor) = reader.resolution() else {
         bail!(
             "{} is {} and does not store the sensor size: pass --sensor WIDTHxHEIGHT",
-            args.input.display(),
+            args.files.input.display(),
             reader.format()
         );
     };
@@ -113,7 +106,7 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
             .with_context(|| format!("--roi {size} does not fit inside the {sensor} sensor"))?,
         None => Roi::full(sensor),
     };
-    let mut writer = EventWriter::create(&args.output, Some(roi.size), reader.source())?;
+    let mut writer = EventWriter::create(&args.files.output, Some(roi.size), reader.source())?;
     let mut imu_writer = match &args.imu {
         Some(path) => Some((
             ImuCsvWriter::new(
@@ -157,14 +150,14 @@ pub fn convert(args: &Args) -> anyhow::Result<Counts> {
         eprintln!(
             "note: {} IMU samples were not written ({} files hold events only); use --imu FILE.csv",
             counts.imu,
-            writer_format_name(&args.output)
+            writer_format_name(&args.files.output)
         );
     }
     if counts.triggers > 0 && !stores_triggers {
         eprintln!(
             "note: {} triggers were not written ({} files hold events only); write .aedat4 to keep them",
             counts.triggers,
-            writer_format_name(&args.output)
+            writer_format_name(&args.files.output)
         );
     }
     Ok(counts)

@@ -8,8 +8,6 @@
 //! does not fit (a region outside the sensor) leaves no output; outputs appear only once
 //! complete ([`evtac_events::output`]), and an output that is the input is refused.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, bail};
 use evtac_events::output::refuse_input;
 use evtac_filters::{Chain, Filter, FilterSpec};
@@ -23,11 +21,8 @@ use evtac_formats::EventWriter;
                         circle=120,120,110"
 )]
 pub struct Args {
-    /// The recording to read (any format `evtac info` reads).
-    pub input: PathBuf,
-    /// The file to write; its extension picks the format: .aedat4 (with the IMU and triggers),
-    /// .csv or .npy.
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub files: crate::rewrite::RewriteArgs,
     /// A filter, applied in the order given (repeat the flag for a chain):
     /// `background-activity=DURATION`, `fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]`,
     /// `k-noise=DURATION`, `polarity=on|off`, `region=X,Y,W,H`, `refractory=DURATION`,
@@ -58,32 +53,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for ((name, removed), spec) in counts.removed.iter().zip(&args.filters) {
         eprintln!("{spec}: removed {removed} events ({name})");
     }
-    eprintln!(
-        "wrote {} of {} events to {}",
-        counts.events_out,
-        counts.events_in,
-        args.output.display()
-    );
+    args.files.say_written(counts.events_out, counts.events_in);
     Ok(())
 }
 
-/// Filters `args.input` into `args.output` as `evtac filter` does.
+/// Filters `args.files.input` into `args.files.output` as `evtac filter` does.
 pub fn filter(args: &Args) -> anyhow::Result<Counts> {
-    refuse_input(&args.output, &[&args.input])?;
-    let mut reader = evtac_formats::open_with(&args.input, &args.streams.selection())?;
+    refuse_input(&args.files.output, &[&args.files.input])?;
+    let mut reader = evtac_formats::open_with(&args.files.input, &args.streams.selection())?;
     if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }
     let Some(sensor) = reader.resolution() else {
         bail!(
             "{} is {} and does not store the sensor size: pass --sensor WIDTHxHEIGHT",
-            args.input.display(),
+            args.files.input.display(),
             reader.format()
         );
     };
     let mut chain = Chain::build(&args.filters, sensor)
-        .with_context(|| format!("{}: the {sensor} sensor", args.input.display()))?;
-    let mut writer = EventWriter::create(&args.output, Some(sensor), reader.source())?;
+        .with_context(|| format!("{}: the {sensor} sensor", args.files.input.display()))?;
+    let mut writer = EventWriter::create(&args.files.output, Some(sensor), reader.source())?;
     let bar = crate::progress::bytes(reader.file_len(), "filtering");
     let mut kept = Vec::new();
     let mut counts = Counts::default();

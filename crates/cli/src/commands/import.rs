@@ -120,7 +120,8 @@ pub struct Args {
     pub calibration: Option<PathBuf>,
     /// Where the dataset's labels come from: imu (the paper's: the gyroscope, integrated; every
     /// recording must hold an IMU) or commanded (the robot's commanded motion from the log's
-    /// times, for recordings without an IMU: the lab's pickles, HDF5, NPY, NPZ, CSV; written to
+    /// times, for recordings without an IMU: AEDAT 2.0, EVT raw, CSV, NPY, NPZ, HDF5, the lab's
+    /// pickles; written to
     /// label_source.json, so every command labels the dataset this way).
     #[arg(long, value_enum, default_value_t = LabelsArg::Imu, value_name = "SOURCE")]
     pub labels: LabelsArg,

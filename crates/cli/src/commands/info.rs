@@ -10,8 +10,12 @@ use evtac_formats::Summary;
 /// Arguments of `evtac info`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording to summarise (any format evtac reads: AEDAT 4.0/3.1/2.0, EVT 2.0/2.1/3.0
-    /// raw, CSV, NPY, NPZ, HDF5, the NeuroTac lab's pickles).
+    // The help is built from the one phrase of readable formats (see `crate::formats`).
+    #[arg(help = concat!(
+        "The recording to summarise (any format evtac reads: ",
+        crate::formats::readable_formats!(),
+        ")"
+    ))]
     pub file: PathBuf,
     /// Print the summary as one JSON object instead of text.
     #[arg(long)]

@@ -61,11 +61,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Action::Run { file, index } => {
             let jobs = job::read(&file)?;
             let Some(job) = jobs.get(index) else {
+                // An empty file has no range of indices to name (not "0 to 0").
+                if jobs.is_empty() {
+                    bail!("{} holds no jobs; there is no job {index}", file.display());
+                }
                 bail!(
                     "{} holds {} jobs (indices 0 to {}); there is no job {index}",
                     file.display(),
                     jobs.len(),
-                    jobs.len().saturating_sub(1)
+                    jobs.len() - 1
                 );
             };
             let line = command_line(&equivalent_command("evtac", job));

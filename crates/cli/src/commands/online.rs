@@ -36,12 +36,13 @@ pub struct Args {
     /// Model bundle folder (from `evtac train`): weights, representation settings, mask.
     #[arg(long)]
     pub model: PathBuf,
-    /// Event source: a recording (any format evtac reads: AEDAT, EVT, CSV, NPY, NPZ, HDF5, ROS
-    /// bags, the NeuroTac pickles), a live DV network stream `tcp://HOST:PORT`, a ROS 2 topic
-    /// `ros2:///TOPIC` (event_camera_msgs/msg/EventPacket or dvs_msgs/msg/EventArray, over DDS,
-    /// no ROS installation needed; see docs/online.md), or `-` for standard input (AEDAT4 or
-    /// CSV).
-    #[arg(long)]
+    // The help is built from the one phrase of readable formats (see `crate::formats`).
+    #[arg(long, help = concat!(
+        "Event source: a recording (any format evtac reads: ", crate::formats::readable_formats!(),
+        "), a live DV network stream `tcp://HOST:PORT`, a ROS 2 topic `ros2:///TOPIC` \
+         (event_camera_msgs/msg/EventPacket or dvs_msgs/msg/EventArray, over DDS, no ROS \
+         installation needed; see docs/online.md), or `-` for standard input (AEDAT4 or CSV)"
+    ))]
     pub input: String,
     /// Interval between estimates, in milliseconds of event time.
     #[arg(long, default_value_t = 1.0)]
@@ -288,8 +289,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(topic) => Some(ros2_publisher(&args, topic, &say)?),
         None => None,
     };
-    let opened = input::open(&spec, &options, &mut |n| say(&n))
-        .with_context(|| format!("opening {spec}"))?;
+    // Every input error names the input (`reading X: ...`, `could not connect to X: ...`).
+    let opened = input::open(&spec, &options, &mut |n| say(&n))?;
     let sensor = opened.resolution.with_context(|| {
         format!("{spec} does not state the sensor size: give it with --sensor WIDTHxHEIGHT")
     })?;
@@ -346,7 +347,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(f) => f,
         None => stdout.insert(std::io::BufWriter::new(std::io::stdout().lock())),
     };
-    writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")?;
+    // Where the estimates go, for the errors of writing them.
+    let destination = args.output.as_ref().map_or_else(
+        || "standard output".to_string(),
+        |p| p.display().to_string(),
+    );
+    writeln!(out, "t_us,pitch_deg,roll_deg,latency_us")
+        .with_context(|| format!("writing the estimates to {destination}"))?;
     let stop = stop_on_interrupt()?;
     let started = Instant::now();
     let mut write_error = None;
@@ -429,9 +436,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     eprintln!("{summary}");
     if let Some(e) = write_error {
-        return Err(e).context("writing the estimates");
+        return Err(e).with_context(|| format!("writing the estimates to {destination}"));
     }
-    flushed.context("writing the estimates")?;
+    flushed.with_context(|| format!("writing the estimates to {destination}"))?;
     if let Some(e) = log_error {
         return Err(e.into());
     }

@@ -22,7 +22,12 @@ use std::time::Instant;
 /// Arguments of `evtac render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A recording (AEDAT4, EVT2/EVT3 raw, CSV or NPY), or with `--trial` a dataset folder.
+    // The help is built from the one phrase of readable formats (see `crate::formats`).
+    #[arg(help = concat!(
+        "A recording (",
+        crate::formats::readable_formats!(),
+        "), or with `--trial` a dataset folder"
+    ))]
     pub input: PathBuf,
     /// Output file: `.gif` (animated), `.mp4` (H.264 video; needs `ffmpeg` on the PATH) or
     /// `.png` (contact sheet of every frame). Written beside and renamed at the end.

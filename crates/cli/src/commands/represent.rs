@@ -74,7 +74,8 @@ pub enum DecayArg {
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("settings").multiple(true)))]
 pub struct Args {
-    /// The event recording (AEDAT4, EVT2/EVT3 raw, CSV or NPY).
+    // The help is built from the one phrase of readable formats (see `crate::formats`).
+    #[arg(help = concat!("The event recording (", crate::formats::readable_formats!(), ")"))]
     pub events: PathBuf,
     /// Text file of sample times t_k in microseconds, one per line, non-decreasing (blank lines
     /// and lines starting with `#` are skipped).

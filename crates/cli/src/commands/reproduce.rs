@@ -12,7 +12,6 @@ use evtac_experiments::plan::{Grid, Plan};
 use evtac_experiments::progress::Progress;
 use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
-use evtac_sim::Scale;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -20,10 +19,13 @@ use std::time::Instant;
 
 /// Arguments of `evtac reproduce`.
 #[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Run time: a few minutes at --scale tiny, under 20 minutes on 2 cores at small. \
+    With --executor slurm, each stage's jobs are one Slurm job array."
+)]
 pub struct Args {
-    /// Size: tiny (tests, a few minutes), small (under 20 minutes on 2 cores) or paper.
-    #[arg(long, default_value = "small")]
-    pub scale: Scale,
+    #[command(flatten)]
+    pub scale_seed: crate::scale_seed::ScaleSeed,
     /// Folder with the datasets `exp1/` (required), `exp2/`, `exp3-speed/`, `exp3-depth/`
     /// (simulated into `OUT/data` when not given).
     #[arg(long)]
@@ -31,9 +33,6 @@ pub struct Args {
     /// Opting out of the `--data` datasets' calibration or mask (simulated datasets have both).
     #[command(flatten)]
     pub inputs: crate::inputs::InputArgs,
-    /// Master seed (simulation, splits, training).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
     /// Output folder: models, report, figures.
     #[arg(long)]
     pub out: PathBuf,
@@ -89,14 +88,8 @@ pub struct Args {
     /// run `evtac reproduce` again with the same arguments: it resumes from the finished jobs.
     #[arg(long)]
     pub export_jobs: Option<PathBuf>,
-    /// Where the jobs run: `local` (this machine's threads) or `slurm` (each stage's jobs as a
-    /// Slurm job array, followed with squeue; OUT must be on storage every node sees). An
-    /// interrupted or partly failed run resumes when run again.
-    #[arg(long, value_enum, default_value_t = Executor::Local)]
-    pub executor: Executor,
-    /// Extra `sbatch` arguments for every Slurm job, e.g. "--partition=cpu --time=4:00:00".
-    #[arg(long, allow_hyphen_values = true)]
-    pub slurm_args: Option<String>,
+    #[command(flatten)]
+    pub executor: crate::cluster::ExecutorArgs,
 }
 
 /// One value of `--noise-levels`: a factor, or none (`--noise-levels ''`, how a shell gives
@@ -134,10 +127,12 @@ impl Args {
     /// Slurm reproduction, whose task has one CPU).
     pub fn for_job(job: &ReproduceJob) -> Args {
         Args {
-            scale: job.scale,
+            scale_seed: crate::scale_seed::ScaleSeed {
+                scale: job.scale,
+                seed: job.seed,
+            },
             data: job.data.clone(),
             inputs: crate::inputs::InputArgs::of(job.inputs),
-            seed: job.seed,
             out: job.out.clone(),
             label_noise_deg: job.label_noise_deg,
             datasets: job.datasets.map(|n| n as u64),
@@ -152,19 +147,9 @@ impl Args {
             no_fusions: !job.fusions,
             workers: crate::workers::Workers { jobs: Some(1) },
             export_jobs: None,
-            executor: Executor::Local,
-            slurm_args: None,
+            executor: crate::cluster::ExecutorArgs::local(),
         }
     }
-}
-
-/// Where the jobs of a reproduction (or the points of a sensitivity study) run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Executor {
-    /// This machine, `--jobs` threads.
-    Local,
-    /// A Slurm cluster: `sbatch` job arrays, one task per job.
-    Slurm,
 }
 
 /// The stage bars plus an overall bar over the estimated cost of every stage: its ETA is the
@@ -353,8 +338,8 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
     let started = Instant::now();
     let absolute = |p: &PathBuf| std::path::absolute(p).with_context(|| p.display().to_string());
     let run = ReproduceJob {
-        scale: args.scale,
-        seed: args.seed,
+        scale: args.scale_seed.scale,
+        seed: args.scale_seed.seed,
         out: absolute(&args.out)?,
         data: args.data.as_ref().map(absolute).transpose()?,
         inputs: args.inputs.inputs(),
@@ -367,17 +352,14 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
         grid: args.grid,
         recheck: !args.no_recheck,
     };
-    let (slurm, task) = (
-        crate::cluster::slurm(args.slurm_args.as_deref()),
-        crate::cluster::task()?,
-    );
+    let (slurm, task) = (args.executor.slurm(), crate::cluster::task()?);
     let bars = Bars::default();
     slurm.reproduce(&run, plan, &task, &bars)?;
     bars.finish();
     println!("{}", run.out.join("report.md").display());
     eprintln!(
         "reproduced at scale {} on Slurm in {:.1} s (task logs in {})",
-        args.scale,
+        args.scale_seed.scale,
         started.elapsed().as_secs_f64(),
         run.out.join("slurm").display()
     );
@@ -387,7 +369,7 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
 /// Runs `evtac reproduce`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let mut plan = Plan::for_scale(args.scale);
+    let mut plan = Plan::for_scale(args.scale_seed.scale);
     if let Some(levels) = &args.noise_levels() {
         if let Some(bad) = levels.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
             anyhow::bail!("--noise-levels: {bad} is not a factor (finite and at least 0)");
@@ -417,11 +399,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "--repeats sets how the datasets are simulated; the --data datasets are already made \
          (simulate them with `evtac simulate --repeats N`)"
     );
-    anyhow::ensure!(
-        args.slurm_args.is_none() || args.executor == Executor::Slurm,
-        "--slurm-args is for --executor slurm"
-    );
-    if args.executor == Executor::Slurm {
+    if args.executor.on_slurm()? {
         anyhow::ensure!(
             args.export_jobs.is_none(),
             "--export-jobs lists the jobs for a scheduler of your own; --executor slurm submits them itself: use one or the other"
@@ -433,7 +411,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sim_dir = args.out.join("data");
     let counts = match &args.data {
         Some(data) => TrialCounts::of_datasets(data),
-        None => TrialCounts::of_simulation(&sim_dir, (args.scale, args.repeats), args.seed),
+        None => TrialCounts::of_simulation(
+            &sim_dir,
+            (args.scale_seed.scale, args.repeats),
+            args.scale_seed.seed,
+        ),
     };
     let bars = Overall::new(&bars, CostModel::new(&plan, counts));
     // Every invocation's stage times go to OUT/stage-times.csv: a resumed run's report
@@ -444,7 +426,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => {
             let d = sim_dir;
             pool.install(|| {
-                pipeline::simulate_all(&d, (args.scale, args.repeats), args.seed, &bars)
+                pipeline::simulate_all(
+                    &d,
+                    (args.scale_seed.scale, args.repeats),
+                    args.scale_seed.seed,
+                    &bars,
+                )
             })?;
             let seconds = started.elapsed().as_secs_f64();
             bars.message(&format!("simulated datasets ready in {seconds:.1} s"));
@@ -464,7 +451,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         data_dir.display()
     );
     if let Some(file) = &args.export_jobs {
-        let jobs = pipeline::export_jobs(&data, &plan, args.seed, &args.out)?;
+        let jobs = pipeline::export_jobs(&data, &plan, args.scale_seed.seed, &args.out)?;
         crate::outputs::write_text(file, &job::to_text(&jobs))?;
         bars.finish();
         let f = file.display();
@@ -476,8 +463,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let results =
-        pool.install(|| pipeline::reproduce(&data, &plan, args.seed, &args.out, &log, &bars))?;
+    let results = pool.install(|| {
+        pipeline::reproduce(&data, &plan, args.scale_seed.seed, &args.out, &log, &bars)
+    })?;
     // The report is the last stage, timed like the others (its own time is in the log, not in
     // the report it writes).
     let report_started = Instant::now();
@@ -498,7 +486,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     eprintln!(
         "reproduced at scale {} in {:.1} s",
-        args.scale,
+        args.scale_seed.scale,
         started.elapsed().as_secs_f64()
     );
     Ok(())

@@ -7,13 +7,11 @@
 //! array (each task `evtac jobs run FILE --index K`, which is `evtac sensitivity --point`), then
 //! writes the summary here.
 
-use super::reproduce::Executor;
 use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::context::RunContext;
 use evtac_experiments::job::{Job, SensitivityPointJob};
 use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter};
-use evtac_sim::Scale;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -21,16 +19,15 @@ use std::time::Instant;
 #[derive(Debug, clap::Args)]
 #[command(
     after_help = "The parameters and what each is: OUT/README.md, or the error a name \
-    that is none of them gets.\n\nExample: evtac sensitivity --scale small --out sensitivity \
+    that is none of them gets. Every point has the same --seed. With --executor slurm the \
+    unfinished points run as one Slurm job array, a task each, and the summary is written here \
+    once every point has finished.\n\nExample: evtac sensitivity --scale small --out sensitivity \
     (39 points, about 90 minutes on 2 cores)"
 )]
 pub struct Args {
-    /// Size of each point's dataset and plan: tiny (tests), small or paper.
-    #[arg(long, default_value = "small")]
-    pub scale: Scale,
-    /// Master seed (simulation, splits, training), the same at every point.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Each point's size and seed (the same seed at every point).
+    #[command(flatten)]
+    pub scale_seed: crate::scale_seed::ScaleSeed,
     /// Output folder: the summary, and `points/<parameter>/x<factor>/` (each point's
     /// `point.json`, `simulator.json` and models; its dataset too with --keep-data).
     #[arg(long)]
@@ -44,14 +41,8 @@ pub struct Args {
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
-    /// Where the points run: `local` (this machine's threads) or `slurm` (one Slurm array, a
-    /// task per unfinished point; OUT must be on storage every node sees). The summary is
-    /// written here once every point has finished; an interrupted study resumes when run again.
-    #[arg(long, value_enum, default_value_t = Executor::Local)]
-    pub executor: Executor,
-    /// Extra `sbatch` arguments, e.g. "--partition=cpu --time=1:00:00".
-    #[arg(long, allow_hyphen_values = true)]
-    pub slurm_args: Option<String>,
+    #[command(flatten)]
+    pub executor: crate::cluster::ExecutorArgs,
     /// Keep each finished point's dataset and feature cache (about 1.1 GB a point at small
     /// scale); by default they are removed once the point's results are in its `point.json`,
     /// and its models are kept.
@@ -70,8 +61,8 @@ fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
         .and_then(|(n, f)| Some((n, f.parse::<f64>().ok()?)))
         .with_context(|| format!("--point {spec}: give PARAMETER:FACTOR, e.g. cutoff:0.5"))?;
     let job = SensitivityPointJob {
-        scale: args.scale,
-        seed: args.seed,
+        scale: args.scale_seed.scale,
+        seed: args.scale_seed.seed,
         parameter: name.to_string(),
         factor,
         out: args.out.clone(),
@@ -92,8 +83,8 @@ fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> 
         .into_iter()
         .map(|(name, factor)| {
             Job::SensitivityPoint(SensitivityPointJob {
-                scale: args.scale,
-                seed: args.seed,
+                scale: args.scale_seed.scale,
+                seed: args.scale_seed.seed,
                 parameter: name.to_string(),
                 factor,
                 out: sensitivity::point_dir(&out, name, factor),
@@ -101,10 +92,7 @@ fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> 
             })
         })
         .collect();
-    let (slurm, task) = (
-        crate::cluster::slurm(args.slurm_args.as_deref()),
-        crate::cluster::task()?,
-    );
+    let (slurm, task) = (args.executor.slurm(), crate::cluster::task()?);
     let bars = Bars::default();
     slurm.sensitivity(&jobs, &task, &out.join("slurm"), &bars)?;
     bars.finish();
@@ -140,29 +128,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
              baseline is always run)"
         );
     }
-    anyhow::ensure!(
-        args.slurm_args.is_none() || args.executor == Executor::Slurm,
-        "--slurm-args is for --executor slurm"
-    );
+    let on_slurm = args.executor.on_slurm()?;
     if let Some(spec) = &args.point {
         anyhow::ensure!(
-            args.executor == Executor::Local,
+            !on_slurm,
             "--point runs one point here (a Slurm task's work): it takes no --executor slurm"
         );
         return one_point(&args, spec);
     }
-    if args.executor == Executor::Slurm {
+    if on_slurm {
         points_on_slurm(&args, &parameters)?;
     }
     // Locally: every point; after Slurm: every point is finished, and reading them back is
     // quick.
-    let plan = sensitivity::plan(args.scale);
+    let plan = sensitivity::plan(args.scale_seed.scale);
     let pool = args.workers.pool()?;
     let bars = Bars::default();
     let models = args.out.join("points");
     let run = RunContext {
         plan: &plan,
-        seed: args.seed,
+        seed: args.scale_seed.seed,
         models: &models,
         progress: &bars,
     };
@@ -179,7 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     eprintln!(
         "sensitivity at scale {}: {} points in {:.1} s",
-        args.scale,
+        args.scale_seed.scale,
         study.points.len(),
         started.elapsed().as_secs_f64()
     );

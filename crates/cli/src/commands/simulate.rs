@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use evtac_sim::{
-    DatasetConfig, Protocol, Scale, SessionConfig, SimParams, read_params, simulate_dataset,
+    DatasetConfig, Protocol, SessionConfig, SimParams, read_params, simulate_dataset,
     simulate_session,
 };
 
@@ -16,12 +16,8 @@ pub struct Args {
     /// Protocol: exp1, exp2, exp3-speed, exp3-depth or no-contact.
     #[arg(long)]
     pub protocol: Protocol,
-    /// Size: tiny (tests), small (minutes) or paper (the paper's trial counts).
-    #[arg(long, default_value = "small")]
-    pub scale: Scale,
-    /// Seed: the same seed gives the same bytes.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub scale_seed: crate::scale_seed::ScaleSeed,
     /// Output folder, a dataset or with --session a session (created if missing).
     #[arg(long)]
     pub out: PathBuf,
@@ -62,7 +58,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         params,
         limit: args.limit,
         repeats: args.repeats,
-        ..DatasetConfig::new(args.protocol, args.scale, args.seed)
+        ..DatasetConfig::new(args.protocol, args.scale_seed.scale, args.scale_seed.seed)
     };
     let trials = config.trials().len();
     let pool = args.workers.pool()?;
@@ -73,7 +69,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let session = SessionConfig {
             dataset: config,
             jitter_us: args.jitter_us,
-            ..SessionConfig::new(args.protocol, args.scale, args.seed)
+            ..SessionConfig::new(args.protocol, args.scale_seed.scale, args.scale_seed.seed)
         };
         let record = pool
             .install(|| simulate_session(&session, &args.out, |_| bar.inc(1)))
@@ -99,8 +95,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     eprintln!(
         "simulated {written} {} trials ({} scale, seed {}) as a {what} into {} in {:.1} s",
         args.protocol,
-        args.scale,
-        args.seed,
+        args.scale_seed.scale,
+        args.scale_seed.seed,
         args.out.display(),
         started.elapsed().as_secs_f64()
     );
