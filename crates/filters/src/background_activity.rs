@@ -10,14 +10,13 @@
 use evtac_events::{Event, Resolution};
 
 use crate::surface::TimeSurface;
-use crate::{Filter, Micros};
+use crate::{Micros, Rule};
 
 /// Keeps events supported by a recent event at a neighbouring pixel.
 #[derive(Debug, Clone)]
 pub struct BackgroundActivity {
     surface: TimeSurface,
     duration: i64,
-    removed: u64,
 }
 
 impl BackgroundActivity {
@@ -26,7 +25,6 @@ impl BackgroundActivity {
         Self {
             surface: TimeSurface::new(sensor),
             duration: duration.get(),
-            removed: 0,
         }
     }
 
@@ -45,35 +43,29 @@ impl BackgroundActivity {
     }
 }
 
-impl Filter for BackgroundActivity {
-    fn name(&self) -> &'static str {
-        "background-activity"
-    }
+impl Rule for BackgroundActivity {
+    const NAME: &'static str = "background-activity";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor dv-processing would read and write outside its surface: removed here.
-        let keep = self.surface.index(event.x, event.y).is_some_and(|i| {
+        self.surface.index(event.x, event.y).is_some_and(|i| {
             let keep = self.supported(usize::from(event.x), usize::from(event.y), event.t);
             self.surface.set(i, event.t);
             keep
-        });
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     const T: i64 = 1_000_000;
 
     fn run(events: &[(i64, u16, u16)]) -> Vec<bool> {
-        let mut f = BackgroundActivity::new(Resolution::new(20, 10), Micros::new(2_000).unwrap());
+        let mut f =
+            BackgroundActivity::new(Resolution::new(20, 10), Micros::new(2_000).unwrap()).counted();
         events
             .iter()
             .map(|&(t, x, y)| {
@@ -118,7 +110,8 @@ mod tests {
 
     #[test]
     fn removed_events_still_update_their_pixel_and_off_sensor_ones_count() {
-        let mut f = BackgroundActivity::new(Resolution::new(20, 10), Micros::new(2_000).unwrap());
+        let mut f =
+            BackgroundActivity::new(Resolution::new(20, 10), Micros::new(2_000).unwrap()).counted();
         let e = |t, x, y| Event {
             t,
             x,

@@ -98,6 +98,7 @@ impl Filter for Chain {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Rule;
     use crate::{PolarityFilter, Region};
 
     #[test]
@@ -112,9 +113,9 @@ mod tests {
             .collect();
         let make = || {
             Chain::new(vec![
-                Box::new(PolarityFilter::new(true)),
-                Box::new(Region::new(1, 1, 4, 3)),
-                Box::new(Region::new(0, 0, 4, 10)),
+                Box::new(PolarityFilter::new(true).counted()),
+                Box::new(Region::new(1, 1, 4, 3).counted()),
+                Box::new(Region::new(0, 0, 4, 10).counted()),
             ])
         };
         let mut whole = make();

@@ -8,7 +8,7 @@
 
 use evtac_events::Event;
 
-use crate::Filter;
+use crate::Rule;
 
 /// Keeps the events inside a disc.
 #[derive(Debug, Clone)]
@@ -16,7 +16,6 @@ pub struct Circle {
     cx: f64,
     cy: f64,
     radius_squared: f64,
-    removed: u64,
 }
 
 impl Circle {
@@ -26,37 +25,29 @@ impl Circle {
             cx,
             cy,
             radius_squared: radius * radius,
-            removed: 0,
         }
     }
 }
 
-impl Filter for Circle {
-    fn name(&self) -> &'static str {
-        "circle"
-    }
+impl Rule for Circle {
+    const NAME: &'static str = "circle";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         let dx = f64::from(event.x) - self.cx;
         let dy = f64::from(event.y) - self.cy;
-        let keep = dx * dx + dy * dy <= self.radius_squared;
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        dx * dx + dy * dy <= self.radius_squared
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     #[test]
     fn the_boundary_is_inside() {
-        let mut f = Circle::new(10.0, 10.0, 5.0);
-        let keep = |f: &mut Circle, x, y| {
+        let mut f = Circle::new(10.0, 10.0, 5.0).counted();
+        let keep = |f: &mut crate::Counted<Circle>, x, y| {
             f.keep(&Event {
                 t: 0,
                 x,
@@ -69,7 +60,7 @@ mod tests {
         assert!(keep(&mut f, 13, 14));
         assert!(!keep(&mut f, 14, 14));
         assert!(!keep(&mut f, 10, 16));
-        let mut half = Circle::new(0.5, 0.5, 0.75);
+        let mut half = Circle::new(0.5, 0.5, 0.75).counted();
         assert!(keep(&mut half, 0, 0) && keep(&mut half, 1, 1) && !keep(&mut half, 2, 0));
         assert_eq!(f.removed(), 2);
     }

@@ -13,7 +13,7 @@
 
 use evtac_events::{Event, Resolution};
 
-use crate::{Filter, Micros};
+use crate::{Micros, Rule};
 
 /// Keeps events in cells of the sensor with enough recent, decaying activity.
 #[derive(Debug, Clone)]
@@ -25,7 +25,6 @@ pub struct FastDecay {
     count: Vec<f32>,
     half_life: f32,
     threshold: f32,
-    removed: u64,
 }
 
 impl FastDecay {
@@ -55,21 +54,17 @@ impl FastDecay {
             // dv-processing keeps the half-life as a float32 number of microseconds.
             half_life: half_life.get() as f32,
             threshold,
-            removed: 0,
         }
     }
 }
 
-impl Filter for FastDecay {
-    fn name(&self) -> &'static str {
-        "fast-decay"
-    }
+impl Rule for FastDecay {
+    const NAME: &'static str = "fast-decay";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor: removed, as by the other filters (dv-processing's grid has a spare
         // row and column, but an event there is no event of this sensor).
         if !self.sensor.contains(event.x, event.y) {
-            self.removed += 1;
             return false;
         }
         let cell = usize::from(event.y) / self.subdivision * self.columns
@@ -79,29 +74,25 @@ impl Filter for FastDecay {
         self.last[cell] = event.t;
         let count = self.count[cell] * decay + 1.0;
         self.count[cell] = count;
-        let keep = count > self.threshold;
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        count > self.threshold
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     const T: i64 = 1_000_000;
 
-    fn filter(threshold: f32) -> FastDecay {
+    fn filter(threshold: f32) -> crate::Counted<FastDecay> {
         FastDecay::new(
             Resolution::new(21, 10),
             Micros::new(10_000).unwrap(),
             4,
             threshold,
         )
+        .counted()
     }
 
     fn e(t: i64, x: u16, y: u16) -> Event {

@@ -19,7 +19,7 @@
 
 use evtac_events::{Event, Resolution};
 
-use crate::{Filter, Micros};
+use crate::{Micros, Rule};
 
 /// The last event of one column (`at` its row) or of one row (`at` its column).
 #[derive(Debug, Clone, Copy, Default)]
@@ -36,7 +36,6 @@ pub struct KNoise {
     columns: Vec<Slot>,
     rows: Vec<Slot>,
     duration: i64,
-    removed: u64,
 }
 
 impl KNoise {
@@ -47,7 +46,6 @@ impl KNoise {
             columns: vec![Slot::default(); usize::from(sensor.width)],
             rows: vec![Slot::default(); usize::from(sensor.height)],
             duration: duration.get(),
-            removed: 0,
         }
     }
 
@@ -70,16 +68,13 @@ fn neighbours(slots: &[Slot], i: u16) -> impl Iterator<Item = &Slot> {
     slots[i.saturating_sub(1)..(i + 2).min(slots.len())].iter()
 }
 
-impl Filter for KNoise {
-    fn name(&self) -> &'static str {
-        "k-noise"
-    }
+impl Rule for KNoise {
+    const NAME: &'static str = "k-noise";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         let (x, y) = (usize::from(event.x), usize::from(event.y));
         // Off the sensor dv-processing would index past its slots: removed here.
         if x >= self.columns.len() || y >= self.rows.len() {
-            self.removed += 1;
             return false;
         }
         let keep = self.supported(event);
@@ -93,23 +88,19 @@ impl Filter for KNoise {
             at: event.x,
             polarity: event.polarity,
         };
-        self.removed += u64::from(!keep);
         keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     const T: i64 = 1_000_000;
 
     fn run(events: &[(i64, u16, u16, bool)]) -> Vec<bool> {
-        let mut f = KNoise::new(Resolution::new(20, 20), Micros::new(1_000).unwrap());
+        let mut f = KNoise::new(Resolution::new(20, 20), Micros::new(1_000).unwrap()).counted();
         events
             .iter()
             .map(|&(t, x, y, polarity)| f.keep(&Event { t, x, y, polarity }))

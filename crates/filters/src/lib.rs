@@ -47,6 +47,7 @@
 mod background_activity;
 mod chain;
 mod circle;
+mod counted;
 mod duration;
 mod fast_decay;
 mod k_noise;
@@ -61,6 +62,7 @@ mod surface;
 pub use background_activity::BackgroundActivity;
 pub use chain::Chain;
 pub use circle::Circle;
+pub use counted::{Counted, Rule};
 pub use duration::{Micros, ParseDurationError};
 pub use fast_decay::FastDecay;
 pub use k_noise::KNoise;

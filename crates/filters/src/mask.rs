@@ -4,7 +4,7 @@
 
 use evtac_events::{Event, Resolution};
 
-use crate::Filter;
+use crate::Rule;
 
 /// Keeps the events on the pixels a mask marks.
 #[derive(Debug, Clone)]
@@ -12,7 +12,6 @@ pub struct Mask {
     width: usize,
     /// Row by row: whether each pixel's events are kept.
     keep: Vec<bool>,
-    removed: u64,
 }
 
 impl Mask {
@@ -27,7 +26,6 @@ impl Mask {
         Self {
             width: usize::from(sensor.width),
             keep: marks.iter().map(|&m| m != 0).collect(),
-            removed: 0,
         }
     }
 
@@ -39,33 +37,26 @@ impl Mask {
     }
 }
 
-impl Filter for Mask {
-    fn name(&self) -> &'static str {
-        "mask"
-    }
+impl Rule for Mask {
+    const NAME: &'static str = "mask";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         // Events off the mask (which the readers' checks against the sensor rule out) are
         // removed rather than read out of bounds.
         let k = usize::from(event.y) * self.width + usize::from(event.x);
-        let keep = usize::from(event.x) < self.width && self.keep.get(k).copied().unwrap_or(false);
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        usize::from(event.x) < self.width && self.keep.get(k).copied().unwrap_or(false)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     #[test]
     fn keeps_the_non_zero_pixels_row_by_row() {
         let sensor = Resolution::new(3, 2);
-        let mut f = Mask::new(sensor, &[0, 1, 0, 0, 0, 255]);
+        let mut f = Mask::new(sensor, &[0, 1, 0, 0, 0, 255]).counted();
         let e = |x, y| Event {
             t: 0,
             x,
@@ -78,7 +69,7 @@ mod tests {
         assert!(!f.keep(&e(1, 1)));
         assert!(!f.keep(&e(3, 0)));
         assert_eq!(f.removed(), 3);
-        let mut hot = Mask::removing(sensor, &[0, 1, 0, 0, 0, 255]);
+        let mut hot = Mask::removing(sensor, &[0, 1, 0, 0, 0, 255]).counted();
         assert!(!hot.keep(&e(1, 0)));
         assert!(hot.keep(&e(0, 0)));
     }

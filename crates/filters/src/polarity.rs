@@ -4,44 +4,33 @@
 
 use evtac_events::Event;
 
-use crate::Filter;
+use crate::Rule;
 
 /// Keeps the events of one polarity.
 #[derive(Debug, Clone)]
 pub struct PolarityFilter {
     polarity: bool,
-    removed: u64,
 }
 
 impl PolarityFilter {
     /// Keeps ON events when `polarity` is `true`, OFF events otherwise.
     pub fn new(polarity: bool) -> Self {
-        Self {
-            polarity,
-            removed: 0,
-        }
+        Self { polarity }
     }
 }
 
-impl Filter for PolarityFilter {
-    fn name(&self) -> &'static str {
-        "polarity"
-    }
+impl Rule for PolarityFilter {
+    const NAME: &'static str = "polarity";
 
-    fn keep(&mut self, event: &Event) -> bool {
-        let keep = event.polarity == self.polarity;
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+    fn accept(&mut self, event: &Event) -> bool {
+        event.polarity == self.polarity
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     #[test]
     fn keeps_one_polarity_and_counts_the_other() {
@@ -52,12 +41,12 @@ mod tests {
             polarity,
         };
         let events = [e(true), e(false), e(false), e(true)];
-        let mut on = PolarityFilter::new(true);
+        let mut on = PolarityFilter::new(true).counted();
         let mut kept = Vec::new();
         on.retain(&events, &mut kept);
         assert_eq!(kept, [e(true), e(true)]);
         assert_eq!(on.removed(), 2);
-        let mut off = PolarityFilter::new(false);
+        let mut off = PolarityFilter::new(false).counted();
         kept.clear();
         off.retain(&events, &mut kept);
         assert_eq!(kept, [e(false), e(false)]);

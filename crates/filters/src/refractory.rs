@@ -11,14 +11,13 @@
 use evtac_events::{Event, Resolution};
 
 use crate::surface::TimeSurface;
-use crate::{Filter, Micros};
+use crate::{Micros, Rule};
 
 /// Removes events that follow their pixel's previous event within the period.
 #[derive(Debug, Clone)]
 pub struct Refractory {
     surface: TimeSurface,
     period: i64,
-    removed: u64,
 }
 
 impl Refractory {
@@ -27,39 +26,31 @@ impl Refractory {
         Self {
             surface: TimeSurface::new(sensor),
             period: period.get(),
-            removed: 0,
         }
     }
 }
 
-impl Filter for Refractory {
-    fn name(&self) -> &'static str {
-        "refractory"
-    }
+impl Rule for Refractory {
+    const NAME: &'static str = "refractory";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor there is no pixel to hold a period: removed.
-        let keep = self.surface.index(event.x, event.y).is_some_and(|i| {
+        self.surface.index(event.x, event.y).is_some_and(|i| {
             let keep = event.t.wrapping_sub(self.surface.at(i)) >= self.period;
             self.surface.set(i, event.t);
             keep
-        });
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     #[test]
     fn every_event_restarts_its_pixel_s_period() {
-        let mut f = Refractory::new(Resolution::new(4, 4), Micros::new(100).unwrap());
+        let mut f = Refractory::new(Resolution::new(4, 4), Micros::new(100).unwrap()).counted();
         let e = |t, x| Event {
             t,
             x,
@@ -78,7 +69,7 @@ mod tests {
 
     #[test]
     fn pixels_start_at_timestamp_zero() {
-        let mut f = Refractory::new(Resolution::new(4, 4), Micros::new(100).unwrap());
+        let mut f = Refractory::new(Resolution::new(4, 4), Micros::new(100).unwrap()).counted();
         let e = |t, x| Event {
             t,
             x,

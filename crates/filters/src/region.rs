@@ -5,7 +5,7 @@
 
 use evtac_events::Event;
 
-use crate::Filter;
+use crate::Rule;
 
 /// Keeps the events inside a rectangle.
 #[derive(Debug, Clone)]
@@ -14,7 +14,6 @@ pub struct Region {
     y: u32,
     width: u32,
     height: u32,
-    removed: u64,
 }
 
 impl Region {
@@ -26,37 +25,28 @@ impl Region {
             y: u32::from(y),
             width: u32::from(width),
             height: u32::from(height),
-            removed: 0,
         }
     }
 }
 
-impl Filter for Region {
-    fn name(&self) -> &'static str {
-        "region"
-    }
+impl Rule for Region {
+    const NAME: &'static str = "region";
 
-    fn keep(&mut self, event: &Event) -> bool {
+    fn accept(&mut self, event: &Event) -> bool {
         let (x, y) = (u32::from(event.x), u32::from(event.y));
-        let keep = (self.x..self.x + self.width).contains(&x)
-            && (self.y..self.y + self.height).contains(&y);
-        self.removed += u64::from(!keep);
-        keep
-    }
-
-    fn removed(&self) -> u64 {
-        self.removed
+        (self.x..self.x + self.width).contains(&x) && (self.y..self.y + self.height).contains(&y)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Filter;
 
     #[test]
     fn left_and_top_edges_in_right_and_bottom_out() {
-        let mut f = Region::new(2, 3, 4, 5);
-        let keep = |f: &mut Region, x, y| {
+        let mut f = Region::new(2, 3, 4, 5).counted();
+        let keep = |f: &mut crate::Counted<Region>, x, y| {
             f.keep(&Event {
                 t: 0,
                 x,

@@ -25,7 +25,7 @@ use evtac_events::Resolution;
 use crate::duration::{Micros, ParseDurationError};
 use crate::{
     BackgroundActivity, Circle, FastDecay, Filter, KNoise, Mask, PolarityFilter, Refractory,
-    Region, mask_file,
+    Region, Rule, mask_file,
 };
 
 /// The filters' names, as SPECs begin.
@@ -448,20 +448,20 @@ impl FilterSpec {
                     });
                 }
                 match self {
-                    Self::Mask { .. } => Box::new(Mask::new(sensor, &image.values)),
-                    _ => Box::new(Mask::removing(sensor, &image.values)),
+                    Self::Mask { .. } => Box::new(Mask::new(sensor, &image.values).counted()),
+                    _ => Box::new(Mask::removing(sensor, &image.values).counted()),
                 }
             }
             Self::BackgroundActivity { duration } => {
-                Box::new(BackgroundActivity::new(sensor, duration))
+                Box::new(BackgroundActivity::new(sensor, duration).counted())
             }
             Self::FastDecay {
                 half_life,
                 subdivision,
                 threshold,
-            } => Box::new(FastDecay::new(sensor, half_life, subdivision, threshold)),
-            Self::KNoise { duration } => Box::new(KNoise::new(sensor, duration)),
-            Self::Polarity { on } => Box::new(PolarityFilter::new(on)),
+            } => Box::new(FastDecay::new(sensor, half_life, subdivision, threshold).counted()),
+            Self::KNoise { duration } => Box::new(KNoise::new(sensor, duration).counted()),
+            Self::Polarity { on } => Box::new(PolarityFilter::new(on).counted()),
             Self::Region {
                 x,
                 y,
@@ -481,9 +481,9 @@ impl FilterSpec {
                         sensor,
                     });
                 }
-                Box::new(Region::new(x, y, width, height))
+                Box::new(Region::new(x, y, width, height).counted())
             }
-            Self::Refractory { period } => Box::new(Refractory::new(sensor, period)),
+            Self::Refractory { period } => Box::new(Refractory::new(sensor, period).counted()),
             Self::Circle { cx, cy, radius } => {
                 let on = |c: f64, size: u16| (0.0..=f64::from(size) - 1.0).contains(&c);
                 if !on(cx, sensor.width) || !on(cy, sensor.height) {
@@ -494,7 +494,7 @@ impl FilterSpec {
                         sensor,
                     });
                 }
-                Box::new(Circle::new(cx, cy, radius))
+                Box::new(Circle::new(cx, cy, radius).counted())
             }
         })
     }

@@ -192,3 +192,10 @@ pub(crate) trait Family: Sync {
         false
     }
 }
+
+/// A path's extension, lower case (empty when it has none).
+pub(crate) fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}

@@ -6,7 +6,7 @@ use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
-use crate::family::Family;
+use crate::family::{Family, extension};
 use crate::{Error, Format};
 
 /// The families, in the order their signatures are tried: magic numbers first; NeuroTac
@@ -31,13 +31,6 @@ pub(crate) fn family(format: Format) -> &'static dyn Family {
         .find(|f| f.formats().contains(&format))
         // Every variant of `Format` is some family's (tested below).
         .expect("a Format no family reads")
-}
-
-/// A path's extension, lower case (empty when it has none).
-pub(crate) fn extension(path: &Path) -> String {
-    path.extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default()
 }
 
 /// Recognises the format of the file at `path`: by its first bytes, else by its extension; a

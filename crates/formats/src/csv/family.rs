@@ -28,7 +28,7 @@ impl Family for Csv {
 
     /// By the extension alone, so it is tried after every format with a signature.
     fn sniff(&self, path: &Path, _head: &[u8]) -> Option<Result<Format, Error>> {
-        (crate::registry::extension(path) == "csv").then_some(Ok(Format::Csv))
+        (crate::family::extension(path) == "csv").then_some(Ok(Format::Csv))
     }
 
     fn open(

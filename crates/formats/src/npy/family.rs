@@ -38,7 +38,7 @@ impl Family for Npy {
             return Some(Ok(Format::Npy));
         }
         let zip = head.starts_with(b"PK\x03\x04") || head.starts_with(b"PK\x05\x06");
-        (zip && crate::registry::extension(path) == "npz").then_some(Ok(Format::Npz))
+        (zip && crate::family::extension(path) == "npz").then_some(Ok(Format::Npz))
     }
 
     fn open(
