@@ -9,7 +9,7 @@
 //! are listed, in the order their signatures are tried, in [`crate::registry`].
 
 use std::io::BufWriter;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use evtac_events::output::OutputFile;
 
@@ -99,6 +99,65 @@ pub trait FormatWriter: Send {
     /// Writes what is buffered (packets, data table, record count) and hands back the file,
     /// which the caller flushes and renames.
     fn finish(self: Box<Self>) -> Result<Sunk, Error>;
+}
+
+/// A format's own streaming reader, before the file's path is put on its errors: what the
+/// simple formats' readers (AEDAT 3.1/2.0, EVT, CSV, NPY) share, so that one adapter,
+/// [`Named`], puts each behind [`FormatReader`].
+pub(crate) trait Decode: Send {
+    /// The format's error.
+    type Error;
+
+    /// The next chunk, checked; `Ok(None)` at the end.
+    fn decode(&mut self) -> Result<Option<Chunk<'_>>, Self::Error>;
+
+    /// The sensor size events are checked against.
+    fn sensor(&self) -> Option<Resolution>;
+
+    /// Declares the sensor size.
+    fn declare(&mut self, resolution: Resolution);
+
+    /// Bytes consumed so far.
+    fn consumed(&self) -> u64;
+
+    /// See [`FormatReader::stream_lag_us`].
+    fn lag_us(&self) -> i64 {
+        0
+    }
+}
+
+/// A [`Decode`] reader of the file at `path`, its errors made the whole-file [`Error`] by
+/// `wrap`.
+pub(crate) struct Named<D: Decode> {
+    pub path: PathBuf,
+    pub inner: D,
+    pub wrap: fn(PathBuf, D::Error) -> Error,
+}
+
+impl<D: Decode> FormatReader for Named<D> {
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
+        let (path, wrap) = (&self.path, self.wrap);
+        self.inner
+            .decode()
+            .map_err(|error| wrap(path.clone(), error))
+    }
+
+    fn resolution(&self) -> Option<Resolution> {
+        self.inner.sensor()
+    }
+
+    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
+        self.inner.declare(resolution);
+        Ok(())
+    }
+
+    fn position(&self) -> u64 {
+        self.inner.consumed()
+    }
+
+    fn stream_lag_us(&self) -> i64 {
+        self.inner.lag_us()
+    }
 }
 
 /// A file of a family opened for reading, with what the whole-file API reports about it.

@@ -2,11 +2,11 @@
 //! (another version is an error naming it), read only.
 
 use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::StreamSelection;
 use crate::aedat_legacy::{self, LegacyError, LegacyReader, Version};
-use crate::family::{Extension, Family, FormatReader, Opened};
+use crate::family::{Decode, Extension, Family, Named, Opened};
 use crate::{Chunk, Error, Format, Resolution};
 
 /// The AEDAT 3.1 / 2.0 family.
@@ -41,50 +41,40 @@ impl Family for Legacy {
         _selection: &StreamSelection,
         _len: u64,
     ) -> Result<Opened, Error> {
-        let r = LegacyReader::from_path(path).map_err(legacy_error(path))?;
+        let wrap = |path, error| Error::AedatLegacy { path, error };
+        let r = LegacyReader::from_path(path).map_err(|e| wrap(path.to_path_buf(), e))?;
         Ok(Opened {
             source: r.header().camera.clone(),
-            ..Opened::plain(Reader {
+            ..Opened::plain(Named {
                 path: path.to_path_buf(),
                 inner: r,
+                wrap,
             })
         })
     }
 }
 
-fn legacy_error(path: &Path) -> impl Fn(LegacyError) -> Error + '_ {
-    |error| Error::AedatLegacy {
-        path: path.to_path_buf(),
-        error,
-    }
-}
+impl Decode for LegacyReader<File> {
+    type Error = LegacyError;
 
-struct Reader {
-    path: PathBuf,
-    inner: LegacyReader<File>,
-}
-
-impl FormatReader for Reader {
-    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
-        let chunk = self.inner.next_chunk().map_err(legacy_error(&self.path))?;
-        Ok(chunk.map(|c| Chunk {
+    fn decode(&mut self) -> Result<Option<Chunk<'_>>, LegacyError> {
+        Ok(self.next_chunk()?.map(|c| Chunk {
             events: c.events,
             imu: c.imu,
             triggers: c.triggers,
         }))
     }
 
-    fn resolution(&self) -> Option<Resolution> {
-        self.inner.resolution()
+    fn sensor(&self) -> Option<Resolution> {
+        self.resolution()
     }
 
-    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
-        self.inner.set_resolution(resolution);
-        Ok(())
+    fn declare(&mut self, resolution: Resolution) {
+        self.set_resolution(resolution);
     }
 
-    fn position(&self) -> u64 {
-        self.inner.position()
+    fn consumed(&self) -> u64 {
+        self.position()
     }
 
     /// AEDAT 2.0 holds only events. AEDAT 3.1 stores one packet per event type: cAER writes
@@ -93,8 +83,8 @@ impl FormatReader for Reader {
     /// default, at most a few hundred ms in any setup seen), so an IMU packet may follow a
     /// polarity packet that already ends past the range. One second covers that with a wide
     /// margin and costs one second of decoding per range read.
-    fn stream_lag_us(&self) -> i64 {
-        match self.inner.header().version {
+    fn lag_us(&self) -> i64 {
+        match self.header().version {
             Version::Aedat31 => 1_000_000,
             Version::Aedat2 => 0,
         }

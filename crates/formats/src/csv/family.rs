@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use crate::StreamSelection;
 use crate::csv::{CsvError, CsvReader, CsvWriter};
-use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Sunk};
+use crate::family::{Decode, Extension, Family, FormatWriter, Named, Opened, Sunk};
 use crate::{Chunk, Error, Event, Format, Resolution};
 
 /// The CSV family.
@@ -46,9 +46,10 @@ impl Family for Csv {
         });
         Ok(Opened {
             note,
-            ..Opened::plain(Reader {
+            ..Opened::plain(Named {
                 path: path.to_path_buf(),
                 inner: r,
+                wrap: |path, error| Error::Csv { path, error },
             })
         })
     }
@@ -85,31 +86,26 @@ fn csv_error(path: &Path) -> impl Fn(CsvError) -> Error + '_ {
     }
 }
 
-struct Reader {
-    path: PathBuf,
-    inner: CsvReader<BufReader<File>>,
-}
+impl Decode for CsvReader<BufReader<File>> {
+    type Error = CsvError;
 
-impl FormatReader for Reader {
-    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
-        let chunk = self.inner.next_chunk().map_err(csv_error(&self.path))?;
-        Ok(chunk.map(|events| Chunk {
+    fn decode(&mut self) -> Result<Option<Chunk<'_>>, CsvError> {
+        Ok(self.next_chunk()?.map(|events| Chunk {
             events,
             ..Chunk::default()
         }))
     }
 
-    fn resolution(&self) -> Option<Resolution> {
-        self.inner.resolution()
+    fn sensor(&self) -> Option<Resolution> {
+        self.resolution()
     }
 
-    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
-        self.inner.set_resolution(resolution);
-        Ok(())
+    fn declare(&mut self, resolution: Resolution) {
+        self.set_resolution(resolution);
     }
 
-    fn position(&self) -> u64 {
-        self.inner.position()
+    fn consumed(&self) -> u64 {
+        self.position()
     }
 }
 

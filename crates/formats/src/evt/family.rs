@@ -2,11 +2,11 @@
 //! header, whose `evt` line gives the version, read only.
 
 use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::StreamSelection;
 use crate::evt::{EvtError, EvtReader, EvtVersion};
-use crate::family::{Extension, Family, FormatReader, Opened};
+use crate::family::{Decode, Extension, Family, Named, Opened};
 use crate::{Chunk, Error, Format, Resolution};
 
 /// The EVT family.
@@ -53,9 +53,10 @@ impl Family for Evt {
         let r = EvtReader::from_path(path).map_err(evt_error(path))?;
         Ok(Opened {
             source: r.header().source(),
-            ..Opened::plain(Reader {
+            ..Opened::plain(Named {
                 path: path.to_path_buf(),
                 inner: r,
+                wrap: |path, error| Error::Evt { path, error },
             })
         })
     }
@@ -68,31 +69,26 @@ fn evt_error(path: &Path) -> impl Fn(EvtError) -> Error + '_ {
     }
 }
 
-struct Reader {
-    path: PathBuf,
-    inner: EvtReader<File>,
-}
+impl Decode for EvtReader<File> {
+    type Error = EvtError;
 
-impl FormatReader for Reader {
-    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
-        let chunk = self.inner.next_chunk().map_err(evt_error(&self.path))?;
-        Ok(chunk.map(|c| Chunk {
+    fn decode(&mut self) -> Result<Option<Chunk<'_>>, EvtError> {
+        Ok(self.next_chunk()?.map(|c| Chunk {
             events: c.events,
             imu: &[],
             triggers: c.triggers,
         }))
     }
 
-    fn resolution(&self) -> Option<Resolution> {
-        self.inner.resolution()
+    fn sensor(&self) -> Option<Resolution> {
+        self.resolution()
     }
 
-    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
-        self.inner.set_resolution(resolution);
-        Ok(())
+    fn declare(&mut self, resolution: Resolution) {
+        self.set_resolution(resolution);
     }
 
-    fn position(&self) -> u64 {
-        self.inner.position()
+    fn consumed(&self) -> u64 {
+        self.position()
     }
 }

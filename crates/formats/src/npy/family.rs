@@ -5,7 +5,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use crate::StreamSelection;
-use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Sunk};
+use crate::family::{Decode, Extension, Family, FormatReader, FormatWriter, Named, Opened, Sunk};
 use crate::npy::npz::{NpzError, NpzReader};
 use crate::npy::{MAGIC, NpyError, NpyReader, NpyWriter};
 use crate::{Chunk, Error, Event, Format, Resolution};
@@ -64,9 +64,10 @@ impl Family for Npy {
             });
         }
         let r = NpyReader::from_path(path).map_err(npy_error(path))?;
-        Ok(Opened::plain(NpySource {
+        Ok(Opened::plain(Named {
             path: path_buf,
             inner: r,
+            wrap: |path, error| Error::Npy { path, error },
         }))
     }
 
@@ -102,31 +103,26 @@ fn npy_error(path: &Path) -> impl Fn(NpyError) -> Error + '_ {
     }
 }
 
-struct NpySource {
-    path: PathBuf,
-    inner: NpyReader<File>,
-}
+impl Decode for NpyReader<File> {
+    type Error = NpyError;
 
-impl FormatReader for NpySource {
-    fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
-        let chunk = self.inner.next_chunk().map_err(npy_error(&self.path))?;
-        Ok(chunk.map(|events| Chunk {
+    fn decode(&mut self) -> Result<Option<Chunk<'_>>, NpyError> {
+        Ok(self.next_chunk()?.map(|events| Chunk {
             events,
             ..Chunk::default()
         }))
     }
 
-    fn resolution(&self) -> Option<Resolution> {
-        self.inner.resolution()
+    fn sensor(&self) -> Option<Resolution> {
+        self.resolution()
     }
 
-    fn set_resolution(&mut self, resolution: Resolution) -> Result<(), Error> {
-        self.inner.set_resolution(resolution);
-        Ok(())
+    fn declare(&mut self, resolution: Resolution) {
+        self.set_resolution(resolution);
     }
 
-    fn position(&self) -> u64 {
-        self.inner.position()
+    fn consumed(&self) -> u64 {
+        self.position()
     }
 }
 
