@@ -86,7 +86,7 @@ pub fn simulate_all(
             continue;
         }
         progress.stage(Stage::Simulating(protocol), job.trials() as u64);
-        job.run(|| progress.advance(1))?;
+        crate::simulation::run(&job, || progress.advance(1))?;
     }
     Ok(())
 }

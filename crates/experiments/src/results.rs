@@ -1,5 +1,6 @@
 //! The numbers a reproduction produces, as one serde tree written to `OUT/results.json` and read
-//! by the report and the figures.
+//! by the report and the figures, and those of the sensitivity study ([`Study`], its
+//! `sensitivity.json`).
 //!
 //! Plain typed data at the bottom of the crate: this file imports nothing from the experiments
 //! that fill it (only the [`Plan`] they ran, itself plain data), so the report reads it without
@@ -564,6 +565,125 @@ pub struct DatasetSeedPoint {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test_truth: Option<MaeStats>,
 }
+
+// The sensitivity study's results (`crate::sensitivity`): what `evtac sensitivity` writes as
+// `sensitivity.json`, a file of its own beside no reproduction's `results.json`.
+
+/// Whether each of the paper's conclusions holds at one point (see [`crate::sensitivity`]); `None`
+/// where the test trials have fewer than two levels to compare.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Conclusions {
+    /// Static's test MAE is the lowest of the three.
+    pub static_best: bool,
+    /// Combined (OR) is not better than static.
+    pub or_not_better: bool,
+    /// Dynamic's rise at the slowest speed exceeds static's.
+    pub dynamic_worse_slow: Option<bool>,
+    /// Dynamic's rise at the shallowest depth exceeds static's.
+    pub dynamic_worse_shallow: Option<bool>,
+}
+
+impl Conclusions {
+    /// The conclusions' names, in the order of [`Conclusions::each`].
+    pub const NAMES: [&'static str; 4] = [
+        "static best",
+        "OR not better than static",
+        "dynamic worse at the slowest speed",
+        "dynamic worse at the shallowest depth",
+    ];
+
+    /// The four, in [`Conclusions::NAMES`]' order (`None`: not measurable at this point).
+    pub fn each(&self) -> [Option<bool>; 4] {
+        [
+            Some(self.static_best),
+            Some(self.or_not_better),
+            self.dynamic_worse_slow,
+            self.dynamic_worse_shallow,
+        ]
+    }
+}
+
+/// How much a representation's error rises at one extreme level of the test trials: its MAE
+/// there minus its mean over the other levels (both means over seeds).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rise {
+    /// The extreme level (deg/s or mm).
+    pub level: f64,
+    /// How many levels the test trials have (fewer than 2: nothing to compare, rises 0).
+    pub levels: usize,
+    /// Static's rise, deg.
+    pub static_deg: f64,
+    /// Dynamic's rise, deg.
+    pub dynamic_deg: f64,
+}
+
+/// What tuning chose for one representation at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Tuned {
+    /// Static's decay tau or dynamic's window, ms.
+    pub time_ms: f64,
+    /// The binarization threshold.
+    pub threshold: f64,
+}
+
+/// One point of the study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// The parameter (`baseline` for the defaults).
+    pub parameter: String,
+    /// The factor on it (1 for the baseline).
+    pub factor: f64,
+    /// The settings tuning chose, static then dynamic.
+    pub tuned: [Tuned; 2],
+    /// Test MAE statistics over seeds: static, dynamic, combined.
+    pub test: [MaeStats; 3],
+    /// Dynamic minus static test MAE (means over seeds), deg.
+    pub gap_deg: f64,
+    /// The rise at the slowest speed.
+    pub slow: Rise,
+    /// The rise at the shallowest depth.
+    pub shallow: Rise,
+    /// What holds.
+    pub conclusions: Conclusions,
+}
+
+/// The whole study: what `evtac sensitivity` writes as `sensitivity.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Study {
+    /// The scale.
+    pub scale: String,
+    /// The master seed.
+    pub seed: u64,
+    /// The factors.
+    pub factors: Vec<f64>,
+    /// The defaults' point first, then each parameter at each factor.
+    pub points: Vec<Point>,
+}
+
+impl Study {
+    /// The baseline (the defaults), when the study has it.
+    pub fn baseline(&self) -> Option<&Point> {
+        self.points.iter().find(|p| p.parameter == BASELINE)
+    }
+
+    /// For each conclusion, in [`Conclusions::NAMES`]' order, how many of the perturbed points
+    /// (the baseline excluded) it holds at, and at how many it could be decided.
+    pub fn shares(&self) -> [(usize, usize); 4] {
+        let mut out = [(0, 0); 4];
+        for p in self.points.iter().filter(|p| p.parameter != BASELINE) {
+            for (o, holds) in out.iter_mut().zip(p.conclusions.each()) {
+                if let Some(holds) = holds {
+                    o.0 += usize::from(holds);
+                    o.1 += 1;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The baseline point's name.
+pub const BASELINE: &str = "baseline";
 
 /// Everything a reproduction measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -229,7 +229,7 @@ impl CostModel {
     /// Expected seconds of the whole reproduction: every stage it will report.
     ///
     /// The latency stage's end-to-end replay runs on the wall clock, as long as the events it
-    /// replays (`crate::paced_latency::extent`).
+    /// replays (`crate::paced_extent::extent`).
     pub fn total_seconds(&self) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
         let reprs = plan.representations();
@@ -286,9 +286,8 @@ impl CostModel {
 /// Wall time of the latency stage's replay at recorded pace (`crate::paced_latency`): it runs
 /// as long as the events it replays, whatever the machine.
 fn paced_replay_seconds(plan: &Plan, reprs: usize) -> f64 {
-    let extent = crate::paced_latency::extent(plan.scale);
-    let cells =
-        reprs * crate::paced_latency::INTERVALS_MS.len() * crate::paced_latency::Load::ALL.len();
+    let extent = crate::paced_extent::extent(plan.scale);
+    let cells = reprs * crate::paced_extent::INTERVALS_MS.len() * crate::results::Load::ALL.len();
     cells as f64 * extent.trials as f64 * extent.motion_ms as f64 / 1000.0
 }
 

@@ -79,7 +79,7 @@ fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
     };
     let pool = args.workers.pool()?;
     let bars = Bars::default();
-    pool.install(|| job.run(&bars))?;
+    pool.install(|| sensitivity::run_point(&job, &bars))?;
     bars.finish();
     eprintln!("point {name} x{factor} finished in {}", args.out.display());
     Ok(())
