@@ -27,11 +27,11 @@ fn row(what: &str, value: String, why: &str, change: &str) -> Choice {
     }
 }
 
-/// A serde enum's name as written in config files (`gt`, `potential`, `total-rotation`).
+/// A serde enum's name as written in config files (`gt`, `potential`, `total-rotation`): its
+/// JSON, unquoted when it is a string.
 fn name_of(value: impl Serialize) -> String {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(s)) => s,
-        Ok(other) => other.to_string(),
+    match serde_json::to_string(&value) {
+        Ok(json) => serde_json::from_str::<String>(&json).unwrap_or(json),
         Err(e) => format!("? ({e})"),
     }
 }

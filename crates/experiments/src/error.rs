@@ -64,18 +64,18 @@ pub enum PerturbError {
         /// The name given.
         name: String,
     },
-    /// A field is not a number of `simulator.json`.
+    /// A field is not one of the numbers of `simulator.json` a parameter scales.
     #[error("simulator parameter {field} is not a number in simulator.json")]
     NotANumber {
         /// The field, `section.field`.
         field: String,
     },
-    /// The scaled parameters are not valid simulator parameters.
+    /// The scaled parameters are not valid simulator parameters (a count out of range).
     #[error("simulator parameters with {field} scaled: {message}")]
     Invalid {
-        /// The field.
+        /// The fields.
         field: String,
-        /// What serde said.
+        /// What is wrong.
         message: String,
     },
 }

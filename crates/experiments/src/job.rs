@@ -21,6 +21,7 @@
 use std::path::{Path, PathBuf};
 
 use evtac_events::IoError;
+use evtac_events::output::write_atomic;
 use evtac_import::inputs::Inputs;
 use evtac_repr::ReprConfig;
 use evtac_sim::{Protocol, Scale};
@@ -341,7 +342,9 @@ pub fn to_text(jobs: &[Job]) -> String {
 
 /// Writes `jobs` to the jobs file `path`, whole or not at all.
 pub fn write(path: &Path, jobs: &[Job]) -> Result<(), FileError> {
-    crate::jobs::write_atomic(path, to_text(jobs).as_bytes()).map_err(IoError::at(path))?;
+    crate::jobs::create_parent(path)
+        .and_then(|()| write_atomic(path, to_text(jobs).as_bytes()))
+        .map_err(IoError::at(path))?;
     Ok(())
 }
 

@@ -3,7 +3,9 @@
 //! ([`crate::error::PerturbError`], which names them) and the study that scales them share the
 //! table without importing each other.
 
-/// One simulator parameter the study varies: one or more fields of [`evtac_sim::SimParams`] scaled
+use evtac_sim::SimParams;
+
+/// One simulator parameter the study varies: one or more fields of [`SimParams`] scaled
 /// together.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Parameter {
@@ -130,4 +132,46 @@ pub fn parameter(name: &str) -> Option<Parameter> {
 /// Every parameter's name, comma-separated (for messages).
 pub fn names() -> String {
     PARAMETERS.map(|p| p.name).join(", ")
+}
+
+/// A number of [`SimParams`] that a parameter scales.
+pub(crate) enum Slot<'a> {
+    /// A real number.
+    Real(&'a mut f64),
+    /// A count (pin rings, hot pixels): rounded to the nearest when scaled.
+    Count(&'a mut u32),
+}
+
+/// The number `field` (`section.field`, as `simulator.json` names it) is in `params`, for the
+/// fields of [`PARAMETERS`]; `None` for any other. Typed fields rather than `simulator.json`'s
+/// untyped tree: the study's tests check, through that tree, that each parameter scales exactly
+/// the fields it names, so a name here cannot drift from `simulator.json`'s.
+pub(crate) fn slot<'a>(params: &'a mut SimParams, field: &str) -> Option<Slot<'a>> {
+    use Slot::{Count, Real};
+    Some(match field {
+        "sensor.rings" => Count(&mut params.sensor.rings),
+        "sensor.pin_sigma_mm" => Real(&mut params.sensor.pin_sigma_mm),
+        "contact.normal_gain" => Real(&mut params.contact.normal_gain),
+        "contact.spread_gain" => Real(&mut params.contact.spread_gain),
+        "contact.skin_tau_s" => Real(&mut params.contact.skin_tau_s),
+        "contact.shear_mm_per_deg" => Real(&mut params.contact.shear_mm_per_deg),
+        "contact.trial_variation" => Real(&mut params.contact.trial_variation),
+        "contact.creep_fraction" => Real(&mut params.contact.creep_fraction),
+        "dvs.pos_thres" => Real(&mut params.dvs.pos_thres),
+        "dvs.neg_thres" => Real(&mut params.dvs.neg_thres),
+        "dvs.sigma_thres" => Real(&mut params.dvs.sigma_thres),
+        "dvs.cutoff_hz" => Real(&mut params.dvs.cutoff_hz),
+        "dvs.refractory_period_s" => Real(&mut params.dvs.refractory_period_s),
+        "dvs.leak_rate_hz" => Real(&mut params.dvs.leak_rate_hz),
+        "dvs.shot_noise_rate_hz" => Real(&mut params.dvs.shot_noise_rate_hz),
+        "dvs.hot_pixels" => Count(&mut params.dvs.hot_pixels),
+        "imu.gyro_noise_deg_s" => Real(&mut params.imu.gyro_noise_deg_s),
+        "imu.accel_noise_g" => Real(&mut params.imu.accel_noise_g),
+        "rig.rolling_centre_sd_mm" => Real(&mut params.rig.rolling_centre_sd_mm),
+        "rig.patch_offset_sd_mm" => Real(&mut params.rig.patch_offset_sd_mm),
+        "rig.reseat_rotation_sd_deg" => Real(&mut params.rig.reseat_rotation_sd_deg),
+        "rig.reseat_tilt_sd_deg" => Real(&mut params.rig.reseat_tilt_sd_deg),
+        "rig.reseat_height_sd_mm" => Real(&mut params.rig.reseat_height_sd_mm),
+        _ => return None,
+    })
 }

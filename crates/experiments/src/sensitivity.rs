@@ -32,6 +32,7 @@ use crate::error::Error;
 use crate::exp1;
 use crate::exp3::{self, Axis};
 use crate::job::SensitivityPointJob;
+use crate::parameters::Slot;
 use crate::progress::Progress;
 use crate::results::{Exp1Repr, Exp3Point, MaeStats, Tuning};
 use crate::splits::Split;
@@ -39,6 +40,7 @@ use crate::stage::{FeatureSet, Stage};
 use crate::tuning::{self, Kind};
 use crate::variant;
 use evtac_events::IoError;
+use evtac_events::output::write_atomic;
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::ReprKind;
@@ -93,37 +95,30 @@ pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(&'static str, f
 
 /// `params` with `parameter`'s fields multiplied by `factor`; integers (pin rings, hot pixels)
 /// are rounded to the nearest.
-///
-/// Through `simulator.json`'s own form (serde), so that a field is named once, as a user reads
-/// it in a dataset's `simulator.json`, rather than by a hand-written accessor per field.
 pub fn perturbed(
     params: &SimParams,
     parameter: &Parameter,
     factor: f64,
 ) -> Result<SimParams, PerturbError> {
-    let mut value = serde_json::to_value(params).map_err(|e| PerturbError::Invalid {
-        field: parameter.name.to_string(),
-        message: e.to_string(),
-    })?;
+    let mut out = params.clone();
     for field in parameter.fields {
-        let not_a_number = || PerturbError::NotANumber {
-            field: (*field).to_string(),
-        };
-        let slot = field
-            .split('.')
-            .try_fold(&mut value, |v, key| v.get_mut(key))
-            .ok_or_else(not_a_number)?;
-        *slot = if let Some(n) = slot.as_u64() {
-            serde_json::Value::from((n as f64 * factor).round() as u64)
-        } else {
-            let x = slot.as_f64().ok_or_else(not_a_number)?;
-            serde_json::Value::from(x * factor)
-        };
+        match crate::parameters::slot(&mut out, field) {
+            Some(Slot::Real(x)) => *x *= factor,
+            Some(Slot::Count(n)) => {
+                let scaled = (f64::from(*n) * factor).round() as u64;
+                *n = u32::try_from(scaled).map_err(|e| PerturbError::Invalid {
+                    field: parameter.fields.join(", "),
+                    message: e.to_string(),
+                })?;
+            }
+            None => {
+                return Err(PerturbError::NotANumber {
+                    field: (*field).to_string(),
+                });
+            }
+        }
     }
-    serde_json::from_value(value).map_err(|e| PerturbError::Invalid {
-        field: parameter.fields.join(", "),
-        message: e.to_string(),
-    })
+    Ok(out)
 }
 
 /// What tuning chose, as a point keeps it.
@@ -200,7 +195,8 @@ pub fn point(
     let json = serde_json::to_string_pretty(&point)
         .map_err(IoError::at(&file))
         .map_err(crate::jobs::Error::from)?;
-    crate::jobs::write_atomic(&file, json.as_bytes())
+    // The point's folder exists: its dataset and models are in it.
+    write_atomic(&file, json.as_bytes())
         .map_err(IoError::at(&file))
         .map_err(crate::jobs::Error::from)?;
     // What made the point stays beside its results, with or without its dataset.
