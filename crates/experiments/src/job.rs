@@ -28,6 +28,7 @@ use evtac_sim::{Protocol, Scale};
 use serde::{Deserialize, Serialize};
 
 use crate::plan::{Grid, Plan};
+use crate::results::Varied;
 use crate::sampling::{Phase, Sampling};
 
 /// The version of the jobs-file format this build writes and reads.
@@ -116,6 +117,33 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+/// How a reproduction simulates its datasets: every protocol at one scale and master seed, with
+/// `repeats` passes over Experiments 1 and 2's conditions instead of the scale's. One value, so
+/// that the simulation, its cost estimate and its Slurm round cannot disagree on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Simulation {
+    /// How many trials.
+    pub scale: Scale,
+    /// Passes over the conditions of Experiments 1 and 2 instead of the scale's, or `None`.
+    pub repeats: Option<usize>,
+    /// Master seed.
+    pub seed: u64,
+}
+
+impl Simulation {
+    /// The job that simulates `protocol`'s dataset into its folder under `dir` (laid out as
+    /// [`crate::pipeline::Datasets::in_dir`] reads them).
+    pub fn job(&self, protocol: Protocol, dir: &Path) -> SimulateJob {
+        SimulateJob {
+            protocol,
+            scale: self.scale,
+            seed: self.seed,
+            out: dir.join(protocol.name()),
+            repeats: self.repeats,
+        }
+    }
+}
+
 /// Training one model on a dataset's training split, selected on its validation split (what
 /// `evtac train` does).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -173,6 +201,15 @@ pub struct ReproduceJob {
 }
 
 impl ReproduceJob {
+    /// How the job simulates its datasets when it is given none.
+    pub fn simulation(&self) -> Simulation {
+        Simulation {
+            scale: self.scale,
+            repeats: self.repeats,
+            seed: self.seed,
+        }
+    }
+
     /// The plan the job runs: the scale's, with the job's settings in place of the plan's
     /// defaults. Built from the job itself, so that `evtac reproduce` and a Slurm task that runs
     /// the job mean the same reproduction. Refuses settings no reproduction can run, naming
@@ -254,8 +291,8 @@ pub struct SensitivityPointJob {
     pub scale: Scale,
     /// The study's master seed.
     pub seed: u64,
-    /// The parameter ([`crate::sensitivity::BASELINE`] for the defaults).
-    pub parameter: String,
+    /// What the point varies.
+    pub parameter: Varied,
     /// The factor on it.
     pub factor: f64,
     /// The point's folder ([`crate::sensitivity::point_dir`]).
@@ -434,7 +471,7 @@ mod tests {
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,
                 seed: 2,
-                parameter: "cutoff".into(),
+                parameter: Varied::from("cutoff"),
                 factor: 0.5,
                 out: "study/points/cutoff/x0.5".into(),
                 keep_data: true,

@@ -6,7 +6,7 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::Dataset;
 use crate::exp3::Axis;
-use crate::job::{Job, SimulateJob};
+use crate::job::{Job, Simulation};
 use crate::jobs;
 use crate::plan::Plan;
 use crate::progress::Progress;
@@ -16,7 +16,7 @@ use crate::results::{
     RunInfo, SensorView, Tuning,
 };
 use crate::splits::{Split, Splits};
-use crate::stage::Stage;
+use crate::stage::{Stage, Timed};
 use crate::stage_log::StageLog;
 use crate::training;
 use crate::tuning::{self, Kind};
@@ -28,7 +28,7 @@ use evtac_events::manifest::TrialMeta;
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::{ReprConfig, ReprKind};
-use evtac_sim::SimParams;
+use evtac_sim::{Protocol, SimParams};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -70,24 +70,16 @@ impl Datasets {
     }
 }
 
-/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) at `scale` (with
-/// `repeats` passes over Experiments 1 and 2's conditions instead of the scale's) into `dir`,
-/// laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked done is kept,
-/// so an interrupted simulation resumes.
+/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) as `simulation` says
+/// into `dir`, laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked
+/// done is kept, so an interrupted simulation resumes.
 pub fn simulate_all(
     dir: &Path,
-    (scale, repeats): (evtac_sim::Scale, Option<usize>),
-    seed: u64,
+    simulation: &Simulation,
     progress: &dyn Progress,
 ) -> Result<(), Error> {
     for protocol in crate::stage::PROTOCOLS {
-        let job = SimulateJob {
-            protocol,
-            scale,
-            seed,
-            out: dir.join(protocol.name()),
-            repeats,
-        };
+        let job = simulation.job(protocol, dir);
         if jobs::is_done(&job.out) {
             continue;
         }
@@ -107,11 +99,11 @@ struct Stages<'a> {
 }
 
 impl Stages<'_> {
-    fn done(&mut self, name: &str) -> Result<(), Error> {
+    fn done(&mut self, stage: Timed) -> Result<(), Error> {
         let s = self.started.elapsed().as_secs_f64();
-        self.list.push((name.to_string(), s));
-        self.progress.message(&format!("{name}: {s:.1} s"));
-        self.log.record(name, s)?;
+        self.list.push((stage.name().to_string(), s));
+        self.progress.message(&format!("{stage}: {s:.1} s"));
+        self.log.record(stage, s)?;
         self.started = Instant::now();
         Ok(())
     }
@@ -140,7 +132,7 @@ pub fn reproduce(
     let ds1 = Dataset::open(&data.exp1, data.inputs)?;
     let splits1 = ds1.splits(seed)?;
     let cache1 = FeatureCache::new(&ds1)?;
-    let mut datasets = vec![("exp1".to_string(), ds1.manifest.trials.len())];
+    let mut datasets = vec![(Protocol::Exp1, ds1.manifest.trials.len())];
 
     let run = RunContext {
         plan,
@@ -153,8 +145,8 @@ pub fn reproduce(
     let on2 = match &data.exp2 {
         Some(dir) => {
             let on2 = on_exp2(dir, data.inputs, &on1.reprs, &run)?;
-            datasets.push(("exp2".into(), on2.trials));
-            stages.done("experiment 2")?;
+            datasets.push((Protocol::Exp2, on2.trials));
+            stages.done(Timed::Exp2)?;
             Some(on2)
         }
         None => None,
@@ -162,14 +154,14 @@ pub fn reproduce(
     let exp1_models = exp1_models(&on1.reprs, &run)?;
     let (e3s, e3d) = on_exp3(data, &ds1, &exp1_models, progress, &mut datasets)?;
     if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
-        stages.done("experiment 3")?;
+        stages.done(Timed::Exp3)?;
     }
     let overlays = examples::overlays(&cache1, on1.reprs[0], on1.reprs[1])?;
     // The paper's Fig. 2, the sensor's camera view and the latency study, on the test trials.
     let test = ds1.trials(splits1.get(Split::Test))?;
     let (repr_example, sensor) = fig2_and_sensor(&cache1, &test, &on1.reprs)?;
     let (lat, paced) = latencies(&ds1, &test, &exp1_models, plan, progress)?;
-    stages.done("latency")?;
+    stages.done(Timed::Latency)?;
 
     let (e2, example, exp2_sim, labels) = match on2 {
         Some(on2) => (on2.cells, on2.example, on2.sim, on2.labels),
@@ -177,7 +169,7 @@ pub fn reproduce(
     };
     let mut results = Results {
         run: RunInfo {
-            scale: plan.scale.name().to_string(),
+            scale: plan.scale,
             seed,
             plan: plan.clone(),
             stage_seconds: Vec::new(),
@@ -239,28 +231,28 @@ fn on_exp1(
 ) -> Result<OnExp1, Error> {
     let ds1 = cache1.dataset();
     let st = tuning::tune(cache1, splits1, Kind::Static, run)?;
-    stages.done("tuning (static)")?;
+    stages.done(Timed::TuningStatic)?;
     let dt = tuning::tune(cache1, splits1, Kind::Dynamic, run)?;
-    stages.done("tuning (dynamic)")?;
+    stages.done(Timed::TuningDynamic)?;
     let reprs = exp1::of_plan(run.plan, st.chosen_config, dt.chosen_config);
 
     let e1 = exp1::run(cache1, splits1, &reprs, run)?;
-    stages.done("experiment 1")?;
+    stages.done(Timed::Exp1)?;
     let noise = noise::run(ds1, &e1, &reprs, run, out)?;
     if !noise.is_empty() {
-        stages.done("experiment 1 at other noise")?;
+        stages.done(Timed::Exp1OtherNoise)?;
     }
     let dataset_seeds = dataset_seeds::run(ds1, &e1, &reprs, run, out)?;
     if !dataset_seeds.is_empty() {
-        stages.done("experiment 1 on other datasets")?;
+        stages.done(Timed::Exp1OtherDatasets)?;
     }
     let repeat_split = repeat_split::run(cache1, &reprs, &e1, run)?;
     if repeat_split.is_some() {
-        stages.done("repeats kept together")?;
+        stages.done(Timed::RepeatsTogether)?;
     }
     let label_noise = label_noise::run(cache1, splits1, &reprs, &e1, run)?;
     if label_noise.is_some() {
-        stages.done("label-noise ablation")?;
+        stages.done(Timed::LabelNoise)?;
     }
     Ok(OnExp1 {
         st,
@@ -348,7 +340,7 @@ fn on_exp3(
     ds1: &Dataset,
     exp1_models: &[(ReprKind, Vec<Model>)],
     progress: &dyn Progress,
-    datasets: &mut Vec<(String, usize)>,
+    datasets: &mut Vec<(Protocol, usize)>,
 ) -> Result<(Vec<Exp3Point>, Vec<Exp3Point>), Error> {
     let speeds: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.speed_deg_s).collect();
     let depths: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.depth_mm).collect();
@@ -362,8 +354,8 @@ fn on_exp3(
         let ds = Dataset::open(dir, data.inputs)?;
         datasets.push((
             match axis {
-                Axis::Speed => "exp3-speed".into(),
-                Axis::Depth => "exp3-depth".into(),
+                Axis::Speed => Protocol::Exp3Speed,
+                Axis::Depth => Protocol::Exp3Depth,
             },
             ds.manifest.trials.len(),
         ));

@@ -8,6 +8,7 @@
 //! (`"Static"`) as `results.json` always spelled them; older files still read.
 
 use evtac_repr::{ReprConfig, ReprKind};
+pub use evtac_sim::{Protocol, Scale};
 use serde::{Deserialize, Serialize};
 
 use crate::plan::Plan;
@@ -375,8 +376,8 @@ pub struct LatencyCell {
 /// Where the reproduction's settings came from and how long it took.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
-    /// `tiny`, `small`, `paper` or `custom`.
-    pub scale: String,
+    /// The scale (the plan's).
+    pub scale: Scale,
     /// Master seed.
     pub seed: u64,
     /// The plan (grids, epochs, seeds) as run.
@@ -387,8 +388,8 @@ pub struct RunInfo {
     /// (`stage-times.csv`; absent in results written before it was kept).
     #[serde(default)]
     pub stage_history: Vec<StageRecord>,
-    /// Trials per dataset.
-    pub datasets: Vec<(String, usize)>,
+    /// Trials per dataset, by the protocol it was made with (its folder's name).
+    pub datasets: Vec<(Protocol, usize)>,
     /// Where every dataset's calibration and mask came from (absent in results written before
     /// this was recorded).
     #[serde(default)]
@@ -629,8 +630,8 @@ pub struct Tuned {
 /// One point of the study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Point {
-    /// The parameter (`baseline` for the defaults).
-    pub parameter: String,
+    /// What the point varies.
+    pub parameter: Varied,
     /// The factor on it (1 for the baseline).
     pub factor: f64,
     /// The settings tuning chose, static then dynamic.
@@ -651,7 +652,7 @@ pub struct Point {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Study {
     /// The scale.
-    pub scale: String,
+    pub scale: Scale,
     /// The master seed.
     pub seed: u64,
     /// The factors.
@@ -663,14 +664,18 @@ pub struct Study {
 impl Study {
     /// The baseline (the defaults), when the study has it.
     pub fn baseline(&self) -> Option<&Point> {
-        self.points.iter().find(|p| p.parameter == BASELINE)
+        self.points.iter().find(|p| p.parameter == Varied::Baseline)
     }
 
     /// For each conclusion, in [`Conclusions::NAMES`]' order, how many of the perturbed points
     /// (the baseline excluded) it holds at, and at how many it could be decided.
     pub fn shares(&self) -> [(usize, usize); 4] {
         let mut out = [(0, 0); 4];
-        for p in self.points.iter().filter(|p| p.parameter != BASELINE) {
+        for p in self
+            .points
+            .iter()
+            .filter(|p| p.parameter != Varied::Baseline)
+        {
             for (o, holds) in out.iter_mut().zip(p.conclusions.each()) {
                 if let Some(holds) = holds {
                     o.0 += usize::from(holds);
@@ -682,8 +687,59 @@ impl Study {
     }
 }
 
-/// The baseline point's name.
+/// The baseline point's name, as files spell it.
 pub const BASELINE: &str = "baseline";
+
+/// What a point of the sensitivity study varies: nothing (the baseline, the simulator's
+/// defaults) or one parameter, by its name. Written as that name (`"baseline"` for the
+/// baseline), as `sensitivity.json`, `point.json` and jobs files always spelled it; a name that
+/// is no parameter reads, and is refused when the point is run (naming the parameters there is).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(from = "String", into = "String")]
+pub enum Varied {
+    /// The simulator's defaults.
+    Baseline,
+    /// The parameter of this name, scaled.
+    Parameter(String),
+}
+
+impl Varied {
+    /// The name the point goes by: its parameter's, or [`BASELINE`].
+    pub fn name(&self) -> &str {
+        match self {
+            Varied::Baseline => BASELINE,
+            Varied::Parameter(name) => name,
+        }
+    }
+}
+
+impl From<String> for Varied {
+    fn from(name: String) -> Self {
+        if name == BASELINE {
+            Varied::Baseline
+        } else {
+            Varied::Parameter(name)
+        }
+    }
+}
+
+impl From<&str> for Varied {
+    fn from(name: &str) -> Self {
+        Varied::from(name.to_string())
+    }
+}
+
+impl From<Varied> for String {
+    fn from(varied: Varied) -> Self {
+        varied.name().to_string()
+    }
+}
+
+impl std::fmt::Display for Varied {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Everything a reproduction measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -49,21 +49,20 @@ use std::path::{Path, PathBuf};
 
 pub use crate::error::PerturbError;
 pub use crate::parameters::{PARAMETERS, Parameter, names, parameter};
-pub use crate::results::{BASELINE, Conclusions, Point, Rise, Study, Tuned};
+pub use crate::results::{BASELINE, Conclusions, Point, Rise, Study, Tuned, Varied};
 
 /// The factors every parameter is scaled by.
 pub const FACTORS: [f64; 2] = [0.5, 1.5];
 
-/// The simulator parameters of the point (`parameter`, `factor`): the defaults for
-/// [`BASELINE`], else the defaults with that parameter scaled.
-pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError> {
+/// The simulator parameters of the point (`varied`, `factor`): the defaults for the baseline,
+/// else the defaults with that parameter scaled.
+pub fn params_of(varied: &Varied, factor: f64) -> Result<SimParams, PerturbError> {
     let defaults = SimParams::default();
-    if parameter == BASELINE {
-        return Ok(defaults);
-    }
-    let p = self::parameter(parameter).ok_or_else(|| PerturbError::Unknown {
-        name: parameter.to_string(),
-    })?;
+    let name = match varied {
+        Varied::Baseline => return Ok(defaults),
+        Varied::Parameter(name) => name,
+    };
+    let p = parameter(name).ok_or_else(|| PerturbError::Unknown { name: name.clone() })?;
     perturbed(&defaults, &p, factor)
 }
 
@@ -85,10 +84,10 @@ pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
 }
 
 /// The study's points in order: the baseline, then every parameter at every factor.
-pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(&'static str, f64)> {
-    let mut out = vec![(BASELINE, 1.0)];
+pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(Varied, f64)> {
+    let mut out = vec![(Varied::Baseline, 1.0)];
     for p in parameters {
-        out.extend(factors.iter().map(|&f| (p.name, f)));
+        out.extend(factors.iter().map(|&f| (Varied::from(p.name), f)));
     }
     out
 }
@@ -130,9 +129,9 @@ fn tuned(t: &Tuning) -> Tuned {
 }
 
 /// The folder of one point under the study's output folder.
-pub fn point_dir(out: &Path, parameter: &str, factor: f64) -> PathBuf {
+pub fn point_dir(out: &Path, varied: &Varied, factor: f64) -> PathBuf {
     out.join("points")
-        .join(parameter)
+        .join(varied.name())
         .join(format!("x{factor}"))
 }
 
@@ -178,7 +177,7 @@ pub const POINT_FILE: &str = "point.json";
 /// scale, of which its models need none), so that a study of 39 points needs the disk of one
 /// dataset at a time.
 pub fn point(
-    (parameter, factor): (&str, f64),
+    (parameter, factor): (&Varied, f64),
     params: &SimParams,
     dir: &Path,
     keep_data: bool,
@@ -219,7 +218,7 @@ pub fn point(
 
 /// [`point`]'s measurement, every part of it resuming on its own.
 fn measure(
-    parameter: &str,
+    parameter: &Varied,
     factor: f64,
     params: &SimParams,
     dir: &Path,
@@ -284,7 +283,7 @@ fn measure(
     let mean = |s: &MaeStats| s.overall.mean;
     let [st_mae, dy_mae, co_mae] = [mean(&test[0]), mean(&test[1]), mean(&test[2])];
     Ok(Point {
-        parameter: parameter.to_string(),
+        parameter: parameter.clone(),
         factor,
         tuned: [tuned(&st), tuned(&dt)],
         test,
@@ -315,7 +314,7 @@ pub fn run_point(job: &SensitivityPointJob, progress: &dyn Progress) -> Result<(
         models: &models,
         progress,
     };
-    let at = (job.parameter.as_str(), job.factor);
+    let at = (&job.parameter, job.factor);
     point(at, &params, &job.out, job.keep_data, &run)?;
     Ok(())
 }
@@ -335,7 +334,10 @@ pub fn run(
     evtac_learn::flush_denormals();
     let todo = points(parameters, factors)
         .into_iter()
-        .map(|(name, factor)| Ok((name, factor, params_of(name, factor)?)))
+        .map(|(name, factor)| {
+            let params = params_of(&name, factor)?;
+            Ok((name, factor, params))
+        })
         .collect::<Result<Vec<_>, PerturbError>>()?;
     let started = std::time::Instant::now();
     let mut points = Vec::with_capacity(todo.len());
@@ -360,7 +362,7 @@ pub fn run(
         points.push(point((name, *factor), params, &dir, keep_data, run)?);
     }
     Ok(Study {
-        scale: run.plan.scale.name().to_string(),
+        scale: run.plan.scale,
         seed: run.seed,
         factors: factors.to_vec(),
         points,
@@ -405,15 +407,26 @@ mod tests {
         assert_eq!(
             points(&p, &[0.5, 2.0]),
             [
-                (BASELINE, 1.0),
-                ("cutoff", 0.5),
-                ("cutoff", 2.0),
-                ("creep", 0.5),
-                ("creep", 2.0)
+                (Varied::Baseline, 1.0),
+                (Varied::from("cutoff"), 0.5),
+                (Varied::from("cutoff"), 2.0),
+                (Varied::from("creep"), 0.5),
+                (Varied::from("creep"), 2.0)
             ]
         );
-        assert_eq!(params_of(BASELINE, 1.0).unwrap(), SimParams::default());
-        let e = params_of("grip", 2.0).unwrap_err().to_string();
+        assert_eq!(
+            params_of(&Varied::Baseline, 1.0).unwrap(),
+            SimParams::default()
+        );
+        assert_eq!(Varied::from(BASELINE), Varied::Baseline);
+        // Files spell a point's parameter as its name, the baseline's included.
+        assert_eq!(
+            serde_json::to_string(&points(&p, &[0.5])[..2]).unwrap(),
+            r#"[["baseline",1.0],["cutoff",0.5]]"#
+        );
+        let e = params_of(&Varied::from("grip"), 2.0)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("\"grip\"") && e.contains("cutoff"), "{e}");
     }
 
@@ -428,7 +441,7 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), PARAMETERS.len() + 1);
         assert_eq!(
-            point_dir(Path::new("out"), "cutoff", 0.5),
+            point_dir(Path::new("out"), &Varied::from("cutoff"), 0.5),
             Path::new("out/points/cutoff/x0.5")
         );
     }

@@ -10,7 +10,7 @@ use evtac_experiments::job::{self, ReproduceJob};
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::{Grid, Plan};
 use evtac_experiments::progress::Progress;
-use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
+use evtac_experiments::stage::{CostModel, Stage, Timed, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
 use evtac_sim::Scale;
 use std::io::IsTerminal;
@@ -410,7 +410,7 @@ fn run_here(
     let sim_dir = job.out.join("data");
     let counts = match &job.data {
         Some(data) => TrialCounts::of_datasets(data),
-        None => TrialCounts::of_simulation(&sim_dir, (job.scale, job.repeats), job.seed),
+        None => TrialCounts::of_simulation(&sim_dir, &job.simulation()),
     };
     let bars = Overall::new(&bars, CostModel::new(plan, counts));
     // Every invocation's stage times go to OUT/stage-times.csv: a resumed run's report
@@ -420,10 +420,10 @@ fn run_here(
         Some(d) => d.clone(),
         None => {
             let d = sim_dir;
-            pool.install(|| pipeline::simulate_all(&d, (job.scale, job.repeats), job.seed, &bars))?;
+            pool.install(|| pipeline::simulate_all(&d, &job.simulation(), &bars))?;
             let seconds = started.elapsed().as_secs_f64();
             bars.message(&format!("simulated datasets ready in {seconds:.1} s"));
-            log.record("simulation", seconds)?;
+            log.record(Timed::Simulation, seconds)?;
             d
         }
     };
@@ -459,7 +459,7 @@ fn run_here(
     evtac_report::write(&job.out, &results)?;
     let seconds = report_started.elapsed().as_secs_f64();
     bars.message(&format!("report: {seconds:.1} s"));
-    log.record("report", seconds)?;
+    log.record(Timed::Report, seconds)?;
     bars.finish();
     println!("{}", job.out.join("report.md").display());
     for e in &results.exp1 {

@@ -12,7 +12,7 @@ use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::context::RunContext;
 use evtac_experiments::job::{Job, SensitivityPointJob};
-use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter};
+use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter, Varied};
 use evtac_sim::Scale;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -72,7 +72,7 @@ fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
     let job = SensitivityPointJob {
         scale: args.scale,
         seed: args.seed,
-        parameter: name.to_string(),
+        parameter: Varied::from(name),
         factor,
         out: args.out.clone(),
         keep_data: args.keep_data,
@@ -94,9 +94,9 @@ fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> 
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: args.scale,
                 seed: args.seed,
-                parameter: name.to_string(),
+                out: sensitivity::point_dir(&out, &name, factor),
+                parameter: name,
                 factor,
-                out: sensitivity::point_dir(&out, name, factor),
                 keep_data: args.keep_data,
             })
         })
