@@ -31,14 +31,6 @@ pub struct ExecutorArgs {
 }
 
 impl ExecutorArgs {
-    /// Running here, without Slurm settings.
-    pub fn local() -> Self {
-        Self {
-            executor: Executor::Local,
-            slurm_args: None,
-        }
-    }
-
     /// Whether the jobs go to Slurm; an error when `--slurm-args` is given without it (the
     /// settings would be silently ignored).
     pub fn on_slurm(&self) -> anyhow::Result<bool> {

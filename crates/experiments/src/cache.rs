@@ -20,6 +20,7 @@ use crate::sampling::{Phase, SampleTime, Sampling};
 use evtac_events::IoError;
 use evtac_events::layout::CACHE_DIR;
 use evtac_events::manifest::TrialMeta;
+use evtac_events::output::write_atomic;
 use evtac_learn::FeatureSet;
 use evtac_repr::CROP;
 use evtac_repr::{FeatureExtractor, Mask, ReprConfig};
@@ -214,7 +215,9 @@ impl<'a> FeatureCache<'a> {
         for (s, l) in times.iter().zip(&labels) {
             let _ = writeln!(text, "{},{},{},{}", s.t_us, s.phase.as_str(), l[0], l[1]);
         }
-        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(io(&path))?;
+        crate::jobs::create_parent(&path)
+            .and_then(|()| write_atomic(&path, text.as_bytes()))
+            .map_err(io(&path))?;
         Ok(TrialSamples { times, labels })
     }
 
@@ -245,7 +248,9 @@ impl<'a> FeatureCache<'a> {
                     "mask": dataset::mask_id(mask.as_ref()),
                     "sampling": sampling,
                 });
-                crate::jobs::write_atomic(&meta, json.to_string().as_bytes()).map_err(io(&meta))?;
+                crate::jobs::create_parent(&meta)
+                    .and_then(|()| write_atomic(&meta, json.to_string().as_bytes()))
+                    .map_err(io(&meta))?;
             }
         }
         let computed = AtomicUsize::new(0);

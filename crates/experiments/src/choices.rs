@@ -27,11 +27,11 @@ fn row(what: &str, value: String, why: &str, change: &str) -> Choice {
     }
 }
 
-/// A serde enum's name as written in config files (`gt`, `potential`, `total-rotation`).
+/// A serde enum's name as written in config files (`gt`, `potential`, `total-rotation`): its
+/// JSON, unquoted when it is a string.
 fn name_of(value: impl Serialize) -> String {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(s)) => s,
-        Ok(other) => other.to_string(),
+    match serde_json::to_string(&value) {
+        Ok(json) => serde_json::from_str::<String>(&json).unwrap_or(json),
         Err(e) => format!("? ({e})"),
     }
 }
@@ -75,22 +75,35 @@ pub fn of_run(
     exp1_sim: Option<&SimParams>,
     exp2_sim: Option<&SimParams>,
 ) -> Vec<Choice> {
-    let labels = LabelConfig::default();
-    let st = StaticConfig::default();
-    let train = TrainConfig::default();
-    let opt = &train.optimizer;
-    let grid = |full: bool, (time, threshold): (f64, String)| {
-        if full {
-            "every combination".to_string()
-        } else {
-            format!("a cross through {time} ms, threshold {threshold}")
-        }
-    };
-    let recorded = "recorded data (no `simulator.json`): the recordings' own";
+    [
+        data(exp1_sim, exp2_sim),
+        labels(),
+        representations(exp1_sim),
+        tuning_and_evaluation(plan, exp1_sim),
+        training(plan, seed),
+        studies(plan, exp1_sim),
+    ]
+    .concat()
+}
+
+/// What a choice says of a value that recorded data brings with it.
+const RECORDED: &str = "recorded data (no `simulator.json`): the recordings' own";
+
+/// How a tuning grid is searched: every combination, or a cross through its centre.
+fn grid_text(full: bool, (time, threshold): (f64, String)) -> String {
+    if full {
+        "every combination".to_string()
+    } else {
+        format!("a cross through {time} ms, threshold {threshold}")
+    }
+}
+
+/// The choices of the data: the simulated sensor, or the recordings' own.
+fn data(exp1_sim: Option<&SimParams>, exp2_sim: Option<&SimParams>) -> Vec<Choice> {
     vec![
         row(
             "Simulated sensor",
-            exp1_sim.map_or(recorded.into(), |sim| {
+            exp1_sim.map_or(RECORDED.into(), |sim| {
                 format!(
                     "evtac's simulator: background noise leak {} Hz + shot {} Hz per pixel, {} \
                      hot pixels at {}-{} Hz; every parameter in `docs/simulator.md`",
@@ -107,7 +120,7 @@ pub fn of_run(
         ),
         row(
             "Stop angle (Experiment 2)",
-            exp2_sim.map_or(recorded.into(), |sim| {
+            exp2_sim.map_or(RECORDED.into(), |sim| {
                 format!(
                     "uniform in {}..{} deg of tilt",
                     sim.timeline.stop_range_deg[0], sim.timeline.stop_range_deg[1]
@@ -117,6 +130,14 @@ pub fn of_run(
              motion's start and end ramps",
             "`timeline.stop_range_deg` in `evtac simulate --params FILE`",
         ),
+    ]
+}
+
+/// The choices of the labels computed from the IMU.
+fn labels() -> Vec<Choice> {
+    let labels = LabelConfig::default();
+    let train = TrainConfig::default();
+    vec![
         row(
             "Label filter",
             format!(
@@ -155,6 +176,13 @@ pub fn of_run(
              total rotation leaves the stop angle free to validate the labels",
             "`evtac labels DATASET --scale METHOD` or `--config FILE`",
         ),
+    ]
+}
+
+/// The choices of the representations and their mask.
+fn representations(exp1_sim: Option<&SimParams>) -> Vec<Choice> {
+    let st = StaticConfig::default();
+    vec![
         row(
             "Static accumulator",
             format!(
@@ -207,6 +235,12 @@ pub fn of_run(
              accumulator settings; the same config makes the mask match the frames it cleans",
             "`no_contact.aedat4` in the dataset; `crates/repr/src/mask.rs`",
         ),
+    ]
+}
+
+/// The choices of tuning, model selection and how the experiments are scored.
+fn tuning_and_evaluation(plan: &Plan, exp1_sim: Option<&SimParams>) -> Vec<Choice> {
+    vec![
         row(
             "Tuning grids",
             format!(
@@ -214,13 +248,13 @@ pub fn of_run(
                  the {} grid{}",
                 list(&plan.static_taus_ms),
                 list(&plan.static_thresholds),
-                grid(
+                grid_text(
                     plan.full_grid,
                     (plan.static_center.0, plan.static_center.1.to_string())
                 ),
                 list(&plan.dynamic_windows_ms),
                 list(&plan.dynamic_thresholds),
-                grid(
+                grid_text(
                     plan.full_grid,
                     (plan.dynamic_center.0, plan.dynamic_center.1.to_string())
                 ),
@@ -237,7 +271,7 @@ pub fn of_run(
         ),
         row(
             "Trial timeline",
-            exp1_sim.map_or(recorded.into(), |sim| {
+            exp1_sim.map_or(RECORDED.into(), |sim| {
                 let t = &sim.timeline;
                 format!(
                     "indentation {} s (a cosine ramp), rest {} s, tilt to {} deg at the trial's \
@@ -297,6 +331,14 @@ pub fn of_run(
              pitch and roll ones, to rounding",
             "`crates/learn/src/metrics.rs`",
         ),
+    ]
+}
+
+/// The choices of the network, its training and its samples, splits and seeds.
+fn training(plan: &Plan, seed: u64) -> Vec<Choice> {
+    let train = TrainConfig::default();
+    let opt = &train.optimizer;
+    vec![
         row(
             "Activation",
             format!(
@@ -348,6 +390,12 @@ pub fn of_run(
             "the paper states ten runs, not their seeds",
             "`evtac reproduce --seed`",
         ),
+    ]
+}
+
+/// The choices of the studies evtac adds to the paper's, and the latency study.
+fn studies(plan: &Plan, exp1_sim: Option<&SimParams>) -> Vec<Choice> {
+    vec![
         row(
             "Background noise study",
             format!(

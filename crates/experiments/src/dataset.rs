@@ -9,6 +9,7 @@ use crate::splits::{self, Splits, Stratum};
 use evtac_events::IoError;
 use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE, SIMULATOR_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
+use evtac_events::output::write_atomic;
 use evtac_events::{Event, Resolution, Roi};
 use evtac_import::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use evtac_labels::geometry::Calibration;
@@ -304,7 +305,8 @@ impl Dataset {
                 .write_csv(&tmp)
                 .map_err(|e| lab(e.to_string()))?;
             std::fs::rename(&tmp, &path).map_err(io_err(&path))?;
-            crate::jobs::write_atomic(&key_path, key.as_bytes()).map_err(io_err(&key_path))?;
+            // In the labels folder, made above.
+            write_atomic(&key_path, key.as_bytes()).map_err(io_err(&key_path))?;
             return Ok(labels.labels);
         }
         LabelSeries::read_csv(&path).map_err(|e| lab(e.to_string()))

@@ -1,6 +1,7 @@
-//! [`Error`]: what can stop a reproduction, one variant per stage that can fail. Its own file so
-//! that the stages (the noise study simulates and trains) and the pipeline that runs them share
-//! it without importing each other.
+//! [`Error`]: what can stop a reproduction, one variant per stage that can fail, and
+//! [`PerturbError`], why the sensitivity study could not scale a simulator parameter. Their own
+//! file so that the stages (the noise study simulates and trains), the pipeline that runs them
+//! and the studies share them without importing each other.
 
 use std::path::PathBuf;
 
@@ -38,7 +39,7 @@ pub enum Error {
     Jobs(#[from] crate::jobs::Error),
     /// A simulator parameter of the sensitivity study could not be scaled.
     #[error(transparent)]
-    Perturb(#[from] crate::sensitivity::PerturbError),
+    Perturb(#[from] PerturbError),
     /// Something a stage needs from an earlier one is not in its results.
     #[error("missing {what}")]
     Missing {
@@ -48,4 +49,33 @@ pub enum Error {
     /// The log of stage times (`stage-times.csv`) could not be read or appended to.
     #[error(transparent)]
     StageLog(#[from] crate::stage_log::Error),
+}
+
+/// Why a parameter could not be scaled.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PerturbError {
+    /// No parameter has this name.
+    #[error(
+        "no simulator parameter {name:?} in the sensitivity study; the parameters are {}",
+        crate::parameters::names()
+    )]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// A field is not one of the numbers of `simulator.json` a parameter scales.
+    #[error("simulator parameter {field} is not a number in simulator.json")]
+    NotANumber {
+        /// The field, `section.field`.
+        field: String,
+    },
+    /// The scaled parameters are not valid simulator parameters (a count out of range).
+    #[error("simulator parameters with {field} scaled: {message}")]
+    Invalid {
+        /// The fields.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
 }

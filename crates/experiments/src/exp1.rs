@@ -129,7 +129,7 @@ pub fn train_all(
     jobs::run_all(
         &ordered,
         |j| j.out.clone(),
-        |j| j.run_on(cache, splits, |_| {}).map(|_| ()),
+        |j| training::train_job(cache, splits, &j.spec, &j.out, |_| {}).map(|_| ()),
         |skipped| progress.finished(skipped),
     )
 }

@@ -4,6 +4,10 @@
 //! file: all four share this type, so a job means the same thing wherever it runs, and no
 //! library code spells a command line that clap would have to parse back.
 //!
+//! A job only describes its work; the module that owns the work runs it
+//! ([`crate::simulation::run`], [`crate::training::run_job`], the pipeline from
+//! [`ReproduceJob::plan`], [`crate::sensitivity::run_point`]), so this file imports none of them.
+//!
 //! A jobs file is JSON Lines: one job per line (line `K` is array task `K`), each object carrying
 //! the file format's version and the job's kind:
 //!
@@ -17,17 +21,15 @@
 use std::path::{Path, PathBuf};
 
 use evtac_events::IoError;
+use evtac_events::output::write_atomic;
 use evtac_import::inputs::Inputs;
-use evtac_learn::EpochRecord;
+use evtac_repr::ReprConfig;
 use evtac_sim::{Protocol, Scale};
 use serde::{Deserialize, Serialize};
 
-use crate::cache::FeatureCache;
-use crate::dataset::Dataset;
-use crate::error::Error;
-use crate::results::Mae;
-use crate::splits::Splits;
-use crate::training::{self, TrainSpec};
+use crate::plan::{Grid, Plan};
+use crate::results::Varied;
+use crate::sampling::{Phase, Sampling};
 
 /// The version of the jobs-file format this build writes and reads.
 pub const FORMAT: u32 = 1;
@@ -77,24 +79,6 @@ pub struct SimulateJob {
 }
 
 impl SimulateJob {
-    /// Simulates the dataset (nothing when it is done already), calling `on_trial` after each
-    /// trial, and marks it done.
-    pub fn run(&self, on_trial: impl Fn() + Sync) -> Result<(), Error> {
-        if crate::jobs::is_done(&self.out) {
-            return Ok(());
-        }
-        let config = self.config();
-        evtac_sim::simulate_dataset(&config, &self.out, |_| on_trial()).map_err(|source| {
-            Error::Simulation {
-                protocol: self.protocol,
-                dir: self.out.clone(),
-                source: Box::new(source),
-            }
-        })?;
-        crate::jobs::mark_done(&self.out)?;
-        Ok(())
-    }
-
     /// What the job simulates.
     pub fn config(&self) -> evtac_sim::DatasetConfig {
         evtac_sim::DatasetConfig {
@@ -106,6 +90,57 @@ impl SimulateJob {
     /// How many trials the dataset has (for a progress bar).
     pub fn trials(&self) -> usize {
         self.config().trials().len()
+    }
+}
+
+/// What one training job trains: the representation, seeds, epochs and samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainSpec {
+    /// The representation.
+    pub repr: ReprConfig,
+    /// Seed of the initial weights and the shuffling.
+    pub seed: u64,
+    /// Epochs.
+    pub epochs: usize,
+    /// Sampling scheme of the dataset.
+    pub sampling: Sampling,
+    /// Phases of the samples to train and validate on.
+    pub phases: Vec<Phase>,
+    /// Standard deviation (degrees) of Gaussian noise added to every training label, pitch and
+    /// roll alike, before training (the label-noise ablation); 0, the default, adds none.
+    /// Validation and test labels are never changed.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub label_noise_deg: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// How a reproduction simulates its datasets: every protocol at one scale and master seed, with
+/// `repeats` passes over Experiments 1 and 2's conditions instead of the scale's. One value, so
+/// that the simulation, its cost estimate and its Slurm round cannot disagree on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Simulation {
+    /// How many trials.
+    pub scale: Scale,
+    /// Passes over the conditions of Experiments 1 and 2 instead of the scale's, or `None`.
+    pub repeats: Option<usize>,
+    /// Master seed.
+    pub seed: u64,
+}
+
+impl Simulation {
+    /// The job that simulates `protocol`'s dataset into its folder under `dir` (laid out as
+    /// [`crate::pipeline::Datasets::in_dir`] reads them).
+    pub fn job(&self, protocol: Protocol, dir: &Path) -> SimulateJob {
+        SimulateJob {
+            protocol,
+            scale: self.scale,
+            seed: self.seed,
+            out: dir.join(protocol.name()),
+            repeats: self.repeats,
+        }
     }
 }
 
@@ -123,40 +158,6 @@ pub struct TrainJob {
     pub spec: TrainSpec,
     /// The model folder to write.
     pub out: PathBuf,
-}
-
-impl TrainJob {
-    /// Trains with `cache` (of the job's dataset) and its `splits`: how the local pipeline runs
-    /// many jobs over one opened dataset.
-    pub fn run_on(
-        &self,
-        cache: &FeatureCache<'_>,
-        splits: &Splits,
-        on_epoch: impl FnMut(&EpochRecord),
-    ) -> Result<Mae, training::Error> {
-        training::train_job(cache, splits, &self.spec, &self.out, on_epoch)
-    }
-
-    /// Opens the dataset, makes its splits when missing and the features the job needs
-    /// (`on_trial(reused)` after each trial), then trains (`on_epoch` after each epoch).
-    /// Returns the best validation MAE.
-    pub fn run(
-        &self,
-        on_trial: &(dyn Fn(bool) + Sync),
-        on_epoch: impl FnMut(&EpochRecord),
-    ) -> Result<Mae, Error> {
-        let ds = Dataset::open(&self.dataset, self.inputs)?;
-        let splits = ds.splits(self.splits_seed)?;
-        let cache = FeatureCache::new(&ds)?;
-        let trials: Vec<_> = ds.manifest.trials.iter().collect();
-        cache.ensure(
-            &trials,
-            std::slice::from_ref(&self.spec.repr),
-            self.spec.sampling,
-            on_trial,
-        )?;
-        Ok(self.run_on(&cache, &splits, on_epoch)?)
-    }
 }
 
 /// A reproduction's settings: those of the `evtac reproduce` it stands for.
@@ -190,13 +191,86 @@ pub struct ReproduceJob {
     /// the split (when the dataset has repeats). Absent from older jobs files: it was.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub repeat_split: bool,
-    /// The tuning grids (`--grid`), or `None` for the plan's ([`crate::plan::Grid::Extended`]).
+    /// The tuning grids (`--grid`), or `None` for the plan's ([`Grid::Extended`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub grid: Option<crate::plan::Grid>,
+    pub grid: Option<Grid>,
     /// Whether the best tuning settings are trained again with more seeds
-    /// ([`crate::plan::Plan::recheck_top`]; `--no-recheck` leaves it out). Absent: it is.
+    /// ([`Plan::recheck_top`]; `--no-recheck` leaves it out). Absent: it is.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub recheck: bool,
+}
+
+impl ReproduceJob {
+    /// How the job simulates its datasets when it is given none.
+    pub fn simulation(&self) -> Simulation {
+        Simulation {
+            scale: self.scale,
+            repeats: self.repeats,
+            seed: self.seed,
+        }
+    }
+
+    /// The plan the job runs: the scale's, with the job's settings in place of the plan's
+    /// defaults. Built from the job itself, so that `evtac reproduce` and a Slurm task that runs
+    /// the job mean the same reproduction. Refuses settings no reproduction can run, naming
+    /// them by the flags of the `evtac reproduce` the job stands for.
+    pub fn plan(&self) -> Result<Plan, PlanError> {
+        let mut plan = Plan::for_scale(self.scale);
+        if let Some(levels) = &self.noise_levels {
+            if let Some(&level) = levels.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
+                return Err(PlanError::NoiseLevel { level });
+            }
+            plan.noise_levels = levels.clone();
+        }
+        plan.fusions = self.fusions;
+        plan.repeat_split = self.repeat_split;
+        if let Some(grid) = self.grid {
+            plan = plan.with_grid(grid);
+        }
+        if !self.recheck {
+            (plan.recheck_top, plan.recheck_seeds) = (0, 0);
+        }
+        if let Some(sd) = self.label_noise_deg {
+            if !(sd.is_finite() && sd >= 0.0) {
+                return Err(PlanError::LabelNoise { sd });
+            }
+            plan.label_noise_deg = (sd > 0.0).then_some(sd);
+        }
+        if let Some(n) = self.datasets {
+            plan.datasets = n;
+        }
+        if self.repeats.is_some() && self.data.is_some() {
+            return Err(PlanError::RepeatsOfGivenData);
+        }
+        Ok(plan)
+    }
+}
+
+/// Why a [`ReproduceJob`] has no plan: settings no reproduction can run, named by the flags of
+/// `evtac reproduce`, where a user gives them.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlanError {
+    /// A noise level is negative or not finite.
+    #[error("--noise-levels: {level} is not a factor (finite and at least 0)")]
+    NoiseLevel {
+        /// The level.
+        level: f64,
+    },
+    /// The label-noise standard deviation is negative or not finite.
+    #[error(
+        "--label-noise-deg {sd}: give a standard deviation in degrees, 0 (no ablation) or more"
+    )]
+    LabelNoise {
+        /// The standard deviation given.
+        sd: f64,
+    },
+    /// Repeats were asked of datasets that are given, not simulated.
+    #[error(
+        "--repeats sets how the datasets are simulated; the --data datasets are already made \
+         (simulate them with `evtac simulate --repeats N`)"
+    )]
+    RepeatsOfGivenData,
 }
 
 /// The default of a flag that older jobs files do not carry.
@@ -217,8 +291,8 @@ pub struct SensitivityPointJob {
     pub scale: Scale,
     /// The study's master seed.
     pub seed: u64,
-    /// The parameter ([`crate::sensitivity::BASELINE`] for the defaults).
-    pub parameter: String,
+    /// What the point varies.
+    pub parameter: Varied,
     /// The factor on it.
     pub factor: f64,
     /// The point's folder ([`crate::sensitivity::point_dir`]).
@@ -227,25 +301,6 @@ pub struct SensitivityPointJob {
     /// [`crate::sensitivity::point`]).
     #[serde(default)]
     pub keep_data: bool,
-}
-
-impl SensitivityPointJob {
-    /// Runs the point (resuming what is finished), reporting to `progress`.
-    pub fn run(&self, progress: &dyn crate::progress::Progress) -> Result<(), Error> {
-        evtac_learn::flush_denormals();
-        let plan = crate::sensitivity::plan(self.scale);
-        let params = crate::sensitivity::params_of(&self.parameter, self.factor)?;
-        let models = self.out.join("models");
-        let run = crate::context::RunContext {
-            plan: &plan,
-            seed: self.seed,
-            models: &models,
-            progress,
-        };
-        let point = (self.parameter.as_str(), self.factor);
-        crate::sensitivity::point(point, &params, &self.out, self.keep_data, &run)?;
-        Ok(())
-    }
 }
 
 /// Errors reading or writing a jobs file.
@@ -324,7 +379,9 @@ pub fn to_text(jobs: &[Job]) -> String {
 
 /// Writes `jobs` to the jobs file `path`, whole or not at all.
 pub fn write(path: &Path, jobs: &[Job]) -> Result<(), FileError> {
-    crate::jobs::write_atomic(path, to_text(jobs).as_bytes()).map_err(IoError::at(path))?;
+    crate::jobs::create_parent(path)
+        .and_then(|()| write_atomic(path, to_text(jobs).as_bytes()))
+        .map_err(IoError::at(path))?;
     Ok(())
 }
 
@@ -370,7 +427,6 @@ pub fn read(path: &Path) -> Result<Vec<Job>, FileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::{Phase, Sampling};
     use evtac_repr::{DynamicConfig, ReprKind, StaticConfig};
 
     fn jobs() -> Vec<Job> {
@@ -409,13 +465,13 @@ mod tests {
                 datasets: Some(3),
                 repeats: Some(2),
                 repeat_split: false,
-                grid: Some(crate::plan::Grid::Paper),
+                grid: Some(Grid::Paper),
                 recheck: false,
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,
                 seed: 2,
-                parameter: "cutoff".into(),
+                parameter: Varied::from("cutoff"),
                 factor: 0.5,
                 out: "study/points/cutoff/x0.5".into(),
                 keep_data: true,

@@ -4,6 +4,7 @@
 //! as one `evtac ...` command per line for a Slurm array or GNU parallel.
 
 use evtac_events::IoError;
+use evtac_events::output::write_atomic;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -28,17 +29,19 @@ pub fn is_done(dir: &Path) -> bool {
 /// Marks the job writing to `dir` as finished (its outputs must be complete by now).
 pub fn mark_done(dir: &Path) -> Result<(), Error> {
     let marker = dir.join(DONE);
-    write_atomic(&marker, b"").map_err(IoError::at(&marker))?;
+    create_parent(&marker)
+        .and_then(|()| write_atomic(&marker, b""))
+        .map_err(IoError::at(&marker))?;
     Ok(())
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename, so readers (and resumed runs)
-/// never see a half-written file. Creates the parent folder.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent)?;
+/// Creates the folder `path` is written into (the experiments write into folders they make as
+/// they go; [`write_atomic`] needs its folder to exist).
+pub fn create_parent(path: &Path) -> std::io::Result<()> {
+    match path.parent() {
+        Some(parent) => std::fs::create_dir_all(parent),
+        None => Ok(()),
     }
-    evtac_events::output::write_atomic(path, bytes)
 }
 
 /// A sibling temporary path for `path` (same folder, so a rename is atomic), unique to this call:

@@ -14,6 +14,9 @@
 //! - [`cache`]: pooled features per (trial, representation config, mask, sampling) as NPY,
 //!   computed in one pass for many configs, reused.
 //! - [`context`]: the plan, seed, model folder and progress an experiment run shares.
+//! - [`job`]: one unit of work as data (simulate, train, reproduce, a sensitivity point), run by
+//!   the module that owns the work ([`simulation`], [`training`], [`pipeline`],
+//!   [`sensitivity`]).
 //! - [`jobs`]: jobs with `done` markers, run in parallel, resumed after interruption; their
 //!   [`stage`]s and what each is expected to cost (for progress bars with an ETA), reported
 //!   through [`progress`]; the crate's `schedule` starts a stage's training runs longest first.
@@ -70,7 +73,9 @@ mod label_check;
 pub mod label_noise;
 pub mod latency;
 mod noise;
+mod paced_extent;
 pub mod paced_latency;
+mod parameters;
 pub mod pipeline;
 pub mod plan;
 pub mod progress;
@@ -81,6 +86,7 @@ pub mod sampling;
 mod schedule;
 pub mod sensitivity;
 pub mod sensor_view;
+pub mod simulation;
 pub mod slurm;
 pub mod splits;
 pub mod stage;

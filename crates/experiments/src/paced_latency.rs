@@ -65,10 +65,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use std::time::{Duration, Instant};
 
-/// The intervals replayed, in ms: the paper's finest, and its coarsest (the same wall time,
-/// little more CPU).
-pub const INTERVALS_MS: [u32; 2] = [1, 10];
-
 /// How long the load may outlast the events it runs beside, at most: a bound on the load
 /// thread should the replay fall far behind (it is normally stopped as the replay ends).
 pub const LOAD_MARGIN: Duration = Duration::from_secs(10);
@@ -77,35 +73,7 @@ pub const LOAD_MARGIN: Duration = Duration::from_secs(10);
 /// releases are one interval each whatever this is).
 const READ_CHUNK: usize = 4096;
 
-/// How much is replayed at a scale.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Extent {
-    /// Test trials replayed (the fastest-moving ones).
-    pub trials: usize,
-    /// The longest stretch of each trial's motion replayed, from its onset, in ms.
-    pub motion_ms: i64,
-}
-
-/// How much is replayed at `scale`: each (representation, interval, load) replays
-/// `trials x motion_ms` of events on the wall clock, so at `small` 2 x 2 s for each of
-/// 5 x 2 x 2 cells, about 80 s.
-pub const fn extent(scale: Scale) -> Extent {
-    match scale {
-        Scale::Tiny => Extent {
-            trials: 1,
-            motion_ms: 500,
-        },
-        Scale::Small => Extent {
-            trials: 2,
-            motion_ms: 2000,
-        },
-        Scale::Paper => Extent {
-            trials: 4,
-            motion_ms: 2000,
-        },
-    }
-}
-
+pub use crate::paced_extent::{Extent, INTERVALS_MS, extent};
 pub use crate::results::{Load, PacedLatencyCell};
 
 /// Errors of the replay.

@@ -6,13 +6,17 @@ use crate::cache::FeatureCache;
 use crate::context::RunContext;
 use crate::dataset::Dataset;
 use crate::exp3::Axis;
-use crate::job::{Job, SimulateJob};
+use crate::job::{Job, Simulation};
 use crate::jobs;
 use crate::plan::Plan;
 use crate::progress::Progress;
-use crate::results::{Exp2Setting, Results, RunInfo};
-use crate::splits::Split;
-use crate::stage::Stage;
+use crate::results::{
+    DatasetSeedPoint, ExampleTrial, Exp1Repr, Exp2Cell, Exp2Setting, Exp3Point, LabelCheck,
+    LabelNoise, LatencyCell, NoisePoint, PacedLatencyCell, RepeatSplit, ReprExample, Results,
+    RunInfo, SensorView, Tuning,
+};
+use crate::splits::{Split, Splits};
+use crate::stage::{Stage, Timed};
 use crate::stage_log::StageLog;
 use crate::training;
 use crate::tuning::{self, Kind};
@@ -20,9 +24,11 @@ use crate::{
     choices, dataset_seeds, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise,
     repeat_split, repr_example, sensor_view,
 };
+use evtac_events::manifest::TrialMeta;
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::{ReprConfig, ReprKind};
+use evtac_sim::{Protocol, SimParams};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -64,29 +70,21 @@ impl Datasets {
     }
 }
 
-/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) at `scale` (with
-/// `repeats` passes over Experiments 1 and 2's conditions instead of the scale's) into `dir`,
-/// laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked done is kept,
-/// so an interrupted simulation resumes.
+/// Simulates the dataset of every protocol ([`crate::stage::PROTOCOLS`]) as `simulation` says
+/// into `dir`, laid out as [`Datasets::in_dir`] reads them. A dataset whose folder is marked
+/// done is kept, so an interrupted simulation resumes.
 pub fn simulate_all(
     dir: &Path,
-    (scale, repeats): (evtac_sim::Scale, Option<usize>),
-    seed: u64,
+    simulation: &Simulation,
     progress: &dyn Progress,
 ) -> Result<(), Error> {
     for protocol in crate::stage::PROTOCOLS {
-        let job = SimulateJob {
-            protocol,
-            scale,
-            seed,
-            out: dir.join(protocol.name()),
-            repeats,
-        };
+        let job = simulation.job(protocol, dir);
         if jobs::is_done(&job.out) {
             continue;
         }
         progress.stage(Stage::Simulating(protocol), job.trials() as u64);
-        job.run(|| progress.advance(1))?;
+        crate::simulation::run(&job, || progress.advance(1))?;
     }
     Ok(())
 }
@@ -101,11 +99,11 @@ struct Stages<'a> {
 }
 
 impl Stages<'_> {
-    fn done(&mut self, name: &str) -> Result<(), Error> {
+    fn done(&mut self, stage: Timed) -> Result<(), Error> {
         let s = self.started.elapsed().as_secs_f64();
-        self.list.push((name.to_string(), s));
-        self.progress.message(&format!("{name}: {s:.1} s"));
-        self.log.record(name, s)?;
+        self.list.push((stage.name().to_string(), s));
+        self.progress.message(&format!("{stage}: {s:.1} s"));
+        self.log.record(stage, s)?;
         self.started = Instant::now();
         Ok(())
     }
@@ -134,7 +132,7 @@ pub fn reproduce(
     let ds1 = Dataset::open(&data.exp1, data.inputs)?;
     let splits1 = ds1.splits(seed)?;
     let cache1 = FeatureCache::new(&ds1)?;
-    let mut datasets = vec![("exp1".to_string(), ds1.manifest.trials.len())];
+    let mut datasets = vec![(Protocol::Exp1, ds1.manifest.trials.len())];
 
     let run = RunContext {
         plan,
@@ -142,140 +140,36 @@ pub fn reproduce(
         models: &models,
         progress,
     };
-    let st = tuning::tune(&cache1, &splits1, Kind::Static, &run)?;
-    stages.done("tuning (static)")?;
-    let dt = tuning::tune(&cache1, &splits1, Kind::Dynamic, &run)?;
-    stages.done("tuning (dynamic)")?;
-    let (static_cfg, dynamic_cfg) = (st.chosen_config, dt.chosen_config);
-    let reprs = exp1::of_plan(plan, static_cfg, dynamic_cfg);
-
-    let e1 = exp1::run(&cache1, &splits1, &reprs, &run)?;
-    stages.done("experiment 1")?;
-    let noise = noise::run(&ds1, &e1, &reprs, &run, out)?;
-    if !noise.is_empty() {
-        stages.done("experiment 1 at other noise")?;
-    }
-    let dataset_seeds = dataset_seeds::run(&ds1, &e1, &reprs, &run, out)?;
-    if !dataset_seeds.is_empty() {
-        stages.done("experiment 1 on other datasets")?;
-    }
-    let repeat_split = repeat_split::run(&cache1, &reprs, &e1, &run)?;
-    if repeat_split.is_some() {
-        stages.done("repeats kept together")?;
-    }
-    let label_noise = label_noise::run(&cache1, &splits1, &reprs, &e1, &run)?;
-    if label_noise.is_some() {
-        stages.done("label-noise ablation")?;
-    }
-
-    let mut e2 = Vec::new();
-    let mut example = None;
+    let on1 = on_exp1(&cache1, &splits1, &run, out, &mut stages)?;
     let exp1_sim = ds1.simulator()?;
-    let mut exp2_sim = None;
-    let mut labels = None;
-    if let Some(dir) = &data.exp2 {
-        let ds2 = Dataset::open(dir, data.inputs)?;
-        labels = Some(label_check::of_dataset(&ds2)?);
-        exp2_sim = ds2.simulator()?.map(|s| s.params);
-        datasets.push(("exp2".into(), ds2.manifest.trials.len()));
-        let splits2 = ds2.splits(seed)?;
-        let cache2 = FeatureCache::new(&ds2)?;
-        e2 = exp2::run(&cache2, &splits2, &reprs, &run)?;
-        // The example: the first test trial with a stop, with the motion + stop models.
-        let test = ds2.trials(splits2.get(Split::Test))?;
-        if let Some(meta) = test.iter().find(|t| t.stop_start_us.is_some()) {
-            let loaded: Vec<(ReprKind, Model)> = reprs
-                .iter()
-                .map(|config| {
-                    let kind = config.kind();
-                    let setting = Exp2Setting::PauseMotionStop;
-                    training::load_model(&exp2::model_dir(&models, setting, kind, seed))
-                        .map(|m| (kind, m))
-                })
-                .collect::<Result<_, _>>()?;
-            let refs: Vec<(ReprKind, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
-            example = Some(examples::example_trial(&cache2, meta, &refs)?);
+    let on2 = match &data.exp2 {
+        Some(dir) => {
+            let on2 = on_exp2(dir, data.inputs, &on1.reprs, &run)?;
+            datasets.push((Protocol::Exp2, on2.trials));
+            stages.done(Timed::Exp2)?;
+            Some(on2)
         }
-        stages.done("experiment 2")?;
-    }
-
-    let exp1_models: Vec<(ReprKind, Vec<Model>)> = reprs
-        .iter()
-        .map(|config| {
-            let kind = config.kind();
-            exp1::models(&models, kind, seed, plan.seeds).map(|m| (kind, m))
-        })
-        .collect::<Result<_, _>>()?;
-    let speeds: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.speed_deg_s).collect();
-    let depths: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.depth_mm).collect();
-    let mut e3s = Vec::new();
-    let mut e3d = Vec::new();
-    for (dir, axis, values) in [
-        (&data.exp3_speed, Axis::Speed, &speeds),
-        (&data.exp3_depth, Axis::Depth, &depths),
-    ] {
-        let Some(dir) = dir else { continue };
-        let ds = Dataset::open(dir, data.inputs)?;
-        datasets.push((
-            match axis {
-                Axis::Speed => "exp3-speed".into(),
-                Axis::Depth => "exp3-depth".into(),
-            },
-            ds.manifest.trials.len(),
-        ));
-        let cache = FeatureCache::new(&ds)?;
-        let points = exp3::run(&cache, axis, &exp1_models, values, progress)?;
-        match axis {
-            Axis::Speed => e3s = points,
-            Axis::Depth => e3d = points,
-        }
-    }
-    if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
-        stages.done("experiment 3")?;
-    }
-    let overlays = examples::overlays(&cache1, reprs[0], reprs[1])?;
-    // The paper's Fig. 2 and the sensor's camera view, both on the first test trial.
-    let test = ds1.trials(splits1.get(Split::Test))?;
-    let (repr_example, sensor) = match test.first() {
-        Some(meta) => {
-            // The paper's three frames (the fusions' are the static and dynamic ones).
-            let paper_reprs: Vec<_> = reprs.iter().filter(|c| c.frames() == 1).copied().collect();
-            let example = repr_example::example(&cache1, meta, &paper_reprs)?;
-            // The tilt at the example's sample (commanded: constant speed from onset).
-            let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
-                (meta.speed_deg_s * e.t_ms / 1000.0).min(meta.total_deg)
-            });
-            (example, Some(sensor_view::view(&ds1, meta, theta)?))
-        }
-        None => (None, None),
+        None => None,
     };
-
-    // Latency: the first model of each representation on the Experiment 1 test trials, alone.
-    let test = &test[..test.len().min(plan.latency_trials)];
-    progress.stage(
-        Stage::Latency,
-        (exp1_models.len() * plan.latency_intervals_ms.len()) as u64,
-    );
-    let mut lat = Vec::new();
-    for (name, ms) in &exp1_models {
-        let Some(model) = ms.first() else { continue };
-        for &iv in &plan.latency_intervals_ms {
-            lat.push(latency::measure(&ds1, test, *name, model, iv)?);
-            progress.advance(1);
-        }
+    let exp1_models = exp1_models(&on1.reprs, &run)?;
+    let (e3s, e3d) = on_exp3(data, &ds1, &exp1_models, progress, &mut datasets)?;
+    if data.exp3_speed.is_some() || data.exp3_depth.is_some() {
+        stages.done(Timed::Exp3)?;
     }
-    // Then end to end, queueing included: a few of these trials replayed at recorded pace,
-    // idle and under load (on the wall clock: its progress is messages, not units).
-    let firsts: Vec<(ReprKind, &Model)> = exp1_models
-        .iter()
-        .filter_map(|(name, ms)| ms.first().map(|m| (*name, m)))
-        .collect();
-    let paced = crate::paced_latency::measure(&ds1, test, &firsts, plan.scale, progress)?;
-    stages.done("latency")?;
+    let overlays = examples::overlays(&cache1, on1.reprs[0], on1.reprs[1])?;
+    // The paper's Fig. 2, the sensor's camera view and the latency study, on the test trials.
+    let test = ds1.trials(splits1.get(Split::Test))?;
+    let (repr_example, sensor) = fig2_and_sensor(&cache1, &test, &on1.reprs)?;
+    let (lat, paced) = latencies(&ds1, &test, &exp1_models, plan, progress)?;
+    stages.done(Timed::Latency)?;
 
+    let (e2, example, exp2_sim, labels) = match on2 {
+        Some(on2) => (on2.cells, on2.example, on2.sim, on2.labels),
+        None => (Vec::new(), None, None, None),
+    };
     let mut results = Results {
         run: RunInfo {
-            scale: plan.scale.name().to_string(),
+            scale: plan.scale,
             seed,
             plan: plan.clone(),
             stage_seconds: Vec::new(),
@@ -283,14 +177,14 @@ pub fn reproduce(
             datasets,
             inputs: Some(data.inputs),
         },
-        tuning: vec![st, dt],
-        exp1: e1,
+        tuning: vec![on1.st, on1.dt],
+        exp1: on1.e1,
         exp2: e2,
         exp3_speed: e3s,
         exp3_depth: e3d,
         latency: lat,
-        noise,
-        label_noise,
+        noise: on1.noise,
+        label_noise: on1.label_noise,
         example,
         choices: choices::of_run(
             plan,
@@ -303,13 +197,229 @@ pub fn reproduce(
         repr_example,
         sensor_kind: sensor.as_ref().map(|v| v.kind),
         sensor,
-        dataset_seeds,
-        repeat_split,
+        dataset_seeds: on1.dataset_seeds,
+        repeat_split: on1.repeat_split,
         paced_latency: paced,
     };
     results.run.stage_seconds = stages.list;
     results.run.stage_history = log.records();
     Ok(results)
+}
+
+/// What the stages on Experiment 1's dataset measured: the tunings, the representations they
+/// chose, Experiment 1 and the studies that train it again (other noise, other datasets,
+/// repeats kept together, noisy labels).
+struct OnExp1 {
+    st: Tuning,
+    dt: Tuning,
+    reprs: Vec<ReprConfig>,
+    e1: Vec<Exp1Repr>,
+    noise: Vec<NoisePoint>,
+    dataset_seeds: Vec<DatasetSeedPoint>,
+    repeat_split: Option<RepeatSplit>,
+    label_noise: Option<LabelNoise>,
+}
+
+/// Tuning, Experiment 1 and the studies built on it, each stage timed in `stages` as it
+/// finishes (a study the plan leaves out is no stage).
+fn on_exp1(
+    cache1: &FeatureCache<'_>,
+    splits1: &Splits,
+    run: &RunContext<'_>,
+    out: &Path,
+    stages: &mut Stages<'_>,
+) -> Result<OnExp1, Error> {
+    let ds1 = cache1.dataset();
+    let st = tuning::tune(cache1, splits1, Kind::Static, run)?;
+    stages.done(Timed::TuningStatic)?;
+    let dt = tuning::tune(cache1, splits1, Kind::Dynamic, run)?;
+    stages.done(Timed::TuningDynamic)?;
+    let reprs = exp1::of_plan(run.plan, st.chosen_config, dt.chosen_config);
+
+    let e1 = exp1::run(cache1, splits1, &reprs, run)?;
+    stages.done(Timed::Exp1)?;
+    let noise = noise::run(ds1, &e1, &reprs, run, out)?;
+    if !noise.is_empty() {
+        stages.done(Timed::Exp1OtherNoise)?;
+    }
+    let dataset_seeds = dataset_seeds::run(ds1, &e1, &reprs, run, out)?;
+    if !dataset_seeds.is_empty() {
+        stages.done(Timed::Exp1OtherDatasets)?;
+    }
+    let repeat_split = repeat_split::run(cache1, &reprs, &e1, run)?;
+    if repeat_split.is_some() {
+        stages.done(Timed::RepeatsTogether)?;
+    }
+    let label_noise = label_noise::run(cache1, splits1, &reprs, &e1, run)?;
+    if label_noise.is_some() {
+        stages.done(Timed::LabelNoise)?;
+    }
+    Ok(OnExp1 {
+        st,
+        dt,
+        reprs,
+        e1,
+        noise,
+        dataset_seeds,
+        repeat_split,
+        label_noise,
+    })
+}
+
+/// What the stage on Experiment 2's dataset measured, and what the report says of that dataset.
+struct OnExp2 {
+    /// Experiment 2.
+    cells: Vec<Exp2Cell>,
+    /// The example trial of the report's figure.
+    example: Option<ExampleTrial>,
+    /// The dataset's simulator parameters (`None` for recordings).
+    sim: Option<SimParams>,
+    /// Its labels against the commanded stop angles.
+    labels: Option<LabelCheck>,
+    /// Its trials.
+    trials: usize,
+}
+
+/// Experiment 2 on the dataset in `dir`, its label check, and the example trial: the first test
+/// trial with a stop, with the motion + stop models.
+fn on_exp2(
+    dir: &Path,
+    inputs: Inputs,
+    reprs: &[ReprConfig],
+    run: &RunContext<'_>,
+) -> Result<OnExp2, Error> {
+    let ds2 = Dataset::open(dir, inputs)?;
+    let labels = Some(label_check::of_dataset(&ds2)?);
+    let sim = ds2.simulator()?.map(|s| s.params);
+    let trials = ds2.manifest.trials.len();
+    let splits2 = ds2.splits(run.seed)?;
+    let cache2 = FeatureCache::new(&ds2)?;
+    let cells = exp2::run(&cache2, &splits2, reprs, run)?;
+    let test = ds2.trials(splits2.get(Split::Test))?;
+    let mut example = None;
+    if let Some(meta) = test.iter().find(|t| t.stop_start_us.is_some()) {
+        let loaded: Vec<(ReprKind, Model)> = reprs
+            .iter()
+            .map(|config| {
+                let kind = config.kind();
+                let setting = Exp2Setting::PauseMotionStop;
+                training::load_model(&exp2::model_dir(run.models, setting, kind, run.seed))
+                    .map(|m| (kind, m))
+            })
+            .collect::<Result<_, _>>()?;
+        let refs: Vec<(ReprKind, &Model)> = loaded.iter().map(|(n, m)| (*n, m)).collect();
+        example = Some(examples::example_trial(&cache2, meta, &refs)?);
+    }
+    Ok(OnExp2 {
+        cells,
+        example,
+        sim,
+        labels,
+        trials,
+    })
+}
+
+/// Experiment 1's models of every representation in `reprs`, every seed of the plan.
+fn exp1_models(
+    reprs: &[ReprConfig],
+    run: &RunContext<'_>,
+) -> Result<Vec<(ReprKind, Vec<Model>)>, Error> {
+    Ok(reprs
+        .iter()
+        .map(|config| {
+            let kind = config.kind();
+            exp1::models(run.models, kind, run.seed, run.plan.seeds).map(|m| (kind, m))
+        })
+        .collect::<Result<_, _>>()?)
+}
+
+/// Experiment 3 by speed and by depth, on those of its datasets `data` has (each one's trials
+/// added to `datasets`), with Experiment 1's models: `ds1`'s levels are the ones seen in training.
+fn on_exp3(
+    data: &Datasets,
+    ds1: &Dataset,
+    exp1_models: &[(ReprKind, Vec<Model>)],
+    progress: &dyn Progress,
+    datasets: &mut Vec<(Protocol, usize)>,
+) -> Result<(Vec<Exp3Point>, Vec<Exp3Point>), Error> {
+    let speeds: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.speed_deg_s).collect();
+    let depths: Vec<f64> = ds1.manifest.trials.iter().map(|t| t.depth_mm).collect();
+    let mut e3s = Vec::new();
+    let mut e3d = Vec::new();
+    for (dir, axis, values) in [
+        (&data.exp3_speed, Axis::Speed, &speeds),
+        (&data.exp3_depth, Axis::Depth, &depths),
+    ] {
+        let Some(dir) = dir else { continue };
+        let ds = Dataset::open(dir, data.inputs)?;
+        datasets.push((
+            match axis {
+                Axis::Speed => Protocol::Exp3Speed,
+                Axis::Depth => Protocol::Exp3Depth,
+            },
+            ds.manifest.trials.len(),
+        ));
+        let cache = FeatureCache::new(&ds)?;
+        let points = exp3::run(&cache, axis, exp1_models, values, progress)?;
+        match axis {
+            Axis::Speed => e3s = points,
+            Axis::Depth => e3d = points,
+        }
+    }
+    Ok((e3s, e3d))
+}
+
+/// The paper's Fig. 2 and the sensor's camera view, both on the first of Experiment 1's `test`
+/// trials (none without one).
+fn fig2_and_sensor(
+    cache1: &FeatureCache<'_>,
+    test: &[&TrialMeta],
+    reprs: &[ReprConfig],
+) -> Result<(Option<ReprExample>, Option<SensorView>), Error> {
+    let Some(meta) = test.first() else {
+        return Ok((None, None));
+    };
+    // The paper's three frames (the fusions' are the static and dynamic ones).
+    let paper_reprs: Vec<_> = reprs.iter().filter(|c| c.frames() == 1).copied().collect();
+    let example = repr_example::example(cache1, meta, &paper_reprs)?;
+    // The tilt at the example's sample (commanded: constant speed from onset).
+    let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
+        (meta.speed_deg_s * e.t_ms / 1000.0).min(meta.total_deg)
+    });
+    let sensor = sensor_view::view(cache1.dataset(), meta, theta)?;
+    Ok((example, Some(sensor)))
+}
+
+/// The latency study: the first model of each representation on the first of Experiment 1's
+/// `test` trials, alone, then end to end at recorded pace.
+fn latencies(
+    ds1: &Dataset,
+    test: &[&TrialMeta],
+    exp1_models: &[(ReprKind, Vec<Model>)],
+    plan: &Plan,
+    progress: &dyn Progress,
+) -> Result<(Vec<LatencyCell>, Vec<PacedLatencyCell>), Error> {
+    let test = &test[..test.len().min(plan.latency_trials)];
+    progress.stage(
+        Stage::Latency,
+        (exp1_models.len() * plan.latency_intervals_ms.len()) as u64,
+    );
+    let mut lat = Vec::new();
+    for (name, ms) in exp1_models {
+        let Some(model) = ms.first() else { continue };
+        for &iv in &plan.latency_intervals_ms {
+            lat.push(latency::measure(ds1, test, *name, model, iv)?);
+            progress.advance(1);
+        }
+    }
+    // Then end to end, queueing included: a few of these trials replayed at recorded pace,
+    // idle and under load (on the wall clock: its progress is messages, not units).
+    let firsts: Vec<(ReprKind, &Model)> = exp1_models
+        .iter()
+        .filter_map(|(name, ms)| ms.first().map(|m| (*name, m)))
+        .collect();
+    let paced = crate::paced_latency::measure(ds1, test, &firsts, plan.scale, progress)?;
+    Ok((lat, paced))
 }
 
 /// Whether every tuning run of both representations is finished in `out`.

@@ -1,5 +1,6 @@
 //! The numbers a reproduction produces, as one serde tree written to `OUT/results.json` and read
-//! by the report and the figures.
+//! by the report and the figures, and those of the sensitivity study ([`Study`], its
+//! `sensitivity.json`).
 //!
 //! Plain typed data at the bottom of the crate: this file imports nothing from the experiments
 //! that fill it (only the [`Plan`] they ran, itself plain data), so the report reads it without
@@ -7,6 +8,7 @@
 //! (`"Static"`) as `results.json` always spelled them; older files still read.
 
 use evtac_repr::{ReprConfig, ReprKind};
+pub use evtac_sim::{Protocol, Scale};
 use serde::{Deserialize, Serialize};
 
 use crate::plan::Plan;
@@ -374,8 +376,8 @@ pub struct LatencyCell {
 /// Where the reproduction's settings came from and how long it took.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
-    /// `tiny`, `small`, `paper` or `custom`.
-    pub scale: String,
+    /// The scale (the plan's).
+    pub scale: Scale,
     /// Master seed.
     pub seed: u64,
     /// The plan (grids, epochs, seeds) as run.
@@ -386,8 +388,8 @@ pub struct RunInfo {
     /// (`stage-times.csv`; absent in results written before it was kept).
     #[serde(default)]
     pub stage_history: Vec<StageRecord>,
-    /// Trials per dataset.
-    pub datasets: Vec<(String, usize)>,
+    /// Trials per dataset, by the protocol it was made with (its folder's name).
+    pub datasets: Vec<(Protocol, usize)>,
     /// Where every dataset's calibration and mask came from (absent in results written before
     /// this was recorded).
     #[serde(default)]
@@ -563,6 +565,180 @@ pub struct DatasetSeedPoint {
     /// Test MAE statistics against the simulator's exact truth, where measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test_truth: Option<MaeStats>,
+}
+
+// The sensitivity study's results (`crate::sensitivity`): what `evtac sensitivity` writes as
+// `sensitivity.json`, a file of its own beside no reproduction's `results.json`.
+
+/// Whether each of the paper's conclusions holds at one point (see [`crate::sensitivity`]); `None`
+/// where the test trials have fewer than two levels to compare.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Conclusions {
+    /// Static's test MAE is the lowest of the three.
+    pub static_best: bool,
+    /// Combined (OR) is not better than static.
+    pub or_not_better: bool,
+    /// Dynamic's rise at the slowest speed exceeds static's.
+    pub dynamic_worse_slow: Option<bool>,
+    /// Dynamic's rise at the shallowest depth exceeds static's.
+    pub dynamic_worse_shallow: Option<bool>,
+}
+
+impl Conclusions {
+    /// The conclusions' names, in the order of [`Conclusions::each`].
+    pub const NAMES: [&'static str; 4] = [
+        "static best",
+        "OR not better than static",
+        "dynamic worse at the slowest speed",
+        "dynamic worse at the shallowest depth",
+    ];
+
+    /// The four, in [`Conclusions::NAMES`]' order (`None`: not measurable at this point).
+    pub fn each(&self) -> [Option<bool>; 4] {
+        [
+            Some(self.static_best),
+            Some(self.or_not_better),
+            self.dynamic_worse_slow,
+            self.dynamic_worse_shallow,
+        ]
+    }
+}
+
+/// How much a representation's error rises at one extreme level of the test trials: its MAE
+/// there minus its mean over the other levels (both means over seeds).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rise {
+    /// The extreme level (deg/s or mm).
+    pub level: f64,
+    /// How many levels the test trials have (fewer than 2: nothing to compare, rises 0).
+    pub levels: usize,
+    /// Static's rise, deg.
+    pub static_deg: f64,
+    /// Dynamic's rise, deg.
+    pub dynamic_deg: f64,
+}
+
+/// What tuning chose for one representation at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Tuned {
+    /// Static's decay tau or dynamic's window, ms.
+    pub time_ms: f64,
+    /// The binarization threshold.
+    pub threshold: f64,
+}
+
+/// One point of the study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// What the point varies.
+    pub parameter: Varied,
+    /// The factor on it (1 for the baseline).
+    pub factor: f64,
+    /// The settings tuning chose, static then dynamic.
+    pub tuned: [Tuned; 2],
+    /// Test MAE statistics over seeds: static, dynamic, combined.
+    pub test: [MaeStats; 3],
+    /// Dynamic minus static test MAE (means over seeds), deg.
+    pub gap_deg: f64,
+    /// The rise at the slowest speed.
+    pub slow: Rise,
+    /// The rise at the shallowest depth.
+    pub shallow: Rise,
+    /// What holds.
+    pub conclusions: Conclusions,
+}
+
+/// The whole study: what `evtac sensitivity` writes as `sensitivity.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Study {
+    /// The scale.
+    pub scale: Scale,
+    /// The master seed.
+    pub seed: u64,
+    /// The factors.
+    pub factors: Vec<f64>,
+    /// The defaults' point first, then each parameter at each factor.
+    pub points: Vec<Point>,
+}
+
+impl Study {
+    /// The baseline (the defaults), when the study has it.
+    pub fn baseline(&self) -> Option<&Point> {
+        self.points.iter().find(|p| p.parameter == Varied::Baseline)
+    }
+
+    /// For each conclusion, in [`Conclusions::NAMES`]' order, how many of the perturbed points
+    /// (the baseline excluded) it holds at, and at how many it could be decided.
+    pub fn shares(&self) -> [(usize, usize); 4] {
+        let mut out = [(0, 0); 4];
+        for p in self
+            .points
+            .iter()
+            .filter(|p| p.parameter != Varied::Baseline)
+        {
+            for (o, holds) in out.iter_mut().zip(p.conclusions.each()) {
+                if let Some(holds) = holds {
+                    o.0 += usize::from(holds);
+                    o.1 += 1;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The baseline point's name, as files spell it.
+pub const BASELINE: &str = "baseline";
+
+/// What a point of the sensitivity study varies: nothing (the baseline, the simulator's
+/// defaults) or one parameter, by its name. Written as that name (`"baseline"` for the
+/// baseline), as `sensitivity.json`, `point.json` and jobs files always spelled it; a name that
+/// is no parameter reads, and is refused when the point is run (naming the parameters there is).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(from = "String", into = "String")]
+pub enum Varied {
+    /// The simulator's defaults.
+    Baseline,
+    /// The parameter of this name, scaled.
+    Parameter(String),
+}
+
+impl Varied {
+    /// The name the point goes by: its parameter's, or [`BASELINE`].
+    pub fn name(&self) -> &str {
+        match self {
+            Varied::Baseline => BASELINE,
+            Varied::Parameter(name) => name,
+        }
+    }
+}
+
+impl From<String> for Varied {
+    fn from(name: String) -> Self {
+        if name == BASELINE {
+            Varied::Baseline
+        } else {
+            Varied::Parameter(name)
+        }
+    }
+}
+
+impl From<&str> for Varied {
+    fn from(name: &str) -> Self {
+        Varied::from(name.to_string())
+    }
+}
+
+impl From<Varied> for String {
+    fn from(varied: Varied) -> Self {
+        varied.name().to_string()
+    }
+}
+
+impl std::fmt::Display for Varied {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Everything a reproduction measured.

@@ -31,161 +31,38 @@ use crate::dataset::Dataset;
 use crate::error::Error;
 use crate::exp1;
 use crate::exp3::{self, Axis};
-use crate::results::{Exp1Repr, Exp3Point, MaeStats};
+use crate::job::SensitivityPointJob;
+use crate::parameters::Slot;
+use crate::progress::Progress;
+use crate::results::{Exp1Repr, Exp3Point, MaeStats, Tuning};
 use crate::splits::Split;
 use crate::stage::{FeatureSet, Stage};
 use crate::tuning::{self, Kind};
 use crate::variant;
 use evtac_events::IoError;
+use evtac_events::output::write_atomic;
 use evtac_import::inputs::Inputs;
 use evtac_learn::Model;
 use evtac_repr::ReprKind;
 use evtac_sim::{Protocol, SimParams};
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+pub use crate::error::PerturbError;
+pub use crate::parameters::{PARAMETERS, Parameter, names, parameter};
+pub use crate::results::{BASELINE, Conclusions, Point, Rise, Study, Tuned, Varied};
 
 /// The factors every parameter is scaled by.
 pub const FACTORS: [f64; 2] = [0.5, 1.5];
 
-/// One simulator parameter the study varies: one or more fields of [`SimParams`] scaled
-/// together.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Parameter {
-    /// Short name, also the point's folder (`points/<name>/`).
-    pub name: &'static str,
-    /// What it is, for the table.
-    pub what: &'static str,
-    /// The fields, as `section.field` of `simulator.json`.
-    pub fields: &'static [&'static str],
-}
-
-/// Every parameter of the simulator that no measurement of a NeuroTac sets, in the order of
-/// `simulator.json`. The rest are either the paper's (tip radius, the protocol's speeds, depths
-/// and timeline, the camera's resolution), the rig's specification (the IRB 120's
-/// repeatability), or only shape the image without a physical meaning of their own
-/// (brightness, vignetting; the pins' count and size are varied instead).
-pub const PARAMETERS: [Parameter; 19] = [
-    Parameter {
-        name: "pin_rings",
-        what: "rings of pins (pin spacing: more rings, closer pins)",
-        fields: &["sensor.rings"],
-    },
-    Parameter {
-        name: "pin_size",
-        what: "radius of a pin's bright tip",
-        fields: &["sensor.pin_sigma_mm"],
-    },
-    Parameter {
-        name: "normal_gain",
-        what: "contact: pin motion along the normal per mm of penetration",
-        fields: &["contact.normal_gain"],
-    },
-    Parameter {
-        name: "spread_gain",
-        what: "contact: lateral spread of pins per mm of penetration",
-        fields: &["contact.spread_gain"],
-    },
-    Parameter {
-        name: "skin_tau",
-        what: "skin's time constant (viscoelastic lag)",
-        fields: &["contact.skin_tau_s"],
-    },
-    Parameter {
-        name: "shear",
-        what: "shear of the stuck patch per degree of lag",
-        fields: &["contact.shear_mm_per_deg"],
-    },
-    Parameter {
-        name: "trial_variation",
-        what: "per-trial spread of the skin's gains",
-        fields: &["contact.trial_variation"],
-    },
-    Parameter {
-        name: "creep",
-        what: "share of the skin's slow (creep) response",
-        fields: &["contact.creep_fraction"],
-    },
-    Parameter {
-        name: "on_threshold",
-        what: "DVS ON threshold (log intensity)",
-        fields: &["dvs.pos_thres"],
-    },
-    Parameter {
-        name: "off_threshold",
-        what: "DVS OFF threshold (log intensity)",
-        fields: &["dvs.neg_thres"],
-    },
-    Parameter {
-        name: "threshold_mismatch",
-        what: "DVS thresholds' pixel-to-pixel spread",
-        fields: &["dvs.sigma_thres"],
-    },
-    Parameter {
-        name: "cutoff",
-        what: "DVS photoreceptor cutoff frequency",
-        fields: &["dvs.cutoff_hz"],
-    },
-    Parameter {
-        name: "refractory",
-        what: "DVS refractory period",
-        fields: &["dvs.refractory_period_s"],
-    },
-    Parameter {
-        name: "leak_rate",
-        what: "DVS leak event rate",
-        fields: &["dvs.leak_rate_hz"],
-    },
-    Parameter {
-        name: "shot_noise",
-        what: "DVS shot-noise event rate",
-        fields: &["dvs.shot_noise_rate_hz"],
-    },
-    Parameter {
-        name: "hot_pixels",
-        what: "number of hot pixels",
-        fields: &["dvs.hot_pixels"],
-    },
-    Parameter {
-        name: "imu_noise",
-        what: "IMU's gyroscope and accelerometer white noise",
-        fields: &["imu.gyro_noise_deg_s", "imu.accel_noise_g"],
-    },
-    Parameter {
-        name: "rig_calibration",
-        what: "rig: the rolling centre's and the contact patch's offsets (tool-centre calibration)",
-        fields: &["rig.rolling_centre_sd_mm", "rig.patch_offset_sd_mm"],
-    },
-    Parameter {
-        name: "seating",
-        what: "rig: the sensor's turn, tilt and reach each time it is seated in its mount",
-        fields: &[
-            "rig.reseat_rotation_sd_deg",
-            "rig.reseat_tilt_sd_deg",
-            "rig.reseat_height_sd_mm",
-        ],
-    },
-];
-
-/// The parameter named `name`.
-pub fn parameter(name: &str) -> Option<Parameter> {
-    PARAMETERS.iter().copied().find(|p| p.name == name)
-}
-
-/// Every parameter's name, comma-separated (for messages).
-pub fn names() -> String {
-    PARAMETERS.map(|p| p.name).join(", ")
-}
-
-/// The simulator parameters of the point (`parameter`, `factor`): the defaults for
-/// [`BASELINE`], else the defaults with that parameter scaled.
-pub fn params_of(parameter: &str, factor: f64) -> Result<SimParams, PerturbError> {
+/// The simulator parameters of the point (`varied`, `factor`): the defaults for the baseline,
+/// else the defaults with that parameter scaled.
+pub fn params_of(varied: &Varied, factor: f64) -> Result<SimParams, PerturbError> {
     let defaults = SimParams::default();
-    if parameter == BASELINE {
-        return Ok(defaults);
-    }
-    let p = self::parameter(parameter).ok_or_else(|| PerturbError::Unknown {
-        name: parameter.to_string(),
-    })?;
+    let name = match varied {
+        Varied::Baseline => return Ok(defaults),
+        Varied::Parameter(name) => name,
+    };
+    let p = parameter(name).ok_or_else(|| PerturbError::Unknown { name: name.clone() })?;
     perturbed(&defaults, &p, factor)
 }
 
@@ -207,207 +84,54 @@ pub fn plan(scale: evtac_sim::Scale) -> crate::plan::Plan {
 }
 
 /// The study's points in order: the baseline, then every parameter at every factor.
-pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(&'static str, f64)> {
-    let mut out = vec![(BASELINE, 1.0)];
+pub fn points(parameters: &[Parameter], factors: &[f64]) -> Vec<(Varied, f64)> {
+    let mut out = vec![(Varied::Baseline, 1.0)];
     for p in parameters {
-        out.extend(factors.iter().map(|&f| (p.name, f)));
+        out.extend(factors.iter().map(|&f| (Varied::from(p.name), f)));
     }
     out
 }
 
-/// Why a parameter could not be scaled.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum PerturbError {
-    /// No parameter has this name.
-    #[error(
-        "no simulator parameter {name:?} in the sensitivity study; the parameters are {}",
-        names()
-    )]
-    Unknown {
-        /// The name given.
-        name: String,
-    },
-    /// A field is not a number of `simulator.json`.
-    #[error("simulator parameter {field} is not a number in simulator.json")]
-    NotANumber {
-        /// The field, `section.field`.
-        field: String,
-    },
-    /// The scaled parameters are not valid simulator parameters.
-    #[error("simulator parameters with {field} scaled: {message}")]
-    Invalid {
-        /// The field.
-        field: String,
-        /// What serde said.
-        message: String,
-    },
-}
-
 /// `params` with `parameter`'s fields multiplied by `factor`; integers (pin rings, hot pixels)
 /// are rounded to the nearest.
-///
-/// Through `simulator.json`'s own form (serde), so that a field is named once, as a user reads
-/// it in a dataset's `simulator.json`, rather than by a hand-written accessor per field.
 pub fn perturbed(
     params: &SimParams,
     parameter: &Parameter,
     factor: f64,
 ) -> Result<SimParams, PerturbError> {
-    let mut value = serde_json::to_value(params).map_err(|e| PerturbError::Invalid {
-        field: parameter.name.to_string(),
-        message: e.to_string(),
-    })?;
+    let mut out = params.clone();
     for field in parameter.fields {
-        let not_a_number = || PerturbError::NotANumber {
-            field: (*field).to_string(),
-        };
-        let slot = field
-            .split('.')
-            .try_fold(&mut value, |v, key| v.get_mut(key))
-            .ok_or_else(not_a_number)?;
-        *slot = if let Some(n) = slot.as_u64() {
-            serde_json::Value::from((n as f64 * factor).round() as u64)
-        } else {
-            let x = slot.as_f64().ok_or_else(not_a_number)?;
-            serde_json::Value::from(x * factor)
-        };
-    }
-    serde_json::from_value(value).map_err(|e| PerturbError::Invalid {
-        field: parameter.fields.join(", "),
-        message: e.to_string(),
-    })
-}
-
-/// Whether each of the paper's conclusions holds at one point (see the module docs); `None`
-/// where the test trials have fewer than two levels to compare.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Conclusions {
-    /// Static's test MAE is the lowest of the three.
-    pub static_best: bool,
-    /// Combined (OR) is not better than static.
-    pub or_not_better: bool,
-    /// Dynamic's rise at the slowest speed exceeds static's.
-    pub dynamic_worse_slow: Option<bool>,
-    /// Dynamic's rise at the shallowest depth exceeds static's.
-    pub dynamic_worse_shallow: Option<bool>,
-}
-
-impl Conclusions {
-    /// The conclusions' names, in the order of [`Conclusions::each`].
-    pub const NAMES: [&'static str; 4] = [
-        "static best",
-        "OR not better than static",
-        "dynamic worse at the slowest speed",
-        "dynamic worse at the shallowest depth",
-    ];
-
-    /// The four, in [`Conclusions::NAMES`]' order (`None`: not measurable at this point).
-    pub fn each(&self) -> [Option<bool>; 4] {
-        [
-            Some(self.static_best),
-            Some(self.or_not_better),
-            self.dynamic_worse_slow,
-            self.dynamic_worse_shallow,
-        ]
-    }
-}
-
-/// How much a representation's error rises at one extreme level of the test trials: its MAE
-/// there minus its mean over the other levels (both means over seeds).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Rise {
-    /// The extreme level (deg/s or mm).
-    pub level: f64,
-    /// How many levels the test trials have (fewer than 2: nothing to compare, rises 0).
-    pub levels: usize,
-    /// Static's rise, deg.
-    pub static_deg: f64,
-    /// Dynamic's rise, deg.
-    pub dynamic_deg: f64,
-}
-
-/// What tuning chose for one representation at a point.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Tuned {
-    /// Static's decay tau or dynamic's window, ms.
-    pub time_ms: f64,
-    /// The binarization threshold.
-    pub threshold: f64,
-}
-
-impl Tuned {
-    fn of(t: &crate::results::Tuning) -> Tuned {
-        Tuned {
-            time_ms: t.chosen_time_ms,
-            threshold: t.chosen_threshold,
-        }
-    }
-}
-
-/// One point of the study.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Point {
-    /// The parameter (`baseline` for the defaults).
-    pub parameter: String,
-    /// The factor on it (1 for the baseline).
-    pub factor: f64,
-    /// The settings tuning chose, static then dynamic.
-    pub tuned: [Tuned; 2],
-    /// Test MAE statistics over seeds: static, dynamic, combined.
-    pub test: [MaeStats; 3],
-    /// Dynamic minus static test MAE (means over seeds), deg.
-    pub gap_deg: f64,
-    /// The rise at the slowest speed.
-    pub slow: Rise,
-    /// The rise at the shallowest depth.
-    pub shallow: Rise,
-    /// What holds.
-    pub conclusions: Conclusions,
-}
-
-/// The whole study: what `evtac sensitivity` writes as `sensitivity.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Study {
-    /// The scale.
-    pub scale: String,
-    /// The master seed.
-    pub seed: u64,
-    /// The factors.
-    pub factors: Vec<f64>,
-    /// The defaults' point first, then each parameter at each factor.
-    pub points: Vec<Point>,
-}
-
-impl Study {
-    /// The baseline (the defaults), when the study has it.
-    pub fn baseline(&self) -> Option<&Point> {
-        self.points.iter().find(|p| p.parameter == BASELINE)
-    }
-
-    /// For each conclusion, in [`Conclusions::NAMES`]' order, how many of the perturbed points
-    /// (the baseline excluded) it holds at, and at how many it could be decided.
-    pub fn shares(&self) -> [(usize, usize); 4] {
-        let mut out = [(0, 0); 4];
-        for p in self.points.iter().filter(|p| p.parameter != BASELINE) {
-            for (o, holds) in out.iter_mut().zip(p.conclusions.each()) {
-                if let Some(holds) = holds {
-                    o.0 += usize::from(holds);
-                    o.1 += 1;
-                }
+        match crate::parameters::slot(&mut out, field) {
+            Some(Slot::Real(x)) => *x *= factor,
+            Some(Slot::Count(n)) => {
+                let scaled = (f64::from(*n) * factor).round() as u64;
+                *n = u32::try_from(scaled).map_err(|e| PerturbError::Invalid {
+                    field: parameter.fields.join(", "),
+                    message: e.to_string(),
+                })?;
+            }
+            None => {
+                return Err(PerturbError::NotANumber {
+                    field: (*field).to_string(),
+                });
             }
         }
-        out
+    }
+    Ok(out)
+}
+
+/// What tuning chose, as a point keeps it.
+fn tuned(t: &Tuning) -> Tuned {
+    Tuned {
+        time_ms: t.chosen_time_ms,
+        threshold: t.chosen_threshold,
     }
 }
 
-/// The baseline point's name.
-pub const BASELINE: &str = "baseline";
-
 /// The folder of one point under the study's output folder.
-pub fn point_dir(out: &Path, parameter: &str, factor: f64) -> PathBuf {
+pub fn point_dir(out: &Path, varied: &Varied, factor: f64) -> PathBuf {
     out.join("points")
-        .join(parameter)
+        .join(varied.name())
         .join(format!("x{factor}"))
 }
 
@@ -453,7 +177,7 @@ pub const POINT_FILE: &str = "point.json";
 /// scale, of which its models need none), so that a study of 39 points needs the disk of one
 /// dataset at a time.
 pub fn point(
-    (parameter, factor): (&str, f64),
+    (parameter, factor): (&Varied, f64),
     params: &SimParams,
     dir: &Path,
     keep_data: bool,
@@ -470,7 +194,8 @@ pub fn point(
     let json = serde_json::to_string_pretty(&point)
         .map_err(IoError::at(&file))
         .map_err(crate::jobs::Error::from)?;
-    crate::jobs::write_atomic(&file, json.as_bytes())
+    // The point's folder exists: its dataset and models are in it.
+    write_atomic(&file, json.as_bytes())
         .map_err(IoError::at(&file))
         .map_err(crate::jobs::Error::from)?;
     // What made the point stays beside its results, with or without its dataset.
@@ -493,7 +218,7 @@ pub fn point(
 
 /// [`point`]'s measurement, every part of it resuming on its own.
 fn measure(
-    parameter: &str,
+    parameter: &Varied,
     factor: f64,
     params: &SimParams,
     dir: &Path,
@@ -558,9 +283,9 @@ fn measure(
     let mean = |s: &MaeStats| s.overall.mean;
     let [st_mae, dy_mae, co_mae] = [mean(&test[0]), mean(&test[1]), mean(&test[2])];
     Ok(Point {
-        parameter: parameter.to_string(),
+        parameter: parameter.clone(),
         factor,
-        tuned: [Tuned::of(&st), Tuned::of(&dt)],
+        tuned: [tuned(&st), tuned(&dt)],
         test,
         gap_deg: dy_mae - st_mae,
         slow,
@@ -573,6 +298,25 @@ fn measure(
                 .then_some(shallow.dynamic_deg > shallow.static_deg),
         },
     })
+}
+
+/// Runs the point `job` describes (a Slurm task of `evtac sensitivity`, or `--point`), resuming
+/// what is finished, reporting to `progress`: [`point`] with the study's [`plan`] and the
+/// parameters of [`params_of`].
+pub fn run_point(job: &SensitivityPointJob, progress: &dyn Progress) -> Result<(), Error> {
+    evtac_learn::flush_denormals();
+    let plan = plan(job.scale);
+    let params = params_of(&job.parameter, job.factor)?;
+    let models = job.out.join("models");
+    let run = RunContext {
+        plan: &plan,
+        seed: job.seed,
+        models: &models,
+        progress,
+    };
+    let at = (&job.parameter, job.factor);
+    point(at, &params, &job.out, job.keep_data, &run)?;
+    Ok(())
 }
 
 /// The study: the baseline, then every parameter of `parameters` at every factor of `factors`
@@ -590,7 +334,10 @@ pub fn run(
     evtac_learn::flush_denormals();
     let todo = points(parameters, factors)
         .into_iter()
-        .map(|(name, factor)| Ok((name, factor, params_of(name, factor)?)))
+        .map(|(name, factor)| {
+            let params = params_of(&name, factor)?;
+            Ok((name, factor, params))
+        })
         .collect::<Result<Vec<_>, PerturbError>>()?;
     let started = std::time::Instant::now();
     let mut points = Vec::with_capacity(todo.len());
@@ -615,7 +362,7 @@ pub fn run(
         points.push(point((name, *factor), params, &dir, keep_data, run)?);
     }
     Ok(Study {
-        scale: run.plan.scale.name().to_string(),
+        scale: run.plan.scale,
         seed: run.seed,
         factors: factors.to_vec(),
         points,
@@ -660,15 +407,26 @@ mod tests {
         assert_eq!(
             points(&p, &[0.5, 2.0]),
             [
-                (BASELINE, 1.0),
-                ("cutoff", 0.5),
-                ("cutoff", 2.0),
-                ("creep", 0.5),
-                ("creep", 2.0)
+                (Varied::Baseline, 1.0),
+                (Varied::from("cutoff"), 0.5),
+                (Varied::from("cutoff"), 2.0),
+                (Varied::from("creep"), 0.5),
+                (Varied::from("creep"), 2.0)
             ]
         );
-        assert_eq!(params_of(BASELINE, 1.0).unwrap(), SimParams::default());
-        let e = params_of("grip", 2.0).unwrap_err().to_string();
+        assert_eq!(
+            params_of(&Varied::Baseline, 1.0).unwrap(),
+            SimParams::default()
+        );
+        assert_eq!(Varied::from(BASELINE), Varied::Baseline);
+        // Files spell a point's parameter as its name, the baseline's included.
+        assert_eq!(
+            serde_json::to_string(&points(&p, &[0.5])[..2]).unwrap(),
+            r#"[["baseline",1.0],["cutoff",0.5]]"#
+        );
+        let e = params_of(&Varied::from("grip"), 2.0)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("\"grip\"") && e.contains("cutoff"), "{e}");
     }
 
@@ -683,7 +441,7 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), PARAMETERS.len() + 1);
         assert_eq!(
-            point_dir(Path::new("out"), "cutoff", 0.5),
+            point_dir(Path::new("out"), &Varied::from("cutoff"), 0.5),
             Path::new("out/points/cutoff/x0.5")
         );
     }

@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use crate::job::{self, Job, ReproduceJob, SimulateJob};
+use crate::job::{self, Job, ReproduceJob};
 use crate::jobs;
 use crate::pipeline::{self, Datasets};
 use crate::plan::Plan;
@@ -234,15 +234,10 @@ fn simulation_jobs(reproduction: &ReproduceJob) -> Vec<Job> {
     if reproduction.data.is_some() {
         return Vec::new();
     }
+    let simulation = reproduction.simulation();
     PROTOCOLS
         .iter()
-        .map(|&protocol| SimulateJob {
-            protocol,
-            scale: reproduction.scale,
-            seed: reproduction.seed,
-            out: sim_dir(reproduction).join(protocol.name()),
-            repeats: reproduction.repeats,
-        })
+        .map(|&protocol| simulation.job(protocol, &sim_dir(reproduction)))
         .filter(|j| !jobs::is_done(&j.out))
         .map(Job::Simulate)
         .collect()

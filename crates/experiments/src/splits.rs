@@ -9,6 +9,7 @@
 
 use evtac_events::IoError;
 use evtac_events::layout::SPLITS_FILE;
+use evtac_events::output::write_atomic;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -279,7 +280,8 @@ impl Splits {
             path: path.clone(),
             source,
         })?;
-        crate::jobs::write_atomic(&path, text.as_bytes()).map_err(IoError::at(&path))?;
+        // The dataset's folder exists: the dataset was opened from it.
+        write_atomic(&path, text.as_bytes()).map_err(IoError::at(&path))?;
         Ok(())
     }
 

@@ -5,12 +5,71 @@
 //! The costs are reference figures from the 2-core development machine: they only weigh the
 //! stages against each other, so the ETA follows the actual machine's pace.
 
+use crate::job::Simulation;
 use crate::plan::{Kind, Plan};
 use crate::splits::Stratum;
 use evtac_events::manifest::Manifest;
 use evtac_repr::ReprKind;
-use evtac_sim::{DatasetConfig, Protocol, Scale};
+use evtac_sim::Protocol;
 use std::path::Path;
+
+/// A timed stage of a reproduction: a row of `stage-times.csv` and of the report's table of
+/// stage times. Its own type beside [`Stage`] (the progress bars' finer stages), so that the
+/// pipeline, the command that simulates and writes the report, and the log name a stage the
+/// same way; the files keep its [`Timed::name`], and read back whatever names they hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Timed {
+    /// Simulating the datasets.
+    Simulation,
+    /// Tuning static.
+    TuningStatic,
+    /// Tuning dynamic.
+    TuningDynamic,
+    /// Experiment 1.
+    Exp1,
+    /// Experiment 1 at other background noise.
+    Exp1OtherNoise,
+    /// Experiment 1 on datasets simulated with other seeds.
+    Exp1OtherDatasets,
+    /// Experiment 1 with each condition's repeats kept on one side of the split.
+    RepeatsTogether,
+    /// Experiment 1 trained on noisy labels.
+    LabelNoise,
+    /// Experiment 2.
+    Exp2,
+    /// Experiment 3.
+    Exp3,
+    /// The latency study.
+    Latency,
+    /// Writing the report.
+    Report,
+}
+
+impl Timed {
+    /// The stage's name, as `stage-times.csv` and the report write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Timed::Simulation => "simulation",
+            Timed::TuningStatic => "tuning (static)",
+            Timed::TuningDynamic => "tuning (dynamic)",
+            Timed::Exp1 => "experiment 1",
+            Timed::Exp1OtherNoise => "experiment 1 at other noise",
+            Timed::Exp1OtherDatasets => "experiment 1 on other datasets",
+            Timed::RepeatsTogether => "repeats kept together",
+            Timed::LabelNoise => "label-noise ablation",
+            Timed::Exp2 => "experiment 2",
+            Timed::Exp3 => "experiment 3",
+            Timed::Latency => "latency",
+            Timed::Report => "report",
+        }
+    }
+}
+
+impl std::fmt::Display for Timed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// The simulated protocols of a reproduction, in the order they are simulated.
 pub const PROTOCOLS: [Protocol; 4] = [
@@ -151,15 +210,15 @@ impl TrialCounts {
 
     /// The counts of the datasets [`crate::pipeline::simulate_all`] writes into `dir` (the
     /// simulation plans; datasets already simulated there count as done).
-    pub fn of_simulation(dir: &Path, (scale, repeats): (Scale, Option<usize>), seed: u64) -> Self {
-        let exp1_repeated = repeats.unwrap_or(scale.design().repeats) >= 2;
+    pub fn of_simulation(dir: &Path, simulation: &Simulation) -> Self {
+        let exp1_repeated = simulation
+            .repeats
+            .unwrap_or(simulation.scale.design().repeats)
+            >= 2;
         let counts = Self::count(|protocol| {
-            let config = DatasetConfig {
-                repeats,
-                ..DatasetConfig::new(protocol, scale, seed)
-            };
-            let n = config.trials().len();
-            let done = crate::jobs::is_done(&dir.join(protocol.name()));
+            let job = simulation.job(protocol, dir);
+            let n = job.trials();
+            let done = crate::jobs::is_done(&job.out);
             (n, if done { 0 } else { n })
         });
         Self {
@@ -229,7 +288,7 @@ impl CostModel {
     /// Expected seconds of the whole reproduction: every stage it will report.
     ///
     /// The latency stage's end-to-end replay runs on the wall clock, as long as the events it
-    /// replays (`crate::paced_latency::extent`).
+    /// replays (`crate::paced_extent::extent`).
     pub fn total_seconds(&self) -> f64 {
         let (plan, counts) = (&self.plan, &self.counts);
         let reprs = plan.representations();
@@ -286,15 +345,15 @@ impl CostModel {
 /// Wall time of the latency stage's replay at recorded pace (`crate::paced_latency`): it runs
 /// as long as the events it replays, whatever the machine.
 fn paced_replay_seconds(plan: &Plan, reprs: usize) -> f64 {
-    let extent = crate::paced_latency::extent(plan.scale);
-    let cells =
-        reprs * crate::paced_latency::INTERVALS_MS.len() * crate::paced_latency::Load::ALL.len();
+    let extent = crate::paced_extent::extent(plan.scale);
+    let cells = reprs * crate::paced_extent::INTERVALS_MS.len() * crate::results::Load::ALL.len();
     cells as f64 * extent.trials as f64 * extent.motion_ms as f64 / 1000.0
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use evtac_sim::Scale;
 
     #[test]
     fn stage_names_read_as_the_bars_show_them() {

@@ -8,6 +8,7 @@
 //! each of its stages finishes, so an interrupted invocation keeps what it finished too.
 
 pub use crate::results::StageRecord;
+use crate::stage::Timed;
 use evtac_events::IoError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -73,7 +74,7 @@ impl StageLog {
     }
 
     /// Appends this invocation's finished `stage` and its `seconds` to the file.
-    pub fn record(&self, stage: &str, seconds: f64) -> Result<(), Error> {
+    pub fn record(&self, stage: Timed, seconds: f64) -> Result<(), Error> {
         let at = IoError::at(&self.path);
         if let Some(dir) = self.path.parent() {
             std::fs::create_dir_all(dir).map_err(IoError::at(dir))?;
@@ -91,7 +92,7 @@ impl StageLog {
         }
         // A comma in a stage name would split its row: written as a semicolon instead of
         // quoting (evtac's stage names have none).
-        let stage = stage.replace(',', ";");
+        let stage = stage.name().replace(',', ";");
         text.push_str(&format!("{},{stage},{seconds:.3}\n", self.invocation));
         file.write_all(text.as_bytes()).map_err(&at)?;
         let record = StageRecord {
@@ -165,12 +166,12 @@ mod tests {
             !dir.path().join(FILE).exists(),
             "nothing written before a stage ends"
         );
-        first.record("simulation", 12.5).unwrap();
-        first.record("tuning (static)", 100.25).unwrap();
+        first.record(Timed::Simulation, 12.5).unwrap();
+        first.record(Timed::TuningStatic, 100.25).unwrap();
         // Interrupted here; the next invocation resumes.
         let second = StageLog::open(dir.path()).unwrap();
         assert_eq!(second.invocation(), 2);
-        second.record("tuning (static)", 0.5).unwrap();
+        second.record(Timed::TuningStatic, 0.5).unwrap();
         let rows: Vec<(u32, String, f64)> = second
             .records()
             .into_iter()

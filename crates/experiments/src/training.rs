@@ -3,15 +3,17 @@
 //! `done` marker. `evtac train` and `evtac reproduce` both run exactly this.
 
 use crate::cache::{self, FeatureCache, LoadedSet};
-use crate::dataset;
+use crate::dataset::{self, Dataset};
+use crate::job::TrainJob;
 use crate::results::Mae;
 use crate::sampling::{Phase, Sampling};
 use crate::splits::{Split, Splits};
 use evtac_learn::bundle::SampleCounts;
 use evtac_learn::{EpochRecord, Model, ModelBundle, Representation, TrainConfig};
 use evtac_repr::ReprConfig;
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+pub use crate::job::TrainSpec;
 
 /// Errors of a training or evaluation job.
 #[derive(Debug, thiserror::Error)]
@@ -55,30 +57,6 @@ pub enum Error {
         /// The phases asked for.
         phases: Vec<Phase>,
     },
-}
-
-/// One training job.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainSpec {
-    /// The representation.
-    pub repr: ReprConfig,
-    /// Seed of the initial weights and the shuffling.
-    pub seed: u64,
-    /// Epochs.
-    pub epochs: usize,
-    /// Sampling scheme of the dataset.
-    pub sampling: Sampling,
-    /// Phases of the samples to train and validate on.
-    pub phases: Vec<Phase>,
-    /// Standard deviation (degrees) of Gaussian noise added to every training label, pitch and
-    /// roll alike, before training (the label-noise ablation); 0, the default, adds none.
-    /// Validation and test labels are never changed.
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub label_noise_deg: f64,
-}
-
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
 }
 
 /// Seeds the label noise apart from the weights and the shuffling, which the same `seed`
@@ -177,6 +155,28 @@ pub fn train_job(
     bundle.save(out)?;
     crate::jobs::mark_done(out)?;
     Ok(val_mae)
+}
+
+/// Runs `job` on its own (`evtac train`, or a task of a jobs file): opens the dataset, makes its
+/// splits when missing and the features the job needs (`on_trial(reused)` after each trial),
+/// then trains (`on_epoch` after each epoch). Returns the best validation MAE. The local
+/// pipeline, which runs many jobs over one opened dataset, calls [`train_job`] instead.
+pub fn run_job(
+    job: &TrainJob,
+    on_trial: &(dyn Fn(bool) + Sync),
+    on_epoch: impl FnMut(&EpochRecord),
+) -> Result<Mae, Error> {
+    let ds = Dataset::open(&job.dataset, job.inputs)?;
+    let splits = ds.splits(job.splits_seed)?;
+    let cache = FeatureCache::new(&ds)?;
+    let trials: Vec<_> = ds.manifest.trials.iter().collect();
+    cache.ensure(
+        &trials,
+        std::slice::from_ref(&job.spec.repr),
+        job.spec.sampling,
+        on_trial,
+    )?;
+    train_job(&cache, &splits, &job.spec, &job.out, on_epoch)
 }
 
 /// Loads the model bundle a training job wrote into `dir`.

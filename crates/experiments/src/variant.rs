@@ -13,6 +13,7 @@ use crate::exp1;
 use crate::jobs;
 use crate::progress::Progress;
 use crate::results::Exp1Repr;
+use crate::simulation;
 use crate::stage::{FeatureSet, Stage};
 use evtac_import::inputs::Inputs;
 use evtac_repr::ReprConfig;
@@ -66,13 +67,5 @@ pub(crate) fn simulate(
         return Ok(());
     }
     progress.stage(stage, config.trials().len() as u64);
-    evtac_sim::simulate_dataset(config, dir, |_| progress.advance(1)).map_err(|source| {
-        Error::Simulation {
-            protocol: config.protocol,
-            dir: dir.to_path_buf(),
-            source: Box::new(source),
-        }
-    })?;
-    jobs::mark_done(dir)?;
-    Ok(())
+    simulation::into(config, dir, || progress.advance(1))
 }

@@ -21,7 +21,7 @@ fn the_committed_example_results_read_as_typed_data() {
     let tuned: Vec<ReprKind> = r.tuning.iter().map(|t| t.repr).collect();
     assert_eq!(tuned, [ReprKind::Static, ReprKind::Dynamic]);
     assert_eq!(r.tuning[0].chosen_config, r.exp1[0].config);
-    assert_eq!(r.run.plan.scale.name(), r.run.scale);
+    assert_eq!(r.run.plan.scale, r.run.scale);
     assert!(r.run.plan.seeds > 0 && !r.run.plan.static_taus_ms.is_empty());
 
     let again: Results =

@@ -66,6 +66,6 @@ fn resumed_run_redoes_only_the_unfinished_job() {
     else {
         panic!("one train job");
     };
-    read.run(&|_| {}, |_| {}).unwrap();
+    evtac_experiments::training::run_job(read, &|_| {}, |_| {}).unwrap();
     assert_eq!(weights(&alone), before[0]);
 }

@@ -4,7 +4,7 @@
 use crate::plots;
 use evtac_events::IoError;
 use evtac_experiments::results::{
-    Exp2Setting, Exp3Point, MaeStats, NoisePoint, Results, RunInfo, SensorKind,
+    Exp2Setting, Exp3Point, MaeStats, NoisePoint, Results, RunInfo, Scale, SensorKind,
 };
 use evtac_repr::ReprKind;
 use std::fmt::Write as _;
@@ -449,7 +449,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         plan.latency_trials,
         json(&plan.latency_intervals_ms),
     );
-    if r.run.scale != "paper" {
+    if r.run.scale != Scale::Paper {
         let _ = writeln!(
             md,
             "The paper trains 100 epochs and repeats ten seeds; this scale uses fewer (above) to \

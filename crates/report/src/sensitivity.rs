@@ -7,7 +7,7 @@ use crate::plots;
 use evtac_events::IoError;
 use evtac_events::output::write_atomic;
 use evtac_experiments::results::MaeStats;
-use evtac_experiments::sensitivity::{BASELINE, Conclusions, PARAMETERS, Point, Study};
+use evtac_experiments::sensitivity::{Conclusions, PARAMETERS, Point, Study, Varied};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -54,7 +54,7 @@ pub fn markdown(study: &Study) -> String {
     let perturbed = study
         .points
         .iter()
-        .filter(|p| p.parameter != BASELINE)
+        .filter(|p| p.parameter != Varied::Baseline)
         .count();
     let _ = writeln!(
         md,
@@ -100,7 +100,7 @@ pub fn markdown(study: &Study) -> String {
     let flips: Vec<String> = study
         .points
         .iter()
-        .filter(|p| p.parameter != BASELINE)
+        .filter(|p| p.parameter != Varied::Baseline)
         .filter_map(|p| {
             let lost: Vec<&str> = Conclusions::NAMES
                 .iter()

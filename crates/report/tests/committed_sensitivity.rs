@@ -4,7 +4,7 @@
 //! and `docs/simulator.md` quotes its shares and its gap's range, so the prose never outlives the
 //! run it describes.
 
-use evtac_experiments::sensitivity::{BASELINE, PARAMETERS, Study};
+use evtac_experiments::sensitivity::{PARAMETERS, Study, Varied};
 use std::path::{Path, PathBuf};
 
 fn docs() -> PathBuf {
@@ -38,7 +38,7 @@ fn the_committed_study_varies_every_parameter_the_code_does_at_each_factor() {
                 study
                     .points
                     .iter()
-                    .any(|p| p.parameter == parameter && p.factor == factor),
+                    .any(|p| p.parameter.name() == parameter && p.factor == factor),
                 "docs/sensitivity has no point {parameter} x{factor}: run the study again"
             );
         }
@@ -46,7 +46,7 @@ fn the_committed_study_varies_every_parameter_the_code_does_at_each_factor() {
     let perturbed = study
         .points
         .iter()
-        .filter(|p| p.parameter != BASELINE)
+        .filter(|p| p.parameter != Varied::Baseline)
         .count();
     assert_eq!(perturbed, PARAMETERS.len() * study.factors.len());
 }

@@ -85,14 +85,16 @@ fn run_job(job: &Job) -> anyhow::Result<()> {
     let pool = crate::workers::Workers { jobs: Some(1) }.pool()?;
     pool.install(|| {
         match job {
-            Job::Simulate(j) => j.run(|| {})?,
+            Job::Simulate(j) => evtac_experiments::simulation::run(j, || {})?,
             Job::Train(j) => {
                 if !evtac_experiments::jobs::is_done(&j.out) {
-                    j.run(&|_| {}, |_| {})?;
+                    evtac_experiments::training::run_job(j, &|_| {}, |_| {})?;
                 }
             }
-            Job::Reproduce(j) => super::reproduce::run(super::reproduce::Args::for_job(j))?,
-            Job::SensitivityPoint(j) => j.run(&evtac_experiments::progress::Quiet)?,
+            Job::Reproduce(j) => super::reproduce::run_job(j)?,
+            Job::SensitivityPoint(j) => {
+                evtac_experiments::sensitivity::run_point(j, &evtac_experiments::progress::Quiet)?
+            }
         }
         Ok(())
     })

@@ -39,8 +39,13 @@ pub struct Args {
     pub identity_calibration: bool,
 }
 
+/// `--scale`: a scale method by its name in label configs (`total-rotation`, ...).
 fn parse_scale(s: &str) -> Result<ScaleMethod, String> {
-    serde_json::from_value(serde_json::Value::String(s.to_owned())).map_err(|_| {
+    use serde::Deserialize;
+    use serde::de::IntoDeserializer;
+    let name: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
+        s.into_deserializer();
+    ScaleMethod::deserialize(name).map_err(|_| {
         format!("unknown scale method `{s}`: use total-rotation, commanded-speed or none")
     })
 }

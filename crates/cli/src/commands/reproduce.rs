@@ -10,10 +10,10 @@ use evtac_experiments::job::{self, ReproduceJob};
 use evtac_experiments::pipeline::{self, Datasets};
 use evtac_experiments::plan::{Grid, Plan};
 use evtac_experiments::progress::Progress;
-use evtac_experiments::stage::{CostModel, Stage, TrialCounts};
+use evtac_experiments::stage::{CostModel, Stage, Timed, TrialCounts};
 use evtac_experiments::stage_log::StageLog;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -123,31 +123,23 @@ impl Args {
             .map(|levels| levels.iter().filter_map(|l| l.0).collect())
     }
 
-    /// The arguments that run `job` on this machine with one worker thread (the last task of a
-    /// Slurm reproduction, whose task has one CPU).
-    pub fn for_job(job: &ReproduceJob) -> Args {
-        Args {
-            scale_seed: crate::scale_seed::ScaleSeed {
-                scale: job.scale,
-                seed: job.seed,
-            },
-            data: job.data.clone(),
-            inputs: crate::inputs::InputArgs::of(job.inputs),
-            out: job.out.clone(),
-            label_noise_deg: job.label_noise_deg,
-            datasets: job.datasets.map(|n| n as u64),
-            repeats: job.repeats,
-            no_repeat_split: !job.repeat_split,
-            grid: job.grid,
-            no_recheck: !job.recheck,
-            noise_levels: job
-                .noise_levels
-                .as_ref()
-                .map(|levels| levels.iter().map(|&l| NoiseLevel(Some(l))).collect()),
-            no_fusions: !job.fusions,
-            workers: crate::workers::Workers { jobs: Some(1) },
-            export_jobs: None,
-            executor: crate::cluster::ExecutorArgs::local(),
+    /// The reproduction these arguments ask for, as the job that stands for it (its paths as
+    /// given).
+    pub(crate) fn job(&self) -> ReproduceJob {
+        ReproduceJob {
+            scale: self.scale_seed.scale,
+            seed: self.scale_seed.seed,
+            out: self.out.clone(),
+            data: self.data.clone(),
+            inputs: self.inputs.inputs(),
+            noise_levels: self.noise_levels(),
+            fusions: !self.no_fusions,
+            label_noise_deg: self.label_noise_deg,
+            datasets: self.datasets.map(|n| n as usize),
+            repeats: self.repeats,
+            repeat_split: !self.no_repeat_split,
+            grid: self.grid,
+            recheck: !self.no_recheck,
         }
     }
 }
@@ -334,23 +326,13 @@ impl Progress for Overall<'_> {
 }
 
 /// Runs `evtac reproduce` on Slurm: submits, follows, and returns when the report is written.
-fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
+fn run_on_slurm(args: &Args, job: &ReproduceJob, plan: &Plan) -> anyhow::Result<()> {
     let started = Instant::now();
     let absolute = |p: &PathBuf| std::path::absolute(p).with_context(|| p.display().to_string());
     let run = ReproduceJob {
-        scale: args.scale_seed.scale,
-        seed: args.scale_seed.seed,
-        out: absolute(&args.out)?,
-        data: args.data.as_ref().map(absolute).transpose()?,
-        inputs: args.inputs.inputs(),
-        noise_levels: args.noise_levels(),
-        fusions: !args.no_fusions,
-        label_noise_deg: args.label_noise_deg,
-        datasets: args.datasets.map(|n| n as usize),
-        repeats: args.repeats,
-        repeat_split: !args.no_repeat_split,
-        grid: args.grid,
-        recheck: !args.no_recheck,
+        out: absolute(&job.out)?,
+        data: job.data.as_ref().map(absolute).transpose()?,
+        ..job.clone()
     };
     let (slurm, task) = (args.executor.slurm(), crate::cluster::task()?);
     let bars = Bars::default();
@@ -369,78 +351,61 @@ fn run_on_slurm(args: &Args, plan: &Plan) -> anyhow::Result<()> {
 /// Runs `evtac reproduce`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let mut plan = Plan::for_scale(args.scale_seed.scale);
-    if let Some(levels) = &args.noise_levels() {
-        if let Some(bad) = levels.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
-            anyhow::bail!("--noise-levels: {bad} is not a factor (finite and at least 0)");
-        }
-        plan.noise_levels = levels.clone();
-    }
-    plan.fusions = !args.no_fusions;
-    plan.repeat_split = !args.no_repeat_split;
-    if let Some(grid) = args.grid {
-        plan = plan.with_grid(grid);
-    }
-    if args.no_recheck {
-        (plan.recheck_top, plan.recheck_seeds) = (0, 0);
-    }
-    if let Some(sd) = args.label_noise_deg {
-        anyhow::ensure!(
-            sd.is_finite() && sd >= 0.0,
-            "--label-noise-deg {sd}: give a standard deviation in degrees, 0 (no ablation) or more"
-        );
-        plan.label_noise_deg = (sd > 0.0).then_some(sd);
-    }
-    if let Some(n) = args.datasets {
-        plan.datasets = n as usize;
-    }
-    anyhow::ensure!(
-        args.repeats.is_none() || args.data.is_none(),
-        "--repeats sets how the datasets are simulated; the --data datasets are already made \
-         (simulate them with `evtac simulate --repeats N`)"
-    );
+    let job = args.job();
+    let plan = job.plan()?;
     if args.executor.on_slurm()? {
         anyhow::ensure!(
             args.export_jobs.is_none(),
             "--export-jobs lists the jobs for a scheduler of your own; --executor slurm submits them itself: use one or the other"
         );
-        return run_on_slurm(&args, &plan);
+        return run_on_slurm(&args, &job, &plan);
     }
     let pool = args.workers.pool()?;
+    run_here(&job, &plan, args.export_jobs.as_deref(), &pool, started)
+}
+
+/// Runs the reproduction `job` on this machine with one worker thread: the last task of a Slurm
+/// reproduction (`evtac jobs run`), whose task has one CPU.
+pub fn run_job(job: &ReproduceJob) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let plan = job.plan()?;
+    let pool = crate::workers::Workers { jobs: Some(1) }.pool()?;
+    run_here(job, &plan, None, &pool, started)
+}
+
+/// Runs `job` with `plan` on `pool`'s threads (or, with `export_jobs`, writes its ready training
+/// jobs to that file and stops): simulation when no datasets are given, the experiments, the
+/// report. `started` is when the command started, for the times it reports.
+fn run_here(
+    job: &ReproduceJob,
+    plan: &Plan,
+    export_jobs: Option<&Path>,
+    pool: &rayon::ThreadPool,
+    started: Instant,
+) -> anyhow::Result<()> {
     let bars = Bars::default();
-    let sim_dir = args.out.join("data");
-    let counts = match &args.data {
+    let sim_dir = job.out.join("data");
+    let counts = match &job.data {
         Some(data) => TrialCounts::of_datasets(data),
-        None => TrialCounts::of_simulation(
-            &sim_dir,
-            (args.scale_seed.scale, args.repeats),
-            args.scale_seed.seed,
-        ),
+        None => TrialCounts::of_simulation(&sim_dir, &job.simulation()),
     };
-    let bars = Overall::new(&bars, CostModel::new(&plan, counts));
+    let bars = Overall::new(&bars, CostModel::new(plan, counts));
     // Every invocation's stage times go to OUT/stage-times.csv: a resumed run's report
     // states what the whole reproduction took.
-    let log = StageLog::open(&args.out)?;
-    let data_dir = match &args.data {
+    let log = StageLog::open(&job.out)?;
+    let data_dir = match &job.data {
         Some(d) => d.clone(),
         None => {
             let d = sim_dir;
-            pool.install(|| {
-                pipeline::simulate_all(
-                    &d,
-                    (args.scale_seed.scale, args.repeats),
-                    args.scale_seed.seed,
-                    &bars,
-                )
-            })?;
+            pool.install(|| pipeline::simulate_all(&d, &job.simulation(), &bars))?;
             let seconds = started.elapsed().as_secs_f64();
             bars.message(&format!("simulated datasets ready in {seconds:.1} s"));
-            log.record("simulation", seconds)?;
+            log.record(Timed::Simulation, seconds)?;
             d
         }
     };
     let data = Datasets {
-        inputs: args.inputs.inputs(),
+        inputs: job.inputs,
         ..Datasets::in_dir(&data_dir)
     };
     anyhow::ensure!(
@@ -450,8 +415,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "{} has no Experiment 1 dataset (exp1/trials.csv)",
         data_dir.display()
     );
-    if let Some(file) = &args.export_jobs {
-        let jobs = pipeline::export_jobs(&data, &plan, args.scale_seed.seed, &args.out)?;
+    if let Some(file) = export_jobs {
+        let jobs = pipeline::export_jobs(&data, plan, job.seed, &job.out)?;
         crate::outputs::write_text(file, &job::to_text(&jobs))?;
         bars.finish();
         let f = file.display();
@@ -463,18 +428,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let results = pool.install(|| {
-        pipeline::reproduce(&data, &plan, args.scale_seed.seed, &args.out, &log, &bars)
-    })?;
+    let results =
+        pool.install(|| pipeline::reproduce(&data, plan, job.seed, &job.out, &log, &bars))?;
     // The report is the last stage, timed like the others (its own time is in the log, not in
     // the report it writes).
     let report_started = Instant::now();
-    evtac_report::write(&args.out, &results)?;
+    evtac_report::write(&job.out, &results)?;
     let seconds = report_started.elapsed().as_secs_f64();
     bars.message(&format!("report: {seconds:.1} s"));
-    log.record("report", seconds)?;
+    log.record(Timed::Report, seconds)?;
     bars.finish();
-    println!("{}", args.out.join("report.md").display());
+    println!("{}", job.out.join("report.md").display());
     for e in &results.exp1 {
         println!(
             "{:<9} test MAE {} deg (pitch {}, roll {})",
@@ -486,7 +450,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     eprintln!(
         "reproduced at scale {} in {:.1} s",
-        args.scale_seed.scale,
+        job.scale,
         started.elapsed().as_secs_f64()
     );
     Ok(())

@@ -11,7 +11,7 @@ use crate::progress::Bars;
 use anyhow::Context;
 use evtac_experiments::context::RunContext;
 use evtac_experiments::job::{Job, SensitivityPointJob};
-use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter};
+use evtac_experiments::sensitivity::{self, FACTORS, PARAMETERS, Parameter, Varied};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -63,14 +63,14 @@ fn one_point(args: &Args, spec: &str) -> anyhow::Result<()> {
     let job = SensitivityPointJob {
         scale: args.scale_seed.scale,
         seed: args.scale_seed.seed,
-        parameter: name.to_string(),
+        parameter: Varied::from(name),
         factor,
         out: args.out.clone(),
         keep_data: args.keep_data,
     };
     let pool = args.workers.pool()?;
     let bars = Bars::default();
-    pool.install(|| job.run(&bars))?;
+    pool.install(|| sensitivity::run_point(&job, &bars))?;
     bars.finish();
     eprintln!("point {name} x{factor} finished in {}", args.out.display());
     Ok(())
@@ -85,9 +85,9 @@ fn points_on_slurm(args: &Args, parameters: &[Parameter]) -> anyhow::Result<()> 
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: args.scale_seed.scale,
                 seed: args.scale_seed.seed,
-                parameter: name.to_string(),
+                out: sensitivity::point_dir(&out, &name, factor),
+                parameter: name,
                 factor,
-                out: sensitivity::point_dir(&out, name, factor),
                 keep_data: args.keep_data,
             })
         })

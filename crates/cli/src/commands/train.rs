@@ -162,16 +162,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bar.set_style(style);
     }
     let started = std::time::Instant::now();
-    let val = job
-        .run(&|_| fbar.inc(1), |r| {
-            fbar.finish_and_clear();
-            bar.set_message(format!(
-                "loss {:.4} val MAE {:.3} deg",
-                r.train_loss, r.val_mae
-            ));
-            bar.inc(1);
-        })
-        .with_context(|| format!("training into {}", args.out.display()))?;
+    let val = evtac_experiments::training::run_job(&job, &|_| fbar.inc(1), |r| {
+        fbar.finish_and_clear();
+        bar.set_message(format!(
+            "loss {:.4} val MAE {:.3} deg",
+            r.train_loss, r.val_mae
+        ));
+        bar.inc(1);
+    })
+    .with_context(|| format!("training into {}", args.out.display()))?;
     bar.finish_and_clear();
     if !args.quiet {
         eprintln!(

@@ -4,7 +4,7 @@
 //! axis title: a legend box would cover bars wherever it sat.
 
 use super::*;
-use evtac_experiments::sensitivity::{BASELINE, Study};
+use evtac_experiments::sensitivity::{Study, Varied};
 
 /// The factor below 1 is drawn in this colour, the one above in the other.
 const LOW: RGBColor = RGBColor(31, 119, 180);
@@ -20,11 +20,15 @@ struct Row<'a> {
 /// farthest last).
 fn rows(study: &Study, base: f64) -> Vec<Row<'_>> {
     let mut rows: Vec<Row<'_>> = Vec::new();
-    for p in study.points.iter().filter(|p| p.parameter != BASELINE) {
-        match rows.iter_mut().find(|r| r.name == p.parameter) {
+    for p in study
+        .points
+        .iter()
+        .filter(|p| p.parameter != Varied::Baseline)
+    {
+        match rows.iter_mut().find(|r| r.name == p.parameter.name()) {
             Some(r) => r.gaps.push((p.factor, p.gap_deg)),
             None => rows.push(Row {
-                name: &p.parameter,
+                name: p.parameter.name(),
                 gaps: vec![(p.factor, p.gap_deg)],
             }),
         }
