@@ -26,7 +26,7 @@
 
 pub mod aedat;
 pub mod aedat_legacy;
-mod columns;
+pub mod columns;
 pub mod csv;
 mod error;
 pub mod evt;

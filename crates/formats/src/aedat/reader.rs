@@ -276,7 +276,7 @@ impl<R: Read> AedatReader<R> {
     }
 
     /// From now on, decodes only the streams `chosen` names, one of each kind (see
-    /// [`StreamSelection::resolve`](super::StreamSelection::resolve)): packets of the others are
+    /// [`StreamSelection::resolve`](crate::StreamSelection::resolve)): packets of the others are
     /// read past like frames. Without it, every event, IMU and trigger stream is decoded and
     /// their elements are handed out as they come, whatever stream they belong to
     /// ([`AedatChunk::stream_id`] tells).
