@@ -35,11 +35,6 @@ impl<R: Rule> Counted<R> {
     pub fn new(rule: R) -> Self {
         Self { rule, removed: 0 }
     }
-
-    /// The rule.
-    pub fn rule(&self) -> &R {
-        &self.rule
-    }
 }
 
 impl<R: Rule> Filter for Counted<R> {

@@ -33,6 +33,14 @@ pub struct Chunk<'a> {
 }
 
 impl<'a> Chunk<'a> {
+    /// A chunk of events only (the formats that hold no IMU samples or triggers).
+    pub(crate) fn of_events(events: &'a [Event]) -> Self {
+        Self {
+            events,
+            ..Self::default()
+        }
+    }
+
     /// The part of the chunk with `from <= t < to`.
     fn within(self, from: i64, to: i64) -> Self {
         Self {

@@ -90,10 +90,7 @@ impl Decode for CsvReader<BufReader<File>> {
     type Error = CsvError;
 
     fn decode(&mut self) -> Result<Option<Chunk<'_>>, CsvError> {
-        Ok(self.next_chunk()?.map(|events| Chunk {
-            events,
-            ..Chunk::default()
-        }))
+        Ok(self.next_chunk()?.map(Chunk::of_events))
     }
 
     fn sensor(&self) -> Option<Resolution> {

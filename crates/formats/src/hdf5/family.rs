@@ -75,10 +75,7 @@ struct Reader {
 impl FormatReader for Reader {
     fn next_chunk(&mut self) -> Result<Option<Chunk<'_>>, Error> {
         let chunk = self.inner.next_chunk().map_err(hdf5_error(&self.path))?;
-        Ok(chunk.map(|events| Chunk {
-            events,
-            ..Chunk::default()
-        }))
+        Ok(chunk.map(Chunk::of_events))
     }
 
     fn resolution(&self) -> Option<Resolution> {

@@ -107,10 +107,7 @@ impl Decode for NpyReader<File> {
     type Error = NpyError;
 
     fn decode(&mut self) -> Result<Option<Chunk<'_>>, NpyError> {
-        Ok(self.next_chunk()?.map(|events| Chunk {
-            events,
-            ..Chunk::default()
-        }))
+        Ok(self.next_chunk()?.map(Chunk::of_events))
     }
 
     fn sensor(&self) -> Option<Resolution> {
@@ -148,10 +145,7 @@ impl FormatReader for NpzSource {
                 error: Box::new(error),
             },
         })?;
-        Ok(chunk.map(|events| Chunk {
-            events,
-            ..Chunk::default()
-        }))
+        Ok(chunk.map(Chunk::of_events))
     }
 
     fn resolution(&self) -> Option<Resolution> {
