@@ -8,6 +8,11 @@
 //! earlier file of that name as it was; the temporary file is deleted when the `OutputFile` is
 //! dropped uncommitted.
 //!
+//! A path that already names something other than a regular file or folder (`/dev/null`,
+//! `/dev/stdout`, a named pipe) is written straight through: there is nothing to keep whole, and
+//! renaming a file over it would replace the device with a regular file (run as root, every
+//! later reader of `/dev/null` would read what the last command wrote there).
+//!
 //! [`refuse_input`] is the other half: a command checks, before it opens anything for writing,
 //! that none of its outputs is one of its inputs, by the same path or through a link (symbolic
 //! or hard), because writing the output would destroy the recording it is reading.
@@ -26,6 +31,7 @@
 //! # Ok::<(), std::io::Error>(())
 //! ```
 
+use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -33,8 +39,23 @@ use std::path::{Path, PathBuf};
 /// [`commit`](Self::commit) and deleted if dropped before.
 #[derive(Debug)]
 pub struct OutputFile {
-    temp: tempfile::NamedTempFile,
+    target: Target,
     path: PathBuf,
+}
+
+/// Where the bytes go until [`OutputFile::commit`].
+#[derive(Debug)]
+enum Target {
+    /// A temporary file beside the final name, renamed over it on commit.
+    Temp(tempfile::NamedTempFile),
+    /// The final name itself, which is a device or a pipe (see the module's docs).
+    Special(File),
+}
+
+/// Whether `path` exists and is neither a regular file nor a folder (a device, a pipe, a
+/// socket), following symbolic links as opening it would.
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|meta| !meta.is_file() && !meta.is_dir())
 }
 
 impl OutputFile {
@@ -43,6 +64,13 @@ impl OutputFile {
     /// by it). The folder must exist.
     pub fn create(path: impl AsRef<Path>) -> io::Result<Self> {
         let path = path.as_ref().to_path_buf();
+        if is_special(&path) {
+            let file = File::options().write(true).open(&path)?;
+            return Ok(Self {
+                target: Target::Special(file),
+                path,
+            });
+        }
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
@@ -65,18 +93,36 @@ impl OutputFile {
                 format!("creating a temporary file in {}: {e}", dir.display()),
             )
         })?;
-        Ok(Self { temp, path })
+        Ok(Self {
+            target: Target::Temp(temp),
+            path,
+        })
     }
 
-    /// Where the bytes are until [`commit`](Self::commit) (for writers that take a path).
+    /// Where the bytes are until [`commit`](Self::commit) (for writers that take a path): the
+    /// final path itself when that is a device or a pipe.
     pub fn temp_path(&self) -> &Path {
-        self.temp.path()
+        match &self.target {
+            Target::Temp(temp) => temp.path(),
+            Target::Special(_) => &self.path,
+        }
     }
 
     /// Flushes the file and renames it to its final name, replacing any file there.
     pub fn commit(mut self) -> io::Result<()> {
-        self.temp.flush()?;
-        self.temp.persist(&self.path).map(drop).map_err(|e| e.error)
+        self.flush()?;
+        match self.target {
+            Target::Temp(temp) => temp.persist(&self.path).map(drop).map_err(|e| e.error),
+            Target::Special(_) => Ok(()),
+        }
+    }
+
+    /// The open file, whichever kind of target it is.
+    fn file(&mut self) -> &mut File {
+        match &mut self.target {
+            Target::Temp(temp) => temp.as_file_mut(),
+            Target::Special(file) => file,
+        }
     }
 
     /// [`create`](Self::create) behind a 64 KiB buffer.
@@ -92,21 +138,21 @@ impl OutputFile {
 
 impl Write for OutputFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.temp.write(buf)
+        self.file().write(buf)
     }
 
     fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        self.temp.write_all(buf)
+        self.file().write_all(buf)
     }
 
     fn flush(&mut self) -> io::Result<()> {
-        self.temp.flush()
+        self.file().flush()
     }
 }
 
 impl Seek for OutputFile {
     fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
-        self.temp.seek(pos)
+        self.file().seek(pos)
     }
 }
 
@@ -171,6 +217,19 @@ mod tests {
         out.write_all(b"whole").unwrap();
         out.commit().unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"whole");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_device_is_written_through_and_never_replaced_by_a_file() {
+        use std::os::unix::fs::FileTypeExt;
+        write_atomic("/dev/null", b"discarded").unwrap();
+        let mut out = OutputFile::buffered("/dev/null").unwrap();
+        out.write_all(b"also discarded").unwrap();
+        OutputFile::commit_buffered(out).unwrap();
+        let kind = std::fs::metadata("/dev/null").unwrap().file_type();
+        assert!(kind.is_char_device(), "/dev/null is still a device");
+        assert!(std::fs::read("/dev/null").unwrap().is_empty());
     }
 
     #[cfg(unix)]
