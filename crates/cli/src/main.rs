@@ -6,6 +6,7 @@
 
 mod cluster;
 mod commands;
+mod filtering;
 mod formats;
 mod inputs;
 mod kinds;

@@ -195,6 +195,19 @@ fn features_made_otherwise_than_the_models_are_refused_naming_both() {
     run_ok(&as_refs(&predict));
     let checked: Array2<f32> = ndarray_npy::read_npy(&out).expect("output");
     assert_eq!(checked.dim(), (3, 2));
+    // The model's settings on filtered events: the model's features were not filtered.
+    run_ok(&as_refs(&represent(&[
+        "--model",
+        &s(&model),
+        "--filter",
+        "polarity=on",
+    ])));
+    let err = run_err(&as_refs(&predict));
+    assert!(
+        err.contains("went through polarity=on, the model's through no filter"),
+        "{err}"
+    );
+    run_ok(&as_refs(&represent(&["--model", &s(&model)])));
 
     // Without a record of what made them: refused, unless the user vouches for them.
     std::fs::remove_file(dir.path().join("f.npy.json")).expect("remove");

@@ -226,3 +226,75 @@ fn bad_inputs_fail_with_clear_messages() {
     let err = run(&["--sensor", "30x24", "--roi", "none"]);
     assert!(err.contains("multiples of 8"), "{err}");
 }
+
+#[test]
+fn filters_apply_before_the_representation_and_are_recorded_beside_the_features() {
+    let dir = tempfile::tempdir().unwrap();
+    let (raw, samples) = (dir.path().join("raw.csv"), dir.path().join("s.txt"));
+    let events = stream(32, 24);
+    write_csv(&raw, &events);
+    write_samples(&samples, &[5_000, 12_000, 21_000]);
+    // The reference: the same events filtered here by hand (ON events in the left half).
+    let kept: Vec<Event> = events
+        .iter()
+        .copied()
+        .filter(|e| e.polarity && e.x < 16)
+        .collect();
+    assert!(!kept.is_empty() && kept.len() < events.len());
+    let prefiltered = dir.path().join("kept.csv");
+    write_csv(&prefiltered, &kept);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let represent = |input: &Path, out: &Path, extra: &[&str]| {
+        let mut args: Vec<String> = ["represent", &s(input), "--samples", &s(&samples)]
+            .map(String::from)
+            .to_vec();
+        args.extend(["--sensor", "32x24", "--roi", "none", "--repr", "combined"].map(String::from));
+        args.extend(["--tau-ms", "3", "--window-ms", "4", "--output"].map(String::from));
+        args.push(s(out));
+        args.extend(extra.iter().map(|a| a.to_string()));
+        crate::common::run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let (filtered, reference) = (dir.path().join("f.npy"), dir.path().join("r.npy"));
+    let ran = represent(
+        &raw,
+        &filtered,
+        &["--filter", "polarity=on", "--filter", "region=0,0,16,24"],
+    );
+    let said = String::from_utf8_lossy(&ran.stderr);
+    let off = events.iter().filter(|e| !e.polarity).count();
+    assert!(said.contains(&format!("removed {off} events")), "{said}");
+    represent(&prefiltered, &reference, &[]);
+    let got: Array2<f32> = ndarray_npy::read_npy(&filtered).unwrap();
+    let want: Array2<f32> = ndarray_npy::read_npy(&reference).unwrap();
+    assert_eq!(
+        got, want,
+        "filtering in represent = representing the filtered events"
+    );
+    let made: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("f.npy.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        made["filters"],
+        serde_json::json!(["polarity=on", "region=0,0,16,24"])
+    );
+    let unfiltered = std::fs::read_to_string(dir.path().join("r.npy.json")).unwrap();
+    assert!(!unfiltered.contains("filters"), "{unfiltered}");
+
+    let bad = dir.path().join("bad.npy");
+    let err = crate::common::run_err(&[
+        "represent",
+        &s(&raw),
+        "--samples",
+        &s(&samples),
+        "--sensor",
+        "32x24",
+        "--roi",
+        "none",
+        "--filter",
+        "region=20,0,16,24",
+        "--output",
+        &s(&bad),
+    ]);
+    assert!(err.contains("region=20,0,16,24"), "{err}");
+    assert!(!bad.exists(), "nothing written");
+}

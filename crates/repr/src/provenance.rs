@@ -4,7 +4,9 @@
 //! right shape (900 columns) and give confident, wrong angles (33 deg pitch on a 20 deg trial).
 //! So features carry a [`FeatureProvenance`]: the representation with every setting that
 //! changes a feature ([`ReprConfig::cache_key`]), the crop they were pooled from, and the
-//! no-contact mask (its SHA-256, since the mask is data, not config). `evtac represent` writes it
+//! no-contact mask (its SHA-256, since the mask is data, not config), and the event filters the
+//! recording went through first (their SPECs, in order; left out of the JSON when there are
+//! none, so files from before filters read the same). `evtac represent` writes it
 //! beside the NPY ([`FeatureProvenance::sidecar`]: `features.npy.json`); the Python package
 //! attaches it to the array; `evtac predict` and `Model.predict` compare it with the model's
 //! and refuse a mismatch, naming both.
@@ -28,6 +30,10 @@ pub struct FeatureProvenance {
     pub crop: String,
     /// The no-contact mask's SHA-256 (hex, over its size and pixels), `None` without a mask.
     pub mask: Option<String>,
+    /// The event filters applied before the representation, as SPECs in order
+    /// (`background-activity=10ms`); empty for unfiltered events.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filters: Vec<String>,
 }
 
 impl FeatureProvenance {
@@ -38,7 +44,13 @@ impl FeatureProvenance {
             representation: config.cache_key(),
             crop: crop.to_string(),
             mask: mask.map(mask_digest),
+            filters: Vec::new(),
         }
+    }
+
+    /// The same provenance for events that went through `filters` (SPECs, in order) first.
+    pub fn with_filters(self, filters: Vec<String>) -> Self {
+        Self { filters, ..self }
     }
 
     /// Where `evtac represent` writes the provenance of the features in `features`: beside it,
@@ -77,6 +89,17 @@ impl FeatureProvenance {
                 show(&expected.mask)
             ));
         }
+        if self.filters != expected.filters {
+            let show = |f: &[String]| match f {
+                [] => "no filter".to_string(),
+                specs => specs.join(" then "),
+            };
+            parts.push(format!(
+                "filters: the features' events went through {}, the model's through {}",
+                show(&self.filters),
+                show(&expected.filters)
+            ));
+        }
         (!parts.is_empty()).then(|| parts.join("; "))
     }
 }
@@ -87,7 +110,11 @@ impl fmt::Display for FeatureProvenance {
         match &self.mask {
             Some(d) => write!(f, ", mask sha256 {}", &d[..16.min(d.len())]),
             None => write!(f, ", no mask"),
+        }?;
+        if !self.filters.is_empty() {
+            write!(f, ", filtered by {}", self.filters.join(" then "))?;
         }
+        Ok(())
     }
 }
 
@@ -138,6 +165,29 @@ mod tests {
         );
         let small = FeatureProvenance::new(&static_, Resolution::new(160, 160), None);
         assert!(small.mismatch(&a).unwrap().contains("pooled from 160x160"));
+        let filtered = a
+            .clone()
+            .with_filters(vec!["background-activity=10ms".into()]);
+        let why = filtered.mismatch(&a).unwrap();
+        assert_eq!(
+            why,
+            "filters: the features' events went through background-activity=10ms, the model's \
+             through no filter"
+        );
+    }
+
+    #[test]
+    fn unfiltered_provenance_reads_and_writes_as_before_filters() {
+        let a = FeatureProvenance::new(&ReprConfig::Static(StaticConfig::default()), CROP, None);
+        let json = serde_json::to_string(&a).unwrap();
+        assert!(!json.contains("filters"), "{json}");
+        let old = r#"{"representation":"x","crop":"240x240","mask":null}"#;
+        let read: FeatureProvenance = serde_json::from_str(old).unwrap();
+        assert!(read.filters.is_empty());
+        let filtered = a.with_filters(vec!["polarity=on".into()]);
+        let back: FeatureProvenance =
+            serde_json::from_str(&serde_json::to_string(&filtered).unwrap()).unwrap();
+        assert_eq!(back, filtered);
     }
 
     #[test]

@@ -8,9 +8,9 @@
 //! does not fit (a region outside the sensor) leaves no output; outputs appear only once
 //! complete ([`evtac_events::output`]), and an output that is the input is refused.
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use evtac_events::output::refuse_input;
-use evtac_filters::{Chain, Filter, FilterSpec};
+use evtac_filters::Filter;
 use evtac_formats::EventWriter;
 
 /// Arguments of `evtac filter`.
@@ -23,13 +23,8 @@ use evtac_formats::EventWriter;
 pub struct Args {
     #[command(flatten)]
     pub files: crate::rewrite::RewriteArgs,
-    /// A filter, applied in the order given (repeat the flag for a chain):
-    /// `background-activity=DURATION`, `fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]`,
-    /// `k-noise=DURATION`, `polarity=on|off`, `region=X,Y,W,H`, `refractory=DURATION`,
-    /// `circle=CX,CY,R`, `mask=FILE` (keeps the pixels a uint8 H x W NPY or 8-bit greyscale
-    /// PNG marks non-zero), `hot-pixels=FILE` (removes them). Durations take `us`, `ms` or `s`.
-    #[arg(long = "filter", value_name = "SPEC", required = true)]
-    pub filters: Vec<FilterSpec>,
+    #[command(flatten)]
+    pub filters: crate::filtering::FilterArgs,
     #[command(flatten)]
     pub sensor: crate::sensor::SensorArgs,
     #[command(flatten)]
@@ -50,7 +45,7 @@ pub struct Counts {
 /// Runs `evtac filter`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let counts = filter(&args)?;
-    for ((name, removed), spec) in counts.removed.iter().zip(&args.filters) {
+    for ((name, removed), spec) in counts.removed.iter().zip(&args.filters.filters) {
         eprintln!("{spec}: removed {removed} events ({name})");
     }
     args.files.say_written(counts.events_out, counts.events_in);
@@ -59,6 +54,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Filters `args.files.input` into `args.files.output` as `evtac filter` does.
 pub fn filter(args: &Args) -> anyhow::Result<Counts> {
+    if args.filters.filters.is_empty() {
+        bail!("no filter: give at least one --filter SPEC (evtac filter --help lists them)");
+    }
     refuse_input(&args.files.output, &[&args.files.input])?;
     let mut reader = evtac_formats::open_with(&args.files.input, &args.streams.selection())?;
     if let Some(resolution) = args.sensor.sensor {
@@ -71,8 +69,7 @@ pub fn filter(args: &Args) -> anyhow::Result<Counts> {
             reader.format()
         );
     };
-    let mut chain = Chain::build(&args.filters, sensor)
-        .with_context(|| format!("{}: the {sensor} sensor", args.files.input.display()))?;
+    let mut chain = args.filters.chain(&args.files.input, sensor)?;
     let mut writer = EventWriter::create(&args.files.output, Some(sensor), reader.source())?;
     let bar = crate::progress::bytes(reader.file_len(), "filtering");
     let mut kept = Vec::new();

@@ -100,6 +100,11 @@ pub struct Args {
     pub sensor: crate::sensor::SensorArgs,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
+    /// Event filters, applied to the recording (and to a no-contact recording given as --mask)
+    /// before the representation; the features' `.json` records them, and `evtac predict`
+    /// refuses features filtered otherwise than its model's.
+    #[command(flatten)]
+    pub filters: crate::filtering::FilterArgs,
     /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
     #[arg(long, group = "settings")]
     pub roi: Option<String>,
@@ -225,7 +230,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let samples = read_samples(&args.samples)?;
 
-    let (sensor, events) = read_events(&args.events, args.sensor.sensor, &args.streams)?;
+    let (sensor, events) = read_events(&args.events, &args)?;
     let roi = match &model {
         Some(m) => Roi::centered(sensor, m.representation().frame).with_context(|| {
             format!(
@@ -291,7 +296,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         What::Potential => write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?)?,
         What::Features => {
             write_npy(out, &Array2::from_shape_vec((n, per_sample), floats)?)?;
-            let made = FeatureProvenance::new(&config, frame, mask.as_ref());
+            let filters = args.filters.filters.iter().map(|f| f.to_string()).collect();
+            let made = FeatureProvenance::new(&config, frame, mask.as_ref()).with_filters(filters);
             crate::outputs::write_text(&sidecar, &(serde_json::to_string_pretty(&made)? + "\n"))?;
         }
     }
@@ -306,14 +312,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Reads a recording and its sensor size: the file's, which `--sensor` must agree with, or
-/// `--sensor` for a file that states none.
-fn read_events(
-    path: &Path,
-    resolution: Option<Resolution>,
-    streams: &crate::streams::StreamArgs,
-) -> anyhow::Result<(Resolution, Vec<Event>)> {
-    let rec = evtac_formats::open_with(path, &streams.selection())
+/// Reads a recording and its sensor size (the file's, which `--sensor` must agree with, or
+/// `--sensor` for a file that states none), through `--filter`'s filters.
+fn read_events(path: &Path, args: &Args) -> anyhow::Result<(Resolution, Vec<Event>)> {
+    let resolution = args.sensor.sensor;
+    let rec = evtac_formats::open_with(path, &args.streams.selection())
         .and_then(evtac_formats::EventReader::into_recording)
         .with_context(|| format!("reading events from {}", path.display()))?;
     if let (Some(given), Some(found)) = (resolution, rec.resolution) {
@@ -329,7 +332,8 @@ fn read_events(
             path.display()
         )
     })?;
-    Ok((sensor, rec.events))
+    let events = args.filters.apply(path, sensor, rec.events)?;
+    Ok((sensor, events))
 }
 
 fn parse_roi(roi: Option<&str>, sensor: Resolution) -> anyhow::Result<Roi> {
@@ -398,7 +402,7 @@ fn read_mask(
     let Some(static_config) = config.static_part() else {
         bail!("--mask applies to the static part: it needs --repr static or combined");
     };
-    let (sensor, events) = read_events(path, args.sensor.sensor, &args.streams)
+    let (sensor, events) = read_events(path, args)
         .with_context(|| format!("reading the no-contact recording {}", path.display()))?;
     let roi = parse_roi(args.roi.as_deref(), sensor)?;
     Mask::from_recording(&roi, static_config, &events)
