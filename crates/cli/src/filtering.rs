@@ -43,18 +43,23 @@ impl FilterArgs {
         let mut chain = self.chain(path, sensor)?;
         let mut kept = Vec::with_capacity(events.len());
         chain.retain(&events, &mut kept);
-        self.say_removed(&chain);
+        self.say_removed(&removed(&chain));
         Ok(kept)
     }
 
-    /// Prints each filter's removed count, in order, on stderr.
-    pub fn say_removed(&self, chain: &Chain) {
-        for (spec, filter) in self.filters.iter().zip(chain.filters()) {
-            eprintln!(
-                "{spec}: removed {} events ({})",
-                filter.removed(),
-                filter.name()
-            );
+    /// Prints each filter's removed count ([`removed`]), in order, beside its SPEC on stderr.
+    pub fn say_removed(&self, removed: &[(&'static str, u64)]) {
+        for (spec, (name, count)) in self.filters.iter().zip(removed) {
+            eprintln!("{spec}: removed {count} events ({name})");
         }
     }
+}
+
+/// Each filter of `chain`, first to last: its name and the events it removed.
+pub fn removed(chain: &Chain) -> Vec<(&'static str, u64)> {
+    chain
+        .filters()
+        .iter()
+        .map(|f| (f.name(), f.removed()))
+        .collect()
 }

@@ -45,9 +45,7 @@ pub struct Counts {
 /// Runs `evtac filter`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let counts = filter(&args)?;
-    for ((name, removed), spec) in counts.removed.iter().zip(&args.filters.filters) {
-        eprintln!("{spec}: removed {removed} events ({name})");
-    }
+    args.filters.say_removed(&counts.removed);
     args.files.say_written(counts.events_out, counts.events_in);
     Ok(())
 }
@@ -86,10 +84,6 @@ pub fn filter(args: &Args) -> anyhow::Result<Counts> {
     }
     bar.finish_and_clear();
     writer.finish()?;
-    counts.removed = chain
-        .filters()
-        .iter()
-        .map(|f| (f.name(), f.removed()))
-        .collect();
+    counts.removed = crate::filtering::removed(&chain);
     Ok(counts)
 }

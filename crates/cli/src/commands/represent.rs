@@ -88,8 +88,8 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "features")]
     pub what: What,
     /// Output NPY file. Features are written with `OUTPUT.json` beside them, saying what made
-    /// them (representation and settings, crop, mask), which `evtac predict` checks against
-    /// the model.
+    /// them (representation and settings, crop, mask, --filter's filters), which `evtac
+    /// predict` checks against the model.
     #[arg(long, short)]
     pub output: PathBuf,
     /// Make the features a model reads: its representation and settings, its crop and its
@@ -100,16 +100,15 @@ pub struct Args {
     pub sensor: crate::sensor::SensorArgs,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
-    /// Event filters, applied to the recording (and to a no-contact recording given as --mask)
-    /// before the representation; the features' `.json` records them, and `evtac predict`
-    /// refuses features filtered otherwise than its model's.
+    // Applied to the recording and to a no-contact recording given as --mask (clap shows only
+    // FilterArgs' own help; --mask and --output say what filters mean here).
     #[command(flatten)]
     pub filters: crate::filtering::FilterArgs,
     /// Crop: a centered WIDTHxHEIGHT region, or `none` for the whole sensor [default: 240x240].
     #[arg(long, group = "settings")]
     pub roi: Option<String>,
     /// No-contact mask: an `.npy` mask (non-zero = masked, crop-sized) or a no-contact recording
-    /// run through the same static settings.
+    /// run through the same static settings (and the same --filter filters).
     #[arg(long, group = "settings")]
     pub mask: Option<PathBuf>,
     /// Static: decay function [default: exponential].
