@@ -27,20 +27,6 @@ impl BackgroundActivity {
             duration: duration.get(),
         }
     }
-
-    /// Whether a neighbour of `(x, y)` fired less than the duration before `t`.
-    fn supported(&self, x: usize, y: usize, t: i64) -> bool {
-        let (width, height) = (self.surface.width(), self.surface.height());
-        let rows = y.saturating_sub(1)..=(y + 1).min(height - 1);
-        rows.into_iter().any(|ny| {
-            let columns = x.saturating_sub(1)..=(x + 1).min(width - 1);
-            columns.into_iter().any(|nx| {
-                // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
-                (nx, ny) != (x, y)
-                    && t.wrapping_sub(self.surface.at(ny * width + nx)) < self.duration
-            })
-        })
-    }
 }
 
 impl Rule for BackgroundActivity {
@@ -48,11 +34,26 @@ impl Rule for BackgroundActivity {
 
     fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor dv-processing would read and write outside its surface: removed here.
-        self.surface.index(event.x, event.y).is_some_and(|i| {
-            let keep = self.supported(usize::from(event.x), usize::from(event.y), event.t);
-            self.surface.set(i, event.t);
-            keep
-        })
+        let Some(i) = self.surface.index(event.x, event.y) else {
+            return false;
+        };
+        // All 8 neighbours tested and the answers combined with `&` and `|`, not `any`: which
+        // neighbour answers, and whether any does, is data-dependent, and a short-circuit
+        // would branch on it. The padded surface makes the reads unconditional; the edges
+        // mask the border out.
+        // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
+        let recent = |last: i64| event.t.wrapping_sub(last) < self.duration;
+        let edges = self.surface.edges(event.x, event.y);
+        let [above, row, below] = self.surface.around(i);
+        let three = |r: &[i64; 3]| {
+            (edges.left & recent(r[0])) | recent(r[1]) | (edges.right & recent(r[2]))
+        };
+        let keep = (edges.up & three(above))
+            | (edges.left & recent(row[0]))
+            | (edges.right & recent(row[2]))
+            | (edges.down & three(below));
+        self.surface.set(i, event.t);
+        keep
     }
 }
 

@@ -18,13 +18,23 @@ use crate::{Micros, Rule};
 /// Keeps events in cells of the sensor with enough recent, decaying activity.
 #[derive(Debug, Clone)]
 pub struct FastDecay {
-    sensor: Resolution,
-    subdivision: usize,
-    columns: usize,
-    last: Vec<i64>,
-    count: Vec<f32>,
+    /// Each column's cell column, and each row's first cell: `x / SUBDIVISION` and
+    /// `y / SUBDIVISION * columns`, looked up rather than divided per event (a division by a
+    /// number known only at run time is the slowest integer instruction), and only for the
+    /// sensor's pixels, so a lookup that fails is an event off the sensor.
+    cell_of_column: Vec<u32>,
+    cell_of_row: Vec<u32>,
+    cells: Vec<Cell>,
     half_life: f32,
     threshold: f32,
+}
+
+/// One cell's decaying count and the time it was last updated, side by side: an event reads
+/// and writes both.
+#[derive(Debug, Clone, Copy, Default)]
+struct Cell {
+    last: i64,
+    count: f32,
 }
 
 impl FastDecay {
@@ -42,15 +52,15 @@ impl FastDecay {
     /// When `subdivision` is 0 ([`crate::FilterSpec`] refuses it with an error).
     pub fn new(sensor: Resolution, half_life: Micros, subdivision: u16, threshold: f32) -> Self {
         assert!(subdivision > 0, "a fast-decay cell has at least one pixel");
-        let subdivision = usize::from(subdivision);
-        let columns = usize::from(sensor.width) / subdivision + 1;
-        let rows = usize::from(sensor.height) / subdivision + 1;
+        let columns = u32::from(sensor.width / subdivision) + 1;
+        let rows = u32::from(sensor.height / subdivision) + 1;
+        let sub = u32::from(subdivision);
         Self {
-            sensor,
-            subdivision,
-            columns,
-            last: vec![0; columns * rows],
-            count: vec![0.0; columns * rows],
+            cell_of_column: (0..u32::from(sensor.width)).map(|x| x / sub).collect(),
+            cell_of_row: (0..u32::from(sensor.height))
+                .map(|y| y / sub * columns)
+                .collect(),
+            cells: vec![Cell::default(); (columns * rows) as usize],
             // dv-processing keeps the half-life as a float32 number of microseconds.
             half_life: half_life.get() as f32,
             threshold,
@@ -64,16 +74,18 @@ impl Rule for FastDecay {
     fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor: removed, as by the other filters (dv-processing's grid has a spare
         // row and column, but an event there is no event of this sensor).
-        if !self.sensor.contains(event.x, event.y) {
+        let (Some(column), Some(row)) = (
+            self.cell_of_column.get(usize::from(event.x)),
+            self.cell_of_row.get(usize::from(event.y)),
+        ) else {
             return false;
-        }
-        let cell = usize::from(event.y) / self.subdivision * self.columns
-            + usize::from(event.x) / self.subdivision;
-        let elapsed = event.t.wrapping_sub(self.last[cell]) as f32;
+        };
+        let cell = &mut self.cells[(row + column) as usize];
+        let elapsed = event.t.wrapping_sub(cell.last) as f32;
         let decay = (-elapsed / self.half_life).exp2();
-        self.last[cell] = event.t;
-        let count = self.count[cell] * decay + 1.0;
-        self.count[cell] = count;
+        cell.last = event.t;
+        let count = cell.count * decay + 1.0;
+        cell.count = count;
         count > self.threshold
     }
 }

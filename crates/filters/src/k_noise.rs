@@ -22,17 +22,46 @@ use evtac_events::{Event, Resolution};
 use crate::{Micros, Rule};
 
 /// The last event of one column (`at` its row) or of one row (`at` its column).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Slot {
     t: i64,
     at: u16,
-    polarity: bool,
+    /// 0 (OFF) or 1 (ON); [`NO_POLARITY`] in the padding slots.
+    polarity: u8,
+}
+
+/// The polarity of the slots beyond the sensor's edges, which no event has: a padding slot
+/// never supports, whatever its timestamp (no timestamp could stand for "never" under the
+/// wrapping subtraction).
+const NO_POLARITY: u8 = 2;
+
+impl Slot {
+    /// dv-processing's starting slot: (0, 0, OFF).
+    const START: Self = Self {
+        t: 0,
+        at: 0,
+        polarity: 0,
+    };
+    const PADDING: Self = Self {
+        polarity: NO_POLARITY,
+        ..Self::START
+    };
+
+    fn of(event: &Event, at: u16) -> Self {
+        Self {
+            t: event.t,
+            at,
+            polarity: u8::from(event.polarity),
+        }
+    }
 }
 
 /// Keeps events supported by a recent event of the same polarity in the neighbouring columns'
 /// or rows' slots.
 #[derive(Debug, Clone)]
 pub struct KNoise {
+    /// Column `x`'s slot at `x + 1`, with a padding slot at each end, so that the three
+    /// neighbouring slots are always there to read (no clipping at the edges); rows alike.
     columns: Vec<Slot>,
     rows: Vec<Slot>,
     duration: i64,
@@ -41,31 +70,24 @@ pub struct KNoise {
 impl KNoise {
     /// The filter for `sensor`, with slots counted for `duration`.
     pub fn new(sensor: Resolution, duration: Micros) -> Self {
+        let padded = |n: u16| {
+            let mut slots = vec![Slot::START; usize::from(n) + 2];
+            slots[0] = Slot::PADDING;
+            slots[usize::from(n) + 1] = Slot::PADDING;
+            slots
+        };
         Self {
-            // Default slots are dv-processing's starting ones: (0, 0, OFF).
-            columns: vec![Slot::default(); usize::from(sensor.width)],
-            rows: vec![Slot::default(); usize::from(sensor.height)],
+            columns: padded(sensor.width),
+            rows: padded(sensor.height),
             duration: duration.get(),
         }
     }
-
-    /// Whether a neighbouring column's or row's slot supports `event`.
-    fn supported(&self, event: &Event) -> bool {
-        let near = |slot: &Slot, coordinate: u16| {
-            slot.polarity == event.polarity
-                && slot.at.abs_diff(coordinate) <= 1
-                // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
-                && event.t.wrapping_sub(slot.t) <= self.duration
-        };
-        neighbours(&self.columns, event.x).any(|slot| near(slot, event.y))
-            || neighbours(&self.rows, event.y).any(|slot| near(slot, event.x))
-    }
 }
 
-/// The slots at `i - 1`, `i` and `i + 1` that exist.
-fn neighbours(slots: &[Slot], i: u16) -> impl Iterator<Item = &Slot> {
-    let i = usize::from(i);
-    slots[i.saturating_sub(1)..(i + 2).min(slots.len())].iter()
+/// The slots of `i - 1`, `i` and `i + 1` in `padded` (slot `i` at `i + 1`).
+#[inline]
+fn neighbours(padded: &[Slot], i: usize) -> &[Slot; 3] {
+    padded[i..i + 3].try_into().expect("a range of three")
 }
 
 impl Rule for KNoise {
@@ -74,20 +96,28 @@ impl Rule for KNoise {
     fn accept(&mut self, event: &Event) -> bool {
         let (x, y) = (usize::from(event.x), usize::from(event.y));
         // Off the sensor dv-processing would index past its slots: removed here.
-        if x >= self.columns.len() || y >= self.rows.len() {
+        if x + 2 >= self.columns.len() || y + 2 >= self.rows.len() {
             return false;
         }
-        let keep = self.supported(event);
-        self.columns[x] = Slot {
-            t: event.t,
-            at: event.y,
-            polarity: event.polarity,
+        let polarity = u8::from(event.polarity);
+        let near = |slot: &Slot, coordinate: u16| {
+            (slot.polarity == polarity)
+                & (slot.at.abs_diff(coordinate) <= 1)
+                // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
+                & (event.t.wrapping_sub(slot.t) <= self.duration)
         };
-        self.rows[y] = Slot {
-            t: event.t,
-            at: event.x,
-            polarity: event.polarity,
-        };
+        // All six slots tested and combined with `|`, not `any`: a short-circuit would branch
+        // on data-dependent answers (polarity, distance, time), mispredicting often.
+        let [c0, c1, c2] = neighbours(&self.columns, x);
+        let [r0, r1, r2] = neighbours(&self.rows, y);
+        let keep = near(c0, event.y)
+            | near(c1, event.y)
+            | near(c2, event.y)
+            | near(r0, event.x)
+            | near(r1, event.x)
+            | near(r2, event.x);
+        self.columns[x + 1] = Slot::of(event, event.y);
+        self.rows[y + 1] = Slot::of(event, event.x);
         keep
     }
 }
