@@ -32,6 +32,8 @@ impl BackgroundActivity {
 impl Rule for BackgroundActivity {
     const NAME: &'static str = "background-activity";
 
+    // `always`: with `#[inline]` alone LLVM judged it too big and kept a call per event.
+    #[inline(always)]
     fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor dv-processing would read and write outside its surface: removed here.
         let Some(i) = self.surface.index(event.x, event.y) else {

@@ -32,6 +32,7 @@ impl Circle {
 impl Rule for Circle {
     const NAME: &'static str = "circle";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         let dx = f64::from(event.x) - self.cx;
         let dy = f64::from(event.y) - self.cy;

@@ -24,6 +24,10 @@ pub trait Rule: Send {
     const NAME: &'static str;
 
     /// Whether to keep `event`, which comes after every event seen before; updates the state.
+    ///
+    /// Implementations are `#[inline]` (or `#[inline(always)]`): [`Counted::retain`] is generic and may be compiled in
+    /// another codegen unit than the rule, and without the hint every event paid a call (and
+    /// the registers it clobbers) instead of the rule's few instructions.
     fn accept(&mut self, event: &Event) -> bool;
 
     /// The rule as a [`Filter`] that counts what it removes.

@@ -71,6 +71,7 @@ impl FastDecay {
 impl Rule for FastDecay {
     const NAME: &'static str = "fast-decay";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor: removed, as by the other filters (dv-processing's grid has a spare
         // row and column, but an event there is no event of this sensor).

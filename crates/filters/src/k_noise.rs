@@ -21,38 +21,79 @@ use evtac_events::{Event, Resolution};
 
 use crate::{Micros, Rule};
 
-/// The last event of one column (`at` its row) or of one row (`at` its column).
+/// The last events of the columns (each `at` its row) or of the rows (each `at` its column),
+/// slot `i` at `i + 1` with a padding slot at each end, so that the three neighbouring slots
+/// are always there to read (no clipping at the edges).
+#[derive(Debug, Clone)]
+struct Slots(Vec<Slot>);
+
+/// One slot: its event's timestamp and [`key_of`] its polarity and coordinate.
 #[derive(Debug, Clone, Copy)]
 struct Slot {
     t: i64,
-    at: u16,
-    /// 0 (OFF) or 1 (ON); [`NO_POLARITY`] in the padding slots.
-    polarity: u8,
+    key: u32,
 }
 
-/// The polarity of the slots beyond the sensor's edges, which no event has: a padding slot
-/// never supports, whatever its timestamp (no timestamp could stand for "never" under the
-/// wrapping subtraction).
+/// A slot's polarity and coordinate in one number, `polarity << 17 | at`, so that "same
+/// polarity and `at` within 1 of `c`" is one test: `key + 1 - key_of(polarity, c) <= 2` in
+/// wrapping u32 arithmetic. With equal polarities that is `at - c` in `{-1, 0, 1}`; with
+/// different ones (at least 2^17 apart against coordinates at most 2^16 - 1 apart) it never
+/// holds.
+fn key_of(polarity: u8, at: u16) -> u32 {
+    u32::from(polarity) << 17 | u32::from(at)
+}
+
+/// The polarity of the padding slots, which no event has: a padding slot never supports,
+/// whatever its timestamp (no timestamp could stand for "never" under the wrapping
+/// subtraction).
 const NO_POLARITY: u8 = 2;
 
-impl Slot {
-    /// dv-processing's starting slot: (0, 0, OFF).
-    const START: Self = Self {
-        t: 0,
-        at: 0,
-        polarity: 0,
-    };
-    const PADDING: Self = Self {
-        polarity: NO_POLARITY,
-        ..Self::START
-    };
+impl Slots {
+    /// `n` slots at dv-processing's start, (timestamp 0, coordinate 0, OFF), and the padding.
+    fn new(n: u16) -> Self {
+        let n = usize::from(n);
+        let start = Slot {
+            t: 0,
+            key: key_of(0, 0),
+        };
+        let padding = Slot {
+            t: 0,
+            key: key_of(NO_POLARITY, 0),
+        };
+        let mut slots = vec![start; n + 2];
+        slots[0] = padding;
+        slots[n + 1] = padding;
+        Self(slots)
+    }
 
-    fn of(event: &Event, at: u16) -> Self {
-        Self {
+    /// Whether slot `i - 1`, `i` or `i + 1` holds an event of `event`'s polarity within 1 of
+    /// `at` and at most `duration` before `event`. All three are tested and combined with `|`,
+    /// not `any`: a short-circuit would branch on data-dependent answers (polarity, distance,
+    /// time), mispredicting often.
+    #[inline(always)]
+    fn support(&self, i: usize, event: &Event, at: u16, duration: i64) -> bool {
+        let slots: &[Slot; 3] = self.0[i..i + 3].try_into().expect("a range of three");
+        let want = key_of(u8::from(event.polarity), at);
+        let near = |slot: &Slot| {
+            // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
+            (slot.key.wrapping_add(1).wrapping_sub(want) <= 2)
+                & (event.t.wrapping_sub(slot.t) <= duration)
+        };
+        near(&slots[0]) | near(&slots[1]) | near(&slots[2])
+    }
+
+    /// Slot `i` takes `event`, `at` its row or column.
+    #[inline(always)]
+    fn take(&mut self, i: usize, event: &Event, at: u16) {
+        self.0[i + 1] = Slot {
             t: event.t,
-            at,
-            polarity: u8::from(event.polarity),
-        }
+            key: key_of(u8::from(event.polarity), at),
+        };
+    }
+
+    /// The number of slots, padding excluded.
+    fn len(&self) -> usize {
+        self.0.len() - 2
     }
 }
 
@@ -60,64 +101,37 @@ impl Slot {
 /// or rows' slots.
 #[derive(Debug, Clone)]
 pub struct KNoise {
-    /// Column `x`'s slot at `x + 1`, with a padding slot at each end, so that the three
-    /// neighbouring slots are always there to read (no clipping at the edges); rows alike.
-    columns: Vec<Slot>,
-    rows: Vec<Slot>,
+    columns: Slots,
+    rows: Slots,
     duration: i64,
 }
 
 impl KNoise {
     /// The filter for `sensor`, with slots counted for `duration`.
     pub fn new(sensor: Resolution, duration: Micros) -> Self {
-        let padded = |n: u16| {
-            let mut slots = vec![Slot::START; usize::from(n) + 2];
-            slots[0] = Slot::PADDING;
-            slots[usize::from(n) + 1] = Slot::PADDING;
-            slots
-        };
         Self {
-            columns: padded(sensor.width),
-            rows: padded(sensor.height),
+            columns: Slots::new(sensor.width),
+            rows: Slots::new(sensor.height),
             duration: duration.get(),
         }
     }
 }
 
-/// The slots of `i - 1`, `i` and `i + 1` in `padded` (slot `i` at `i + 1`).
-#[inline]
-fn neighbours(padded: &[Slot], i: usize) -> &[Slot; 3] {
-    padded[i..i + 3].try_into().expect("a range of three")
-}
-
 impl Rule for KNoise {
     const NAME: &'static str = "k-noise";
 
+    // `always`: with `#[inline]` alone LLVM judged it too big and kept a call per event.
+    #[inline(always)]
     fn accept(&mut self, event: &Event) -> bool {
         let (x, y) = (usize::from(event.x), usize::from(event.y));
         // Off the sensor dv-processing would index past its slots: removed here.
-        if x + 2 >= self.columns.len() || y + 2 >= self.rows.len() {
+        if x >= self.columns.len() || y >= self.rows.len() {
             return false;
         }
-        let polarity = u8::from(event.polarity);
-        let near = |slot: &Slot, coordinate: u16| {
-            (slot.polarity == polarity)
-                & (slot.at.abs_diff(coordinate) <= 1)
-                // Wrapping: dv-processing subtracts int64s as they come, whatever they are.
-                & (event.t.wrapping_sub(slot.t) <= self.duration)
-        };
-        // All six slots tested and combined with `|`, not `any`: a short-circuit would branch
-        // on data-dependent answers (polarity, distance, time), mispredicting often.
-        let [c0, c1, c2] = neighbours(&self.columns, x);
-        let [r0, r1, r2] = neighbours(&self.rows, y);
-        let keep = near(c0, event.y)
-            | near(c1, event.y)
-            | near(c2, event.y)
-            | near(r0, event.x)
-            | near(r1, event.x)
-            | near(r2, event.x);
-        self.columns[x + 1] = Slot::of(event, event.y);
-        self.rows[y + 1] = Slot::of(event, event.x);
+        let keep = self.columns.support(x, event, event.y, self.duration)
+            | self.rows.support(y, event, event.x, self.duration);
+        self.columns.take(x, event, event.y);
+        self.rows.take(y, event, event.x);
         keep
     }
 }
@@ -154,6 +168,27 @@ mod tests {
             run(&[(T, 5, 5, true), (T + 1_001, 6, 6, true)]),
             [false, false]
         );
+    }
+
+    #[test]
+    fn one_key_test_is_same_polarity_and_within_one() {
+        let coordinates = [0u16, 1, 2, 3, 1000, 65533, 65534, 65535];
+        for slot_polarity in [0, 1, NO_POLARITY] {
+            for event_polarity in [0, 1] {
+                for &at in &coordinates {
+                    for &c in &coordinates {
+                        let key = key_of(slot_polarity, at);
+                        let one_test =
+                            key.wrapping_add(1).wrapping_sub(key_of(event_polarity, c)) <= 2;
+                        let expected = slot_polarity == event_polarity && at.abs_diff(c) <= 1;
+                        assert_eq!(
+                            one_test, expected,
+                            "{slot_polarity} {event_polarity} {at} {c}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

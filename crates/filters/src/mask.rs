@@ -40,6 +40,7 @@ impl Mask {
 impl Rule for Mask {
     const NAME: &'static str = "mask";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         // Events off the mask (which the readers' checks against the sensor rule out) are
         // removed rather than read out of bounds.

@@ -22,6 +22,7 @@ impl PolarityFilter {
 impl Rule for PolarityFilter {
     const NAME: &'static str = "polarity";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         event.polarity == self.polarity
     }

@@ -33,6 +33,7 @@ impl Refractory {
 impl Rule for Refractory {
     const NAME: &'static str = "refractory";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         // Off the sensor there is no pixel to hold a period: removed.
         self.surface.index(event.x, event.y).is_some_and(|i| {

@@ -32,6 +32,7 @@ impl Region {
 impl Rule for Region {
     const NAME: &'static str = "region";
 
+    #[inline]
     fn accept(&mut self, event: &Event) -> bool {
         let (x, y) = (u32::from(event.x), u32::from(event.y));
         // `&`, not `&&`: both tests are cheap, and a short-circuit would be a branch on where
