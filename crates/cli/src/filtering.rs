@@ -2,12 +2,15 @@
 //! them, so the flag, its help and the report of what each filter removed have one owner.
 //! `evtac filter` streams a recording through them chunk by chunk; `evtac represent`, which
 //! reads the whole recording into memory, filters it once read, with [`FilterArgs::apply`].
+//! `hot-pixels=auto` learns the recording's hot pixels first, as `evtac stats` measures them:
+//! from the events in memory, or with a pass over the file before a streaming one.
 
 use std::path::Path;
 
-use anyhow::Context;
 use evtac_events::{Event, Resolution};
-use evtac_filters::{Chain, Filter, FilterSpec};
+use evtac_filters::{Chain, FilterSpec};
+pub use evtac_import::filtering::removed;
+use evtac_import::filtering::{Learned, filter_events};
 
 /// The filter flags.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -16,21 +19,25 @@ pub struct FilterArgs {
     /// `background-activity=DURATION`, `fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]`,
     /// `k-noise=DURATION`, `polarity=on|off`, `region=X,Y,W,H`, `refractory=DURATION`,
     /// `circle=CX,CY,R`, `mask=FILE` (keeps the pixels a uint8 H x W NPY or 8-bit greyscale
-    /// PNG marks non-zero), `hot-pixels=FILE` (removes them). Durations take `us`, `ms` or `s`.
+    /// PNG marks non-zero), `hot-pixels=FILE` (removes them), `hot-pixels=auto` (removes the
+    /// hot pixels learned from the recording's stretches at rest, as `evtac stats` finds them).
+    /// Durations take `us`, `ms` or `s`.
     #[arg(long = "filter", value_name = "SPEC")]
     pub filters: Vec<FilterSpec>,
 }
 
 impl FilterArgs {
-    /// The chain of these filters for `sensor`, an error naming the recording at `path` and
-    /// the SPEC that does not fit it.
+    /// The chain of these filters for the recording at `path` on `sensor`, an error naming the
+    /// recording and the SPEC that does not fit it. `hot-pixels=auto` reads the file once here
+    /// to learn its hot pixels.
     pub fn chain(&self, path: &Path, sensor: Resolution) -> anyhow::Result<Chain> {
-        Chain::build(&self.filters, sensor)
-            .with_context(|| format!("{}: the {sensor} sensor", path.display()))
+        let learned = Learned::from_file(path, &Default::default(), &self.filters)?;
+        say_learned(path, &learned);
+        Ok(learned.chain(path, sensor, &self.filters)?)
     }
 
     /// `events` of the recording at `path` through the filters (unchanged when there are none),
-    /// printing on stderr what each removed.
+    /// printing on stderr what each removed; `hot-pixels=auto` learns from `events`.
     pub fn apply(
         &self,
         path: &Path,
@@ -40,9 +47,8 @@ impl FilterArgs {
         if self.filters.is_empty() {
             return Ok(events);
         }
-        let mut chain = self.chain(path, sensor)?;
-        let mut kept = Vec::with_capacity(events.len());
-        chain.retain(&events, &mut kept);
+        let (kept, chain, learned) = filter_events(path, sensor, &self.filters, events)?;
+        say_learned(path, &learned);
         self.say_removed(&removed(&chain));
         Ok(kept)
     }
@@ -55,11 +61,12 @@ impl FilterArgs {
     }
 }
 
-/// Each filter of `chain`, first to last: its name and the events it removed.
-pub fn removed(chain: &Chain) -> Vec<(&'static str, u64)> {
-    chain
-        .filters()
-        .iter()
-        .map(|f| (f.name(), f.removed()))
-        .collect()
+/// Says how many hot pixels `hot-pixels=auto` learned from the recording at `path`, if it ran.
+fn say_learned(path: &Path, learned: &Learned) {
+    if let Some(n) = learned.hot_pixels() {
+        eprintln!(
+            "hot-pixels=auto: {n} hot pixels learned from {}",
+            path.display()
+        );
+    }
 }

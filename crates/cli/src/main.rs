@@ -163,7 +163,10 @@ mod tests {
             seed: 7,
             out: "runs/out".into(),
             data: Some("data sets".into()),
-            inputs: evtac_import::inputs::Inputs::from_flags(true, true),
+            inputs: evtac_import::inputs::Inputs::from_flags(true, true).with_filters(vec![
+                "polarity=on".parse().unwrap(),
+                "hot-pixels=auto".parse().unwrap(),
+            ]),
             noise_levels: Some(vec![0.0, 2.5]),
             fusions: false,
             label_noise_deg: Some(0.0),
@@ -172,12 +175,26 @@ mod tests {
             repeat_split: false,
             grid: Some(evtac_experiments::plan::Grid::Paper),
             recheck: false,
+            capture_filter: None,
+            capture_ablation: false,
         };
         let line = crate::commands::jobs::equivalent_command("evtac", &Job::Reproduce(job.clone()));
         let Command::Reproduce(parsed) = Cli::try_parse_from(&line).unwrap().command else {
             panic!("{line:?} is not a reproduce command");
         };
         assert_eq!(parsed.job(), job);
+        // The other way of setting the ablation: a filter of its own.
+        let own = ReproduceJob {
+            capture_filter: Some("k-noise=2ms".parse().unwrap()),
+            capture_ablation: true,
+            ..job.clone()
+        };
+        let own_line =
+            crate::commands::jobs::equivalent_command("evtac", &Job::Reproduce(own.clone()));
+        let Command::Reproduce(own_parsed) = Cli::try_parse_from(&own_line).unwrap().command else {
+            panic!("{own_line:?} is not a reproduce command");
+        };
+        assert_eq!(own_parsed.job(), own);
         assert_eq!(parsed.workers.jobs, Some(1));
         assert_eq!(
             (

@@ -67,6 +67,50 @@ fn imports_a_session_and_refuses_bad_logs() {
     );
     run_ok(&["check", out_s]);
 
+    // With --filter, every written recording goes through the chain on its own: the trial and
+    // the no-contact recording equal the same files filtered by `evtac filter`.
+    let filtered = dir.path().join("filtered");
+    let mut with_filter = args.to_vec();
+    with_filter[5] = filtered.to_str().unwrap();
+    with_filter.extend([
+        "--filter",
+        "background-activity=10ms",
+        "--filter",
+        "polarity=on",
+    ]);
+    let said = run_ok(&with_filter);
+    // The imported trial (unfiltered, above) and the no-contact recording, filtered by hand.
+    for (from, imported) in [
+        (out.join(&t.file), filtered.join(&t.file)),
+        (no_contact.clone(), filtered.join("no_contact.aedat4")),
+    ] {
+        let by_hand = dir.path().join("by-hand.aedat4");
+        run_ok(&[
+            "filter",
+            from.to_str().unwrap(),
+            by_hand.to_str().unwrap(),
+            "--filter",
+            "background-activity=10ms",
+            "--filter",
+            "polarity=on",
+        ]);
+        let source = read_recording(&from).unwrap();
+        let (want, got) = (
+            read_recording(&by_hand).unwrap(),
+            read_recording(&imported).unwrap(),
+        );
+        assert_eq!(got.events, want.events, "{}", from.display());
+        assert!(got.events.len() < source.events.len(), "{}", from.display());
+        assert_eq!(got.imu, source.imu, "{}", from.display());
+        std::fs::remove_file(by_hand).unwrap();
+    }
+    let stderr = String::from_utf8_lossy(&said.stderr);
+    assert!(
+        stderr.contains("background-activity=10ms: removed "),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&filtered).unwrap();
+
     // Writing over an existing folder, a negative speed, a missing column: errors, nothing new.
     let fails = |args: &[&str], want: &str| {
         let o = evtac().args(args).output().unwrap();

@@ -807,3 +807,98 @@ with open(sys.argv[1], 'rb') as f:
         assert_eq!(counts.get(topic), Some(&rows.len()), "{topic}: {counts:?}");
     }
 }
+
+#[test]
+fn filters_run_as_the_model_records_them_and_others_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (plain, filtered) = (dir.path().join("plain"), dir.path().join("filtered"));
+    bundle(&plain);
+    let representation = Representation {
+        filters: vec!["polarity=on".into(), "region=200,100,240,240".into()],
+        ..Representation::new(ReprConfig::default())
+    };
+    ModelBundle::untrained(4, representation, None)
+        .save(&filtered)
+        .unwrap();
+    let events = dir.path().join("events.csv");
+    std::fs::write(&events, csv_events()).unwrap();
+    let online = |model: &Path, input: &Path, filters: &[&str]| {
+        let mut args = vec![
+            "online".to_string(),
+            "--model".into(),
+            s(model),
+            "--input".into(),
+            s(input),
+            "--sensor".into(),
+            "640x480".into(),
+        ];
+        for f in filters {
+            args.extend(["--filter".to_string(), f.to_string()]);
+        }
+        args
+    };
+    let err = run_err(&as_strs(&online(&filtered, &events, &["polarity=on"])));
+    assert!(
+        err.contains(
+            "was trained on events through polarity=on region=200,100,240,240, and this \
+             run's go through polarity=on: give its filters (--filter polarity=on --filter \
+             region=200,100,240,240)"
+        ),
+        "{err}"
+    );
+    let err = run_err(&as_strs(&online(&plain, &events, &["polarity=on"])));
+    assert!(
+        err.contains("through no filter, and this run's go through polarity=on: give no --filter"),
+        "{err}"
+    );
+
+    // The estimator's filters remove what `evtac filter` removes from the file: the estimates
+    // equal those of the unfiltered model's bundle on the filtered file (the same weights).
+    let run = run_ok(&as_strs(&online(
+        &filtered,
+        &events,
+        &["polarity=on", "region=200,100,240,240"],
+    )));
+    let said = String::from_utf8_lossy(&run.stderr);
+    let cleaned = dir.path().join("cleaned.csv");
+    run_ok(&[
+        "filter",
+        &s(&events),
+        &s(&cleaned),
+        "--sensor",
+        "640x480",
+        "--filter",
+        "polarity=on",
+        "--filter",
+        "region=200,100,240,240",
+    ]);
+    let kept = std::fs::read_to_string(&cleaned).unwrap().lines().count() - 1;
+    assert!(kept > 0 && kept < 20_000);
+    assert!(
+        said.contains(&format!("filters: removed {} events", 20_000 - kept)),
+        "{said}"
+    );
+    let reference = run_ok(&as_strs(&online(&plain, &cleaned, &[])));
+    let values = |out: &[u8]| -> Vec<[String; 3]> {
+        rows(&String::from_utf8_lossy(out))
+            .into_iter()
+            .map(|r| [r[0].clone(), r[1].clone(), r[2].clone()])
+            .collect()
+    };
+    // The filtered file's events start later (the first kept event), so its grid may start
+    // later too: the shared estimate times agree.
+    let (a, b) = (values(&run.stdout), values(&reference.stdout));
+    let common: Vec<_> = a
+        .iter()
+        .filter(|r| b.iter().any(|q| q[0] == r[0]))
+        .collect();
+    assert!(common.len() >= 45, "{} of {}", common.len(), a.len());
+    for r in common {
+        assert!(b.contains(r), "{r:?}");
+    }
+}
+
+fn as_strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
+}

@@ -64,12 +64,24 @@ pub fn tiny_run() -> &'static Path {
     out
 }
 
-/// The arguments of the tiny reproduction (scale tiny, seed 1) into `out`.
+/// The arguments of the tiny reproduction (scale tiny, seed 1) into `out`, with the
+/// capture-filter ablation (`small`'s default, none at `tiny`) so that every test of a tiny
+/// run goes through it too.
 pub fn tiny_args(out: &Path) -> Vec<String> {
     let out = out.to_str().expect("utf-8 path");
-    ["reproduce", "--scale", "tiny", "--seed", "1", "--out", out]
-        .map(String::from)
-        .to_vec()
+    [
+        "reproduce",
+        "--scale",
+        "tiny",
+        "--seed",
+        "1",
+        "--out",
+        out,
+        "--capture-filter",
+        "background-activity=10ms",
+    ]
+    .map(String::from)
+    .to_vec()
 }
 
 /// A decoded 8-bit RGB figure.
@@ -273,6 +285,38 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
     let noisy_model = out.join("models/label-noise/sd0.04/exp1/static/seed1/config.json");
     assert!(noisy_model.is_file(), "{}", noisy_model.display());
     assert!(report.contains("## Label-noise ablation"), "{report}");
+    // The capture-filter ablation: the paper's three on filtered events, paired with Experiment
+    // 1's, their models recording the filter and their features cached apart.
+    let ablation = &results["capture_filter"];
+    assert_eq!(ablation["spec"], "background-activity=10ms");
+    for (filtered, plain) in ablation["filtered"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(ablation["unfiltered"].as_array().unwrap())
+    {
+        assert_eq!(filtered["name"], plain["name"]);
+        assert_eq!(filtered["config"], plain["config"]);
+        assert_eq!(filtered["seeds"], plain["seeds"]);
+        assert!(e1.contains(plain), "{plain} is not Experiment 1's");
+        assert_ne!(
+            filtered["runs"], plain["runs"],
+            "the filter changed nothing"
+        );
+    }
+    assert_eq!(ablation["filtered"].as_array().map(Vec::len), Some(3));
+    let model = out.join("models/capture-filter/exp1/static/seed1/config.json");
+    let config: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(
+        config["representation"]["filters"],
+        serde_json::json!(["background-activity=10ms"])
+    );
+    assert!(
+        report.contains("## Capture-filter ablation")
+            && report.contains("through `background-activity=10ms` on the full sensor"),
+        "{report}"
+    );
     let settings = 3; // continuous-only, pause-motion, pause-motion-stop
     assert_eq!(
         results["exp2"].as_array().map(Vec::len),

@@ -54,3 +54,59 @@ fn rejects_unknown_protocol() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown protocol `exp9`"), "{err}");
 }
+
+#[test]
+fn a_filtering_capture_saves_each_recording_filtered_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let (plain, filtered) = (dir.path().join("plain"), dir.path().join("filtered"));
+    let simulate = |out: &std::path::Path, filters: &[&str]| {
+        let mut args = vec!["simulate", "--protocol", "exp1", "--scale", "tiny"];
+        args.extend(["--limit", "1", "--out", out.to_str().unwrap()]);
+        for f in filters {
+            args.extend(["--filter", f]);
+        }
+        run_ok(&args);
+    };
+    simulate(&plain, &[]);
+    simulate(&filtered, &["background-activity=10ms"]);
+    for file in ["t0000.aedat4", "no_contact.aedat4"] {
+        let by_hand = dir.path().join(format!("by-hand-{file}"));
+        run_ok(&[
+            "filter",
+            plain.join(file).to_str().unwrap(),
+            by_hand.to_str().unwrap(),
+            "--filter",
+            "background-activity=10ms",
+        ]);
+        let want = evtac_formats::read_recording(&by_hand).unwrap();
+        let got = evtac_formats::read_recording(filtered.join(file)).unwrap();
+        let original = evtac_formats::read_recording(plain.join(file)).unwrap();
+        assert_eq!(got.events, want.events, "{file}");
+        assert!(got.events.len() < original.events.len(), "{file}");
+        assert_eq!(got.imu, original.imu, "{file}");
+    }
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(filtered.join("simulator.json")).unwrap()).unwrap();
+    assert_eq!(
+        record["capture"],
+        serde_json::json!(["background-activity=10ms"])
+    );
+    let plain_record = std::fs::read_to_string(plain.join("simulator.json")).unwrap();
+    assert!(!plain_record.contains("capture"));
+
+    let session = dir.path().join("session");
+    let err = crate::common::run_err(&[
+        "simulate",
+        "--protocol",
+        "exp1",
+        "--scale",
+        "tiny",
+        "--session",
+        "--out",
+        session.to_str().unwrap(),
+        "--filter",
+        "polarity=on",
+    ]);
+    assert!(err.contains("a --session is one stream"), "{err}");
+    assert!(!session.exists());
+}

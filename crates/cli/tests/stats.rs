@@ -130,6 +130,78 @@ fn stats_recover_the_simulated_noise_and_simulate_params_uses_them() {
         fit_events > 3 * default_events,
         "{fit_events} vs {default_events}"
     );
+
+    hot_pixels_are_learned_written_and_removed(dir.path(), &session.join("session.aedat4"));
+}
+
+/// `stats --hot-pixels` writes the 25 simulated hot pixels as a mask, `--filter
+/// hot-pixels=auto` removes the same pixels as `--filter hot-pixels=MASK`, and the recording
+/// filtered so has no hot pixel left.
+fn hot_pixels_are_learned_written_and_removed(dir: &std::path::Path, recording: &std::path::Path) {
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let mask = dir.join("hot.npy");
+    let said = run_ok(&["stats", &s(recording), "--hot-pixels", &s(&mask)]);
+    assert!(String::from_utf8_lossy(&said.stdout).contains("(25 hot pixels of 640x480)"));
+    let mask: ndarray::Array2<u8> = ndarray_npy::read_npy(&mask).unwrap();
+    let marked: std::collections::BTreeSet<(u16, u16)> = mask
+        .indexed_iter()
+        .filter(|(_, v)| **v != 0)
+        .map(|((y, x), _)| (x as u16, y as u16))
+        .collect();
+    // Independently: the 25 busiest pixels of the recording out of contact, where every pixel
+    // but the hot ones fires at the background's rate.
+    let rest = evtac_formats::read_recording(recording.with_file_name("no_contact.aedat4"))
+        .unwrap()
+        .events;
+    let mut counts = std::collections::HashMap::<(u16, u16), u32>::new();
+    rest.iter()
+        .for_each(|e| *counts.entry((e.x, e.y)).or_default() += 1);
+    let mut busiest: Vec<_> = counts.into_iter().collect();
+    busiest.sort_by_key(|&(p, n)| (std::cmp::Reverse(n), p));
+    let top: std::collections::BTreeSet<_> = busiest[..25].iter().map(|&(p, _)| p).collect();
+    assert_eq!(marked, top);
+
+    let (auto, file) = (dir.join("auto.aedat4"), dir.join("file.aedat4"));
+    let out = run_ok(&[
+        "filter",
+        &s(recording),
+        &s(&auto),
+        "--filter",
+        "hot-pixels=auto",
+    ]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("hot-pixels=auto: 25 hot pixels learned from"),
+        "{said}"
+    );
+    run_ok(&[
+        "filter",
+        &s(recording),
+        &s(&file),
+        "--filter",
+        &format!("hot-pixels={}", dir.join("hot.npy").display()),
+    ]);
+    let original = evtac_formats::read_recording(recording).unwrap();
+    let kept: Vec<_> = original
+        .events
+        .iter()
+        .filter(|e| !marked.contains(&(e.x, e.y)))
+        .copied()
+        .collect();
+    assert!(kept.len() < original.events.len());
+    assert_eq!(evtac_formats::read_recording(&auto).unwrap().events, kept);
+    assert_eq!(evtac_formats::read_recording(&file).unwrap().events, kept);
+
+    let json = run_ok(&[
+        "stats",
+        &s(recording),
+        "--json",
+        "--filter",
+        "hot-pixels=auto",
+    ]);
+    let stats: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(stats["hot"], serde_json::json!([]), "{stats}");
+    assert_eq!(stats["events"], kept.len());
 }
 
 #[test]

@@ -46,3 +46,53 @@ fn bad_arguments_fail_with_a_message() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("trials.csv"));
 }
+
+#[test]
+fn a_dataset_opened_with_filters_trains_a_model_that_records_them() {
+    let data = tiny_run().join("data").join("exp1");
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
+    let spec = "background-activity=10ms";
+    run_ok(&[
+        "train", d, "--repr", "static", "--epochs", "1", "--seed", "4", "--out", m, "--filter",
+        spec,
+    ]);
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(model.join("config.json")).unwrap()).unwrap();
+    assert_eq!(
+        config["representation"]["filters"],
+        serde_json::json!([spec]),
+        "{config}"
+    );
+    // The filtered features are cached apart from the unfiltered ones, and say so.
+    let cached: Vec<std::path::PathBuf> =
+        std::fs::read_dir(data.join(evtac_events::layout::CACHE_DIR))
+            .unwrap()
+            .flat_map(|s| std::fs::read_dir(s.unwrap().path()).unwrap())
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.join("config.json").is_file())
+            .filter(|p| {
+                std::fs::read_to_string(p.join("config.json"))
+                    .unwrap()
+                    .contains(spec)
+            })
+            .collect();
+    assert!(!cached.is_empty());
+    for dir in &cached {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(name.rsplit('-').next().unwrap().starts_with('f'), "{name}");
+    }
+
+    // Evaluating it on the dataset without the filters is refused, with them it runs.
+    let refused = crate::common::run_err(&["evaluate", "--model", m, d]);
+    assert!(
+        refused.contains(&format!(
+            "filters: the features' events went through no filter, the model's through {spec}"
+        )),
+        "{refused}"
+    );
+    let out = run_ok(&["evaluate", "--model", m, d, "--json", "--filter", spec]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["mae"][0]["overall"].as_f64().unwrap().is_finite());
+}

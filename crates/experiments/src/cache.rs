@@ -23,7 +23,7 @@ use evtac_events::manifest::TrialMeta;
 use evtac_events::output::write_atomic;
 use evtac_learn::FeatureSet;
 use evtac_repr::CROP;
-use evtac_repr::{FeatureExtractor, Mask, ReprConfig};
+use evtac_repr::{FeatureExtractor, FeatureProvenance, Mask, ReprConfig};
 use ndarray::Array2;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -173,6 +173,19 @@ impl<'a> FeatureCache<'a> {
         Ok(mask)
     }
 
+    /// What `config`'s features from this dataset are made of (representation, crop, mask and
+    /// the dataset's filters), to compare with a model's.
+    pub fn provenance(&self, config: &ReprConfig) -> Result<FeatureProvenance, Error> {
+        let filters = self
+            .ds
+            .inputs
+            .filters
+            .iter()
+            .map(|f| f.to_string())
+            .collect();
+        Ok(FeatureProvenance::new(config, CROP, self.mask(config)?.as_ref()).with_filters(filters))
+    }
+
     fn sampling_dir(&self, sampling: Sampling) -> PathBuf {
         self.ds.dir.join(CACHE_DIR).join(sampling.key())
     }
@@ -180,11 +193,11 @@ impl<'a> FeatureCache<'a> {
     /// The folder of `config`'s features under `sampling`.
     pub fn config_dir(&self, config: &ReprConfig, sampling: Sampling) -> Result<PathBuf, Error> {
         let mask = self.mask(config)?;
-        Ok(self.sampling_dir(sampling).join(format!(
-            "{}-{}",
-            config.cache_key(),
-            dataset::mask_id(mask.as_ref())
-        )))
+        let mut name = format!("{}-{}", config.cache_key(), dataset::mask_id(mask.as_ref()));
+        if let Some(filters) = dataset::filters_id(&self.ds.inputs.filters) {
+            name = format!("{name}-{filters}");
+        }
+        Ok(self.sampling_dir(sampling).join(name))
     }
 
     /// The labels at `trial`'s samples: keyed by what the labels were computed with (the
@@ -243,11 +256,14 @@ impl<'a> FeatureCache<'a> {
         for (dir, (config, mask)) in dirs.iter().zip(configs.iter().zip(&masks)) {
             let meta = dir.join("config.json");
             if !meta.is_file() {
-                let json = serde_json::json!({
+                let mut json = serde_json::json!({
                     "representation": config,
                     "mask": dataset::mask_id(mask.as_ref()),
                     "sampling": sampling,
                 });
+                if !self.ds.inputs.filters.is_empty() {
+                    json["filters"] = serde_json::json!(self.ds.inputs.filters);
+                }
                 crate::jobs::create_parent(&meta)
                     .and_then(|()| write_atomic(&meta, json.to_string().as_bytes()))
                     .map_err(io(&meta))?;

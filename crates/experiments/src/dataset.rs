@@ -11,6 +11,7 @@ use evtac_events::layout::{LABELS_DIR, NO_CONTACT_FILE, SIMULATOR_FILE};
 use evtac_events::manifest::{Manifest, TrialMeta};
 use evtac_events::output::write_atomic;
 use evtac_events::{Event, Resolution, Roi};
+use evtac_filters::FilterSpec;
 use evtac_import::inputs::{Inputs, MaskSource, NO_MASK_FLAG};
 use evtac_labels::geometry::Calibration;
 use evtac_labels::{LabelConfig, LabelSeries, LabelSource};
@@ -68,6 +69,10 @@ pub enum Error {
     /// The splits file is broken or does not match the manifest.
     #[error(transparent)]
     Splits(#[from] splits::Error),
+    /// A recording's events could not go through the dataset's filters (a SPEC that does not
+    /// fit its sensor, `hot-pixels=auto` with nothing to learn from).
+    #[error(transparent)]
+    Filter(evtac_import::sensor_stats::StatsError),
     /// The mask could not be built.
     #[error("{path}: mask: {source}")]
     Mask {
@@ -161,13 +166,23 @@ fn crop_of(sensor: Resolution, path: &Path) -> Result<Roi, Error> {
 
 /// Reads a recording's events, cropped to the centered [`CROP`], in time order.
 pub fn read_cropped(path: &Path) -> Result<Vec<Event>, Error> {
-    Ok(read_in_crop(path)?.1)
+    Ok(read_in_crop(path, &[])?.1)
 }
 
-/// A recording's centered [`CROP`] on its sensor, and its events cropped to it.
-fn read_in_crop(path: &Path) -> Result<(Roi, Vec<Event>), Error> {
+/// [`read_cropped`] of the recording's events through `filters` on the full sensor, before the
+/// crop (so a region, a circle or a neighbourhood means on the sensor what it means in
+/// `evtac filter`).
+pub fn read_filtered_cropped(path: &Path, filters: &[FilterSpec]) -> Result<Vec<Event>, Error> {
+    Ok(read_in_crop(path, filters)?.1)
+}
+
+/// A recording's centered [`CROP`] on its sensor, and its events through `filters`, cropped
+/// to it.
+fn read_in_crop(path: &Path, filters: &[FilterSpec]) -> Result<(Roi, Vec<Event>), Error> {
     let (sensor, events) = read_full(path)?;
     let roi = crop_of(sensor, path)?;
+    let (events, _, _) = evtac_import::filtering::filter_events(path, sensor, filters, events)
+        .map_err(Error::Filter)?;
     let mut cropped = Vec::with_capacity(events.len());
     roi.crop_into(&events, &mut cropped);
     Ok((roi, cropped))
@@ -328,9 +343,9 @@ impl Dataset {
         sampling.times((meta.motion_start_us, meta.motion_end_us), stop)
     }
 
-    /// The events of `meta`'s recording cropped to [`CROP`].
+    /// The events of `meta`'s recording through the dataset's filters, cropped to [`CROP`].
     pub fn events(&self, meta: &TrialMeta) -> Result<Vec<Event>, Error> {
-        read_cropped(&self.dir.join(&meta.file))
+        read_filtered_cropped(&self.dir.join(&meta.file), &self.inputs.filters)
     }
 
     /// The no-contact recording, or `None` when the dataset was opened without a mask.
@@ -338,7 +353,7 @@ impl Dataset {
         if self.inputs.mask == MaskSource::Unmasked {
             return Ok(None);
         }
-        let (roi, cropped) = read_in_crop(&self.dir.join(NO_CONTACT_FILE))?;
+        let (roi, cropped) = read_in_crop(&self.dir.join(NO_CONTACT_FILE), &self.inputs.filters)?;
         Ok(Some(NoContact { roi, cropped }))
     }
 
@@ -374,4 +389,30 @@ pub fn mask_id(mask: Option<&Mask>) -> String {
             format!("mask{hex}")
         }
     }
+}
+
+/// A short identity of the filters for cache keys: `None` without filters (so the keys of
+/// unfiltered features are what they were before filters existed), else `f` and the first 12
+/// hex digits of the SHA-256 of the SPECs in order and of every mask file they read, so that
+/// editing a mask in place never reuses features made with the old one.
+pub fn filters_id(filters: &[FilterSpec]) -> Option<String> {
+    if filters.is_empty() {
+        return None;
+    }
+    let mut hasher = Sha256::new();
+    for spec in filters {
+        hasher.update(spec.to_string().as_bytes());
+        hasher.update(b"\n");
+        if let FilterSpec::Mask { path } | FilterSpec::HotPixels { path } = spec {
+            // A file that cannot be read fails when the filter is built, before any feature.
+            hasher.update(std::fs::read(path).unwrap_or_default());
+        }
+    }
+    let hex: String = hasher
+        .finalize()
+        .iter()
+        .take(6)
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Some(format!("f{hex}"))
 }

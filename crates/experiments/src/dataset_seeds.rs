@@ -77,7 +77,8 @@ pub fn run(
             simulating: Stage::DatasetSeedSimulating,
             training: (FeatureSet::DatasetSeed, Stage::DatasetSeedTraining),
         };
-        let (_, results) = variant::exp1_on(&sim.config(seed), &at, (reprs, ds1.inputs), run)?;
+        let (_, results) =
+            variant::exp1_on(&sim.config(seed), &at, (reprs, ds1.inputs.clone()), run)?;
         all.extend(points(seed, &results));
     }
     Ok(all)

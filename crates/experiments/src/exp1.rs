@@ -100,7 +100,7 @@ pub(crate) fn seed_jobs(
         for &seed in seeds {
             v.push(TrainJob {
                 dataset: ds.dir.clone(),
-                inputs: ds.inputs,
+                inputs: ds.inputs.clone(),
                 splits_seed,
                 spec: TrainSpec {
                     repr,

@@ -198,6 +198,14 @@ pub struct ReproduceJob {
     /// ([`Plan::recheck_top`]; `--no-recheck` leaves it out). Absent: it is.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub recheck: bool,
+    /// The capture-filter ablation's filter instead of the plan's (`--capture-filter`), or
+    /// `None` for the plan's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capture_filter: Option<evtac_filters::FilterSpec>,
+    /// Whether the capture-filter ablation runs when the plan has one (`--no-capture-filter`
+    /// leaves it out). Absent from older jobs files: it does.
+    #[serde(default = "yes", skip_serializing_if = "is_yes")]
+    pub capture_ablation: bool,
 }
 
 impl ReproduceJob {
@@ -238,6 +246,12 @@ impl ReproduceJob {
         }
         if let Some(n) = self.datasets {
             plan.datasets = n;
+        }
+        if let Some(spec) = &self.capture_filter {
+            plan.capture_filter = Some(spec.clone());
+        }
+        if !self.capture_ablation {
+            plan.capture_filter = None;
         }
         if self.repeats.is_some() && self.data.is_some() {
             return Err(PlanError::RepeatsOfGivenData);
@@ -467,6 +481,8 @@ mod tests {
                 repeat_split: false,
                 grid: Some(Grid::Paper),
                 recheck: false,
+                capture_filter: Some("k-noise=2ms".parse().unwrap()),
+                capture_ablation: true,
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

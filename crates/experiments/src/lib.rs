@@ -58,6 +58,7 @@
 //! ```
 
 pub mod cache;
+pub mod capture_filter;
 pub mod choices;
 pub mod context;
 pub mod dataset;

@@ -77,7 +77,7 @@ pub fn run(
             simulating: Stage::NoiseSimulating,
             training: (FeatureSet::Noise, Stage::NoiseTraining),
         };
-        let (ds, results) = variant::exp1_on(&config, &at, (reprs, ds1.inputs), run)?;
+        let (ds, results) = variant::exp1_on(&config, &at, (reprs, ds1.inputs.clone()), run)?;
         all.extend(points(level, background_rate(&ds, seconds)?, &results));
     }
     Ok(all)

@@ -11,9 +11,9 @@ use crate::jobs;
 use crate::plan::Plan;
 use crate::progress::Progress;
 use crate::results::{
-    DatasetSeedPoint, ExampleTrial, Exp1Repr, Exp2Cell, Exp2Setting, Exp3Point, LabelCheck,
-    LabelNoise, LatencyCell, NoisePoint, PacedLatencyCell, RepeatSplit, ReprExample, Results,
-    RunInfo, SensorView, Tuning,
+    CaptureFilter, DatasetSeedPoint, ExampleTrial, Exp1Repr, Exp2Cell, Exp2Setting, Exp3Point,
+    LabelCheck, LabelNoise, LatencyCell, NoisePoint, PacedLatencyCell, RepeatSplit, ReprExample,
+    Results, RunInfo, SensorView, Tuning,
 };
 use crate::splits::{Split, Splits};
 use crate::stage::{Stage, Timed};
@@ -21,8 +21,8 @@ use crate::stage_log::StageLog;
 use crate::training;
 use crate::tuning::{self, Kind};
 use crate::{
-    choices, dataset_seeds, examples, exp1, exp2, exp3, label_check, label_noise, latency, noise,
-    repeat_split, repr_example, sensor_view,
+    capture_filter, choices, dataset_seeds, examples, exp1, exp2, exp3, label_check, label_noise,
+    latency, noise, repeat_split, repr_example, sensor_view,
 };
 use evtac_events::manifest::TrialMeta;
 use evtac_import::inputs::Inputs;
@@ -129,7 +129,7 @@ pub fn reproduce(
         log,
     };
     let models = out.join("models");
-    let ds1 = Dataset::open(&data.exp1, data.inputs)?;
+    let ds1 = Dataset::open(&data.exp1, data.inputs.clone())?;
     let splits1 = ds1.splits(seed)?;
     let cache1 = FeatureCache::new(&ds1)?;
     let mut datasets = vec![(Protocol::Exp1, ds1.manifest.trials.len())];
@@ -144,7 +144,7 @@ pub fn reproduce(
     let exp1_sim = ds1.simulator()?;
     let on2 = match &data.exp2 {
         Some(dir) => {
-            let on2 = on_exp2(dir, data.inputs, &on1.reprs, &run)?;
+            let on2 = on_exp2(dir, data.inputs.clone(), &on1.reprs, &run)?;
             datasets.push((Protocol::Exp2, on2.trials));
             stages.done(Timed::Exp2)?;
             Some(on2)
@@ -175,7 +175,7 @@ pub fn reproduce(
             stage_seconds: Vec::new(),
             stage_history: Vec::new(),
             datasets,
-            inputs: Some(data.inputs),
+            inputs: Some(data.inputs.clone()),
         },
         tuning: vec![on1.st, on1.dt],
         exp1: on1.e1,
@@ -185,6 +185,7 @@ pub fn reproduce(
         latency: lat,
         noise: on1.noise,
         label_noise: on1.label_noise,
+        capture_filter: on1.capture_filter,
         example,
         choices: choices::of_run(
             plan,
@@ -218,6 +219,7 @@ struct OnExp1 {
     dataset_seeds: Vec<DatasetSeedPoint>,
     repeat_split: Option<RepeatSplit>,
     label_noise: Option<LabelNoise>,
+    capture_filter: Option<CaptureFilter>,
 }
 
 /// Tuning, Experiment 1 and the studies built on it, each stage timed in `stages` as it
@@ -254,6 +256,10 @@ fn on_exp1(
     if label_noise.is_some() {
         stages.done(Timed::LabelNoise)?;
     }
+    let capture_filter = capture_filter::run(ds1, splits1, &reprs, &e1, run)?;
+    if capture_filter.is_some() {
+        stages.done(Timed::CaptureFilter)?;
+    }
     Ok(OnExp1 {
         st,
         dt,
@@ -263,6 +269,7 @@ fn on_exp1(
         dataset_seeds,
         repeat_split,
         label_noise,
+        capture_filter,
     })
 }
 
@@ -351,7 +358,7 @@ fn on_exp3(
         (&data.exp3_depth, Axis::Depth, &depths),
     ] {
         let Some(dir) = dir else { continue };
-        let ds = Dataset::open(dir, data.inputs)?;
+        let ds = Dataset::open(dir, data.inputs.clone())?;
         datasets.push((
             match axis {
                 Axis::Speed => Protocol::Exp3Speed,
@@ -439,7 +446,7 @@ pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
 /// Makes the splits (and needs the Experiment 1 dataset).
 pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Result<Vec<Job>, Error> {
     let models = out.join("models");
-    let ds1 = Dataset::open(&data.exp1, data.inputs)?;
+    let ds1 = Dataset::open(&data.exp1, data.inputs.clone())?;
     ds1.splits(seed)?;
     let mut jobs = Vec::new();
     let mut tuned = Vec::new();
@@ -481,8 +488,9 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
         let reprs = exp1::of_plan(plan, s, d);
         let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);
         train.extend(label_noise::jobs(&ds1, &reprs, plan, seed, &models));
+        train.extend(capture_filter::jobs((&ds1, &reprs), plan, seed, &models)?);
         if let Some(d2) = &data.exp2 {
-            let ds2 = Dataset::open(d2, data.inputs)?;
+            let ds2 = Dataset::open(d2, data.inputs.clone())?;
             ds2.splits(seed)?;
             train.extend(exp2::jobs(&ds2, &reprs, plan, seed, &models));
         }

@@ -198,6 +198,18 @@ pub struct LabelNoise {
     pub noisy: Vec<Exp1Repr>,
 }
 
+/// The capture-filter ablation: Experiment 1's paper representations on events through the
+/// lab's capture filter (`crate::capture_filter`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaptureFilter {
+    /// The filter, as its SPEC (`background-activity=10ms`).
+    pub spec: String,
+    /// Experiment 1's results for the same representations (unfiltered events).
+    pub unfiltered: Vec<Exp1Repr>,
+    /// The same representations, settings and seeds trained and tested on the filtered events.
+    pub filtered: Vec<Exp1Repr>,
+}
+
 /// Experiment 1 at one background-noise level, for one representation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NoisePoint {
@@ -782,6 +794,9 @@ pub struct Results {
     /// The label-noise ablation (absent when the plan has none, and from older results).
     #[serde(default)]
     pub label_noise: Option<LabelNoise>,
+    /// The capture-filter ablation (absent when the plan has none, and from older results).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capture_filter: Option<CaptureFilter>,
     /// What the sensor figure shows: its view is not in JSON but its kind is, so that the
     /// report's caption can be rebuilt from `results.json` alone. Absent from older results.
     #[serde(default)]

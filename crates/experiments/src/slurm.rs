@@ -272,7 +272,7 @@ impl Slurm {
             check(slurm, "simulate", &job, &unfinished, &logs)?;
         }
         let data = Datasets {
-            inputs: reproduction.inputs,
+            inputs: reproduction.inputs.clone(),
             ..Datasets::in_dir(
                 reproduction
                     .data

@@ -35,6 +35,8 @@ pub enum Timed {
     RepeatsTogether,
     /// Experiment 1 trained on noisy labels.
     LabelNoise,
+    /// Experiment 1 on events through the lab's capture filter.
+    CaptureFilter,
     /// Experiment 2.
     Exp2,
     /// Experiment 3.
@@ -57,6 +59,7 @@ impl Timed {
             Timed::Exp1OtherDatasets => "experiment 1 on other datasets",
             Timed::RepeatsTogether => "repeats kept together",
             Timed::LabelNoise => "label-noise ablation",
+            Timed::CaptureFilter => "capture-filter ablation",
             Timed::Exp2 => "experiment 2",
             Timed::Exp3 => "experiment 3",
             Timed::Latency => "latency",
@@ -96,6 +99,8 @@ pub enum FeatureSet {
     Noise,
     /// Experiment 1 on a dataset simulated with another seed.
     DatasetSeed,
+    /// Experiment 1 on events through the lab's capture filter.
+    CaptureFilter,
 }
 
 /// One stage of a reproduction; its units of work are given with it.
@@ -128,6 +133,8 @@ pub enum Stage {
     /// Experiment 1's paper representations on the split that keeps each condition's repeats
     /// on one side (units: runs).
     RepeatSplitTraining,
+    /// Experiment 1's paper representations on events through the capture filter (units: runs).
+    CaptureFilterTraining,
 }
 
 impl std::fmt::Display for Stage {
@@ -152,6 +159,8 @@ impl std::fmt::Display for Stage {
             Stage::DatasetSeedSimulating => f.write_str("simulating exp1 with other seeds"),
             Stage::DatasetSeedTraining => f.write_str("other datasets' training"),
             Stage::RepeatSplitTraining => f.write_str("repeats-together training"),
+            Stage::Features(FeatureSet::CaptureFilter) => f.write_str("features (capture filter)"),
+            Stage::CaptureFilterTraining => f.write_str("capture-filter training"),
         }
     }
 }
@@ -274,7 +283,8 @@ impl CostModel {
             | Stage::NoiseTraining
             | Stage::LabelNoiseTraining
             | Stage::DatasetSeedTraining
-            | Stage::RepeatSplitTraining => units * plan.epochs as f64 * train(counts.exp1),
+            | Stage::RepeatSplitTraining
+            | Stage::CaptureFilterTraining => units * plan.epochs as f64 * train(counts.exp1),
             Stage::Exp2Training => units * plan.epochs as f64 * train(counts.exp2),
             Stage::Latency => {
                 let trials = plan.latency_trials.min(counts.exp1.div_ceil(6).max(1));
@@ -337,6 +347,13 @@ impl CostModel {
                 Stage::LabelNoiseTraining,
                 ReprKind::PAPER.len() * plan.seeds,
             );
+        }
+        if plan.capture_filter.is_some() {
+            sum += c(Stage::Features(FeatureSet::CaptureFilter), counts.exp1)
+                + c(
+                    Stage::CaptureFilterTraining,
+                    ReprKind::PAPER.len() * plan.seeds,
+                );
         }
         sum
     }

@@ -149,6 +149,13 @@ pub fn train_job(
             stop_points: spec.sampling.stop_points,
         }),
         phases: spec.phases.iter().map(|p| p.as_str().to_string()).collect(),
+        filters: cache
+            .dataset()
+            .inputs
+            .filters
+            .iter()
+            .map(|f| f.to_string())
+            .collect(),
         ..Representation::new(spec.repr)
     };
     let bundle = ModelBundle::from_trained(trained, cfg, representation, mask);
@@ -166,7 +173,7 @@ pub fn run_job(
     on_trial: &(dyn Fn(bool) + Sync),
     on_epoch: impl FnMut(&EpochRecord),
 ) -> Result<Mae, Error> {
-    let ds = Dataset::open(&job.dataset, job.inputs)?;
+    let ds = Dataset::open(&job.dataset, job.inputs.clone())?;
     let splits = ds.splits(job.splits_seed)?;
     let cache = FeatureCache::new(&ds)?;
     let trials: Vec<_> = ds.manifest.trials.iter().collect();

@@ -78,7 +78,7 @@ pub fn job(
 ) -> TrainJob {
     TrainJob {
         dataset: ds.dir.clone(),
-        inputs: ds.inputs,
+        inputs: ds.inputs.clone(),
         splits_seed: seed,
         spec: TrainSpec {
             repr: config,

@@ -36,7 +36,7 @@ fn missing_files_are_refused_unless_opted_out() {
 
     // Opting out is honoured even when the files are there.
     let out = Inputs::from_flags(true, true);
-    let ds = Dataset::open(dir.path(), out).unwrap();
+    let ds = Dataset::open(dir.path(), out.clone()).unwrap();
     assert_eq!(ds.calibration, Calibration::default());
     assert!(ds.no_contact().unwrap().is_none());
 
@@ -49,8 +49,9 @@ fn missing_files_are_refused_unless_opted_out() {
     let identity = Inputs {
         calibration: CalibrationSource::Identity,
         mask: MaskSource::NoContact,
+        filters: Vec::new(),
     };
-    let ds = Dataset::open(dir.path(), identity).unwrap();
+    let ds = Dataset::open(dir.path(), identity.clone()).unwrap();
     assert_eq!(ds.calibration, Calibration::default());
     assert!(ds.no_contact().unwrap().is_some());
 

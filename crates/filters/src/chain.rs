@@ -26,9 +26,19 @@ impl Chain {
 
     /// The chain of `specs` built for `sensor`, or the first spec's error.
     pub fn build(specs: &[FilterSpec], sensor: Resolution) -> Result<Self, Error> {
+        Self::build_with(specs, sensor, None)
+    }
+
+    /// [`Self::build`], with the hot pixels learned from the recording to be filtered for
+    /// `hot-pixels=auto` ([`FilterSpec::build_with`]).
+    pub fn build_with(
+        specs: &[FilterSpec],
+        sensor: Resolution,
+        hot_pixels: Option<&[(u16, u16)]>,
+    ) -> Result<Self, Error> {
         let filters = specs
             .iter()
-            .map(|spec| spec.build(sensor))
+            .map(|spec| spec.build_with(sensor, hot_pixels))
             .collect::<Result<_, _>>()?;
         Ok(Self::new(filters))
     }

@@ -15,7 +15,8 @@
 //! | `refractory=DURATION` | [`Refractory`] | C++ `dv::RefractoryPeriodFilter` (not in the Python bindings) |
 //! | `circle=CX,CY,R` | [`Circle`] | none |
 //! | `mask=FILE` | [`Mask`] | `dv.EventMaskFilter` |
-//! | `hot-pixels=FILE` | [`Mask::removing`] | none (`dv.EventMaskFilter` with the mask inverted) |
+//! | `hot-pixels=FILE` | [`HotPixels`] | none (`dv.EventMaskFilter` with the mask inverted) |
+//! | `hot-pixels=auto` | [`HotPixels`], of the hot pixels learned from the recording | none |
 //!
 //! A [`FilterSpec`] is parsed from a SPEC and built for a sensor; a [`Chain`] applies several in
 //! order, as `dv.EventFilterChain` does.
@@ -50,6 +51,7 @@ mod circle;
 mod counted;
 mod duration;
 mod fast_decay;
+mod hot_pixels;
 mod k_noise;
 mod mask;
 pub mod mask_file;
@@ -65,6 +67,7 @@ pub use circle::Circle;
 pub use counted::{Counted, Rule};
 pub use duration::{Micros, ParseDurationError};
 pub use fast_decay::FastDecay;
+pub use hot_pixels::HotPixels;
 pub use k_noise::KNoise;
 pub use mask::Mask;
 pub use polarity::PolarityFilter;

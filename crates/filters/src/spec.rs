@@ -12,9 +12,13 @@
 //! | `circle=CX,CY,R` | keep the disc `(x-CX)^2 + (y-CY)^2 <= R^2` |
 //! | `mask=FILE` | keep the pixels a uint8 `H x W` mask (NPY or 8-bit greyscale PNG) marks non-zero |
 //! | `hot-pixels=FILE` | remove the pixels such a mask marks non-zero (a mask of hot pixels) |
+//! | `hot-pixels=auto` | remove the hot pixels learned from the recording being filtered |
 //!
 //! DURATIONs take a unit: `us`, `ms` or `s` (`500us`, `2ms`, `1.5ms`). A SPEC written back
-//! ([`std::fmt::Display`]) parses to the same filter.
+//! ([`std::fmt::Display`]) parses to the same filter. `hot-pixels=auto` is the one SPEC that needs
+//! more than the sensor to be built: the hot pixels of the recording it filters, which the caller
+//! learns (as `evtac stats` measures them, `evtac_import::sensor_stats::hot_pixels`) and hands to
+//! [`FilterSpec::build_with`]. A mask file named `auto` is written `hot-pixels=./auto`.
 
 use std::fmt;
 use std::path::PathBuf;
@@ -24,8 +28,8 @@ use evtac_events::Resolution;
 
 use crate::duration::{Micros, ParseDurationError};
 use crate::{
-    BackgroundActivity, Circle, FastDecay, Filter, KNoise, Mask, PolarityFilter, Refractory,
-    Region, Rule, mask_file,
+    BackgroundActivity, Circle, FastDecay, Filter, HotPixels, KNoise, Mask, PolarityFilter,
+    Refractory, Region, Rule, mask_file,
 };
 
 /// The filters' names, as SPECs begin.
@@ -103,6 +107,9 @@ pub enum FilterSpec {
         /// The mask of hot pixels, as for `mask=`.
         path: PathBuf,
     },
+    /// `hot-pixels=auto`: [`Mask::removing`] the hot pixels learned from the recording being
+    /// filtered (see [`FilterSpec::build_with`]).
+    HotPixelsAuto,
 }
 
 /// A SPEC that does not parse, or a filter that does not fit the sensor.
@@ -204,6 +211,17 @@ pub enum Error {
         /// Why it is no mask.
         reason: String,
     },
+    /// `hot-pixels=auto` where nothing was learned: no recording to learn from (a live input,
+    /// say), or a caller that builds without learning.
+    #[error(
+        "filter `{spec}`: learns the hot pixels from the recording it filters, and there is none \
+         to learn from here; learn them from a recording with `evtac stats RECORDING \
+         --hot-pixels MASK.npy` and give `hot-pixels=MASK.npy`"
+    )]
+    NotLearned {
+        /// The SPEC, written back.
+        spec: String,
+    },
     /// A mask of another size than the sensor.
     #[error("filter `{spec}`: the mask is {found} (columns x rows), the sensor {sensor}")]
     MaskSize {
@@ -226,7 +244,8 @@ const USAGE_REGION: &str = "region=X,Y,W,H, e.g. region=40,0,240,240";
 const USAGE_REFRACTORY: &str = "refractory=DURATION, e.g. refractory=250us";
 const USAGE_CIRCLE: &str = "circle=CX,CY,R, e.g. circle=120,120,110";
 const USAGE_MASK: &str = "mask=FILE, a uint8 H x W NPY array or 8-bit greyscale PNG";
-const USAGE_HOT_PIXELS: &str = "hot-pixels=FILE, a uint8 H x W NPY array or 8-bit greyscale PNG";
+const USAGE_HOT_PIXELS: &str =
+    "hot-pixels=FILE (a uint8 H x W NPY array or 8-bit greyscale PNG) or hot-pixels=auto";
 
 impl FromStr for FilterSpec {
     type Err = Error;
@@ -270,6 +289,9 @@ impl FromStr for FilterSpec {
             let path = PathBuf::from(value.trim());
             if path.as_os_str().is_empty() {
                 return Err(p.values());
+            }
+            if name == "hot-pixels" && value.trim() == "auto" {
+                return Ok(Self::HotPixelsAuto);
             }
             return Ok(if name == "mask" {
                 Self::Mask { path }
@@ -426,14 +448,37 @@ impl FilterSpec {
             Self::Refractory { .. } => NAMES[5],
             Self::Circle { .. } => NAMES[6],
             Self::Mask { .. } => NAMES[7],
-            Self::HotPixels { .. } => NAMES[8],
+            Self::HotPixels { .. } | Self::HotPixelsAuto => NAMES[8],
         }
+    }
+
+    /// Whether building this filter needs what is learned from the recording it filters
+    /// (`hot-pixels=auto`).
+    pub fn learns(&self) -> bool {
+        matches!(self, Self::HotPixelsAuto)
     }
 
     /// The filter for `sensor`, or why it does not fit: a region must lie wholly on the sensor,
     /// a circle's centre on it, a mask be the sensor's size (its file is read here).
+    /// `hot-pixels=auto` is an error here ([`Error::NotLearned`]): see [`Self::build_with`].
     pub fn build(&self, sensor: Resolution) -> Result<Box<dyn Filter>, Error> {
+        self.build_with(sensor, None)
+    }
+
+    /// [`Self::build`], with the hot pixels (column, row) learned from the recording to be
+    /// filtered for `hot-pixels=auto`; pixels off the sensor are ignored.
+    pub fn build_with(
+        &self,
+        sensor: Resolution,
+        hot_pixels: Option<&[(u16, u16)]>,
+    ) -> Result<Box<dyn Filter>, Error> {
         Ok(match *self {
+            Self::HotPixelsAuto => {
+                let hot = hot_pixels.ok_or_else(|| Error::NotLearned {
+                    spec: self.to_string(),
+                })?;
+                Box::new(HotPixels::at(sensor, hot).counted())
+            }
             Self::Mask { ref path } | Self::HotPixels { ref path } => {
                 let image = mask_file::read(path).map_err(|reason| Error::MaskFile {
                     spec: self.to_string(),
@@ -449,7 +494,7 @@ impl FilterSpec {
                 }
                 match self {
                     Self::Mask { .. } => Box::new(Mask::new(sensor, &image.values).counted()),
-                    _ => Box::new(Mask::removing(sensor, &image.values).counted()),
+                    _ => Box::new(HotPixels::new(sensor, &image.values).counted()),
                 }
             }
             Self::BackgroundActivity { duration } => {
@@ -523,9 +568,32 @@ impl fmt::Display for FilterSpec {
             } => write!(f, "{name}={x},{y},{width},{height}"),
             Self::Circle { cx, cy, radius } => write!(f, "{name}={cx},{cy},{radius}"),
             Self::Mask { path } | Self::HotPixels { path } => {
-                write!(f, "{name}={}", path.display())
+                // A file named `auto` keeps a directory part, so it does not read back as auto.
+                let shown = if path.as_os_str() == "auto" {
+                    std::path::Path::new(".").join(path)
+                } else {
+                    path.clone()
+                };
+                write!(f, "{name}={}", shown.display())
             }
+            Self::HotPixelsAuto => write!(f, "{name}=auto"),
         }
+    }
+}
+
+impl serde::Serialize for FilterSpec {
+    /// As its SPEC ([`fmt::Display`]), so a file that records filters says them as a user
+    /// types them.
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for FilterSpec {
+    /// From its SPEC, the parse error as the serde error.
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let spec = String::deserialize(deserializer)?;
+        spec.parse().map_err(serde::de::Error::custom)
     }
 }
 
@@ -624,6 +692,9 @@ mod tests {
             "region=1,2,3,4",
             "refractory=250us",
             "circle=119.5,120,110.25",
+            "hot-pixels=auto",
+            "hot-pixels=./auto",
+            "mask=masks/a,b.npy",
         ] {
             let spec = parse(s).unwrap();
             assert_eq!(spec.to_string(), s);
@@ -684,6 +755,53 @@ mod tests {
         );
         assert!(message("circle=1,2,0").contains("the radius `0` is not a positive number"));
         assert!(message("circle=1,inf,3").contains("the centre row `inf` is not a finite number"));
+    }
+
+    #[test]
+    fn specs_serialize_as_they_are_written() {
+        let specs: Vec<FilterSpec> = ["background-activity=10ms", "hot-pixels=auto"]
+            .iter()
+            .map(|s| parse(s).unwrap())
+            .collect();
+        let json = serde_json::to_string(&specs).unwrap();
+        assert_eq!(json, r#"["background-activity=10ms","hot-pixels=auto"]"#);
+        assert_eq!(
+            serde_json::from_str::<Vec<FilterSpec>>(&json).unwrap(),
+            specs
+        );
+        let err = serde_json::from_str::<FilterSpec>(r#""k-noise=0ms""#).unwrap_err();
+        assert!(err.to_string().contains("filter `k-noise=0ms`"), "{err}");
+    }
+
+    #[test]
+    fn hot_pixels_auto_removes_what_was_learned_and_only_then() {
+        let sensor = Resolution::new(4, 3);
+        let spec = parse("hot-pixels=auto").unwrap();
+        assert!(spec.learns() && !parse("hot-pixels=auto.npy").unwrap().learns());
+        assert_eq!(
+            parse("hot-pixels=./auto"),
+            Ok(FilterSpec::HotPixels {
+                path: "./auto".into()
+            })
+        );
+        let err = spec.build(sensor).map(|f| f.name()).unwrap_err();
+        assert!(
+            err.to_string().starts_with(
+                "filter `hot-pixels=auto`: learns the hot pixels from the recording it filters"
+            ),
+            "{err}"
+        );
+        // (9, 9) is off the sensor and ignored.
+        let mut f = spec.build_with(sensor, Some(&[(1, 2), (9, 9)])).unwrap();
+        let e = |x, y| evtac_events::Event {
+            t: 0,
+            x,
+            y,
+            polarity: true,
+        };
+        assert!(!f.keep(&e(1, 2)));
+        assert!(f.keep(&e(2, 1)) && f.keep(&e(0, 0)));
+        assert_eq!((f.name(), f.removed()), ("hot-pixels", 1));
     }
 
     #[test]

@@ -160,7 +160,7 @@ fn dv_json(spec: &FilterSpec) -> String {
             spec.name(),
             path.to_str().unwrap()
         ),
-        FilterSpec::Refractory { .. } | FilterSpec::Circle { .. } => {
+        FilterSpec::Refractory { .. } | FilterSpec::Circle { .. } | FilterSpec::HotPixelsAuto => {
             panic!("{spec} has no dv-processing class")
         }
     }
@@ -403,5 +403,48 @@ fn fast_decay_rounds_as_dv_processing_does() {
     assert_eq!(cases.len(), 16, "thresholds where the roundings differ");
     let streams: Vec<Vec<Event>> = streams.iter().map(|s| s.to_vec()).collect();
     let dir = tempfile::tempdir().unwrap();
+    compare(&streams, &cases, dir.path());
+}
+
+#[test]
+fn simulated_trials_filter_as_in_dv_processing() {
+    if evtac_testkit::python().is_none() {
+        return;
+    }
+    // Two trials of the simulator (640x480, its background noise and hot pixels, a contact
+    // moving across the dome): the events the experiments' datasets are made of.
+    let params = evtac_sim::SimParams::default();
+    let sim = evtac_sim::Simulator::new(params.clone(), 3);
+    let specs_of = evtac_sim::plan(
+        evtac_sim::Protocol::Exp1,
+        evtac_sim::Scale::Tiny,
+        3,
+        &params.timeline,
+    );
+    let sensor = Resolution::new(params.camera.width, params.camera.height);
+    let streams: Vec<Vec<Event>> = specs_of[..2]
+        .iter()
+        .map(|s| sim.simulate(s).events)
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases = Vec::new();
+    let mut add = |spec: &str, stream: usize, batches: usize| {
+        let seed = cases.len() as u64 + 300;
+        let n = streams[stream].len();
+        cases.push(Case {
+            name: format!("{spec} on simulated trial {stream}"),
+            specs: specs(spec),
+            sensor,
+            stream,
+            ours: random_cuts(seed, n, batches),
+            theirs: random_cuts(seed + 1000, n, batches + 11),
+            mixed: true,
+        });
+    };
+    add("background-activity=10ms", 0, 30);
+    add("fast-decay", 1, 20);
+    add("k-noise=1ms", 0, 25);
+    add("background-activity=10ms region=200,120,240,240", 1, 15);
+    add("polarity=on k-noise=2ms", 1, 10);
     compare(&streams, &cases, dir.path());
 }

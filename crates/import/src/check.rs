@@ -102,7 +102,11 @@ fn dataset_dirs(dir: &Path) -> Vec<PathBuf> {
 
 /// Checks the dataset in `dir` (or each of the datasets `reproduce --data` would read from it)
 /// as it would be opened with `inputs`; `progress` follows the recordings read.
-pub fn check(dir: &Path, inputs: Inputs, progress: &(dyn Fn(CheckProgress) + Sync)) -> CheckReport {
+pub fn check(
+    dir: &Path,
+    inputs: &Inputs,
+    progress: &(dyn Fn(CheckProgress) + Sync),
+) -> CheckReport {
     let mut report = CheckReport::default();
     // A folder that is not there, or holds nothing, is said as such rather than as the first
     // file a dataset would need (`exp1/trials.csv cannot be read`).
@@ -135,7 +139,7 @@ pub fn check(dir: &Path, inputs: Inputs, progress: &(dyn Fn(CheckProgress) + Syn
 
 fn check_dataset(
     dir: &Path,
-    inputs: Inputs,
+    inputs: &Inputs,
     progress: &(dyn Fn(CheckProgress) + Sync),
     report: &mut CheckReport,
 ) {
@@ -450,7 +454,7 @@ fn group_problems(path: &Path, trials: &[(usize, TrialMeta)]) -> Vec<Problem> {
     out
 }
 
-fn calibration_problems(dir: &Path, inputs: Inputs) -> Vec<Problem> {
+fn calibration_problems(dir: &Path, inputs: &Inputs) -> Vec<Problem> {
     if inputs.calibration == CalibrationSource::Identity {
         return Vec::new();
     }
@@ -478,7 +482,7 @@ fn calibration_problems(dir: &Path, inputs: Inputs) -> Vec<Problem> {
     }
 }
 
-fn no_contact_problems(dir: &Path, inputs: Inputs) -> Vec<Problem> {
+fn no_contact_problems(dir: &Path, inputs: &Inputs) -> Vec<Problem> {
     if inputs.mask == MaskSource::Unmasked {
         return Vec::new();
     }

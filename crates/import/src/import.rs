@@ -46,7 +46,7 @@ pub enum NoContact {
 }
 
 /// What an import writes besides the trials.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ImportConfig {
     /// Kept before each onset, us.
     pub pre_us: i64,
@@ -60,6 +60,11 @@ pub struct ImportConfig {
     /// the commanded motion (recordings without IMU accepted; written to
     /// `label_source.json`).
     pub labels: LabelSource,
+    /// Event filters every written recording (each trial and the no-contact recording) goes
+    /// through, each file on its own from its first event (a trial's `pre_us` before the onset
+    /// gives the filters their history); IMU and triggers untouched. None: the events as
+    /// recorded.
+    pub filters: Vec<evtac_filters::FilterSpec>,
 }
 
 /// Errors of an import; nothing is left in the output folder after any of them.
@@ -84,6 +89,9 @@ pub enum ImportError {
     /// The manifest could not be written.
     #[error(transparent)]
     Manifest(#[from] evtac_events::manifest::ManifestError),
+    /// A written recording could not go through the filters.
+    #[error(transparent)]
+    Filter(#[from] crate::sensor_stats::StatsError),
     /// The imported trials do not make a usable dataset; each line names the log's line.
     #[error("{} problem(s) with the imported trials:\n{}", .0.len(), .0.join("\n"))]
     Problems(Vec<String>),
@@ -100,6 +108,9 @@ pub struct ImportSummary {
     pub events: u64,
     /// How the session's ranges were found (the first trial's; the same file for all).
     pub index: Option<RangeIndex>,
+    /// Each filter's name and the events it removed over every written recording, in order
+    /// (empty without filters); `events` counts what they kept.
+    pub removed: Vec<(&'static str, u64)>,
 }
 
 /// One recording and the log of the motions to cut from it.
@@ -368,6 +379,7 @@ fn write_all(
         trials: parts.iter().map(|p| p.log.rows.len()).sum(),
         events: 0,
         index: None,
+        removed: Vec::new(),
     };
     let no_contact = dir.join(NO_CONTACT_FILE);
     let mut outside = Vec::new();
@@ -428,6 +440,30 @@ fn write_all(
     if let Some(NoContact::File(path)) = &config.no_contact {
         copy_range(path, None, &no_contact)?;
     }
+    if !config.filters.is_empty() {
+        summary.events = 0;
+        let trials = parts
+            .iter()
+            .flat_map(|p| p.log.rows.iter().map(|(_, t)| &t.file));
+        let files: Vec<PathBuf> = trials.map(|f| dir.join(f)).collect();
+        for (k, file) in files
+            .iter()
+            .chain(no_contact.is_file().then_some(&no_contact))
+            .enumerate()
+        {
+            let (removed, kept) = crate::filtering::filter_in_place(file, &config.filters)?;
+            if k < files.len() {
+                summary.events += kept;
+            }
+            if summary.removed.is_empty() {
+                summary.removed = removed;
+            } else {
+                for (sum, (_, n)) in summary.removed.iter_mut().zip(removed) {
+                    sum.1 += n;
+                }
+            }
+        }
+    }
     if config.labels != LabelSource::Imu {
         config.labels.write(dir).map_err(ImportError::LabelSource)?;
     }
@@ -465,8 +501,9 @@ fn write_all(
         } else {
             MaskSource::Unmasked
         },
+        filters: Vec::new(),
     };
-    let report = check::check(dir, inputs, &|_| {});
+    let report = check::check(dir, &inputs, &|_| {});
     if !report.problems.is_empty() {
         return Err(ImportError::Problems(
             report

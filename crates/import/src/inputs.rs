@@ -2,7 +2,10 @@
 //! dataset without `calibration.json` or `no_contact.aedat4` is refused unless the caller opts out
 //! explicitly (`--identity-calibration`, `--no-mask`), because running a real sensor's data with
 //! the identity rotation or without a mask changes the labels and the static features without a
-//! word. The report states which were used (`evtac_experiments::results::RunInfo`).
+//! word. The report states which were used (`evtac_experiments::results::RunInfo`). The event
+//! filters every recording of the dataset goes through are part of the same record: they
+//! change what every representation sees, so they travel with the dataset wherever it is opened
+//! (a training job, a cache key, a model bundle's provenance).
 
 use evtac_labels::CalibrationSource;
 use serde::{Deserialize, Serialize};
@@ -23,21 +26,41 @@ pub enum MaskSource {
     Unmasked,
 }
 
-/// The calibration and mask a dataset is opened with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// The calibration, mask and event filters a dataset is opened with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Inputs {
     /// The IMU-to-sensor rotation.
     pub calibration: CalibrationSource,
     /// The no-contact mask.
     pub mask: MaskSource,
+    /// The event filters every recording of the dataset (its trials and its no-contact
+    /// recording) goes through on the full sensor, before the crop, in order. Absent from
+    /// files written before filters: none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filters: Vec<evtac_filters::FilterSpec>,
 }
 
 impl Inputs {
-    /// Both from the dataset's files (what simulated datasets have).
+    /// Both from the dataset's files (what simulated datasets have), no filter.
     pub const FROM_FILES: Inputs = Inputs {
         calibration: CalibrationSource::File,
         mask: MaskSource::NoContact,
+        filters: Vec::new(),
     };
+
+    /// These inputs with the recordings through `filters`.
+    pub fn with_filters(self, filters: Vec<evtac_filters::FilterSpec>) -> Inputs {
+        Inputs { filters, ..self }
+    }
+
+    /// The filters in words, for the report: the SPECs in order, or `none`.
+    pub fn filters_text(&self) -> String {
+        if self.filters.is_empty() {
+            return "none".to_string();
+        }
+        let specs: Vec<String> = self.filters.iter().map(|f| format!("`{f}`")).collect();
+        specs.join(", ")
+    }
 
     /// The inputs the two opt-out flags ask for.
     pub fn from_flags(identity_calibration: bool, no_mask: bool) -> Inputs {
@@ -52,6 +75,7 @@ impl Inputs {
             } else {
                 MaskSource::NoContact
             },
+            filters: Vec::new(),
         }
     }
 
@@ -95,5 +119,23 @@ mod tests {
         let out = Inputs::from_flags(true, true);
         assert!(out.calibration_text().contains("--identity-calibration"));
         assert!(out.mask_text().contains("--no-mask"));
+        assert_eq!(Inputs::FROM_FILES.filters_text(), "none");
+        let filtered =
+            Inputs::FROM_FILES.with_filters(vec!["background-activity=10ms".parse().unwrap()]);
+        assert_eq!(filtered.filters_text(), "`background-activity=10ms`");
+    }
+
+    #[test]
+    fn filters_are_absent_from_the_json_when_there_are_none() {
+        let plain = serde_json::to_string(&Inputs::FROM_FILES).unwrap();
+        assert!(!plain.contains("filters"), "{plain}");
+        let filtered = Inputs::FROM_FILES.with_filters(vec!["polarity=on".parse().unwrap()]);
+        let json = serde_json::to_string(&filtered).unwrap();
+        assert!(json.ends_with(r#","filters":["polarity=on"]}"#), "{json}");
+        assert_eq!(serde_json::from_str::<Inputs>(&json).unwrap(), filtered);
+        assert_eq!(
+            serde_json::from_str::<Inputs>(&plain).unwrap(),
+            Inputs::FROM_FILES
+        );
     }
 }

@@ -7,6 +7,8 @@
 //! - [`check`]: a dataset validated before training, every problem listed (`evtac check`), as
 //!   it would be opened with [`inputs`]: whether its calibration and mask come from its files
 //!   or were opted out of.
+//! - [`filtering`]: a recording's events through event filters, `hot-pixels=auto` learned from
+//!   the recording itself.
 //! - [`sensor_stats`]: what a recording says about its sensor (noise at rest, hot pixels, the
 //!   IMU's noise and bias), as simulator parameters (`evtac stats`).
 //!
@@ -26,6 +28,7 @@
 //!     no_contact: Some(NoContact::File("no_contact.aedat4".into())),
 //!     calibration: Some("calibration.json".into()),
 //!     labels: evtac_labels::LabelSource::Imu,
+//!     filters: Vec::new(),
 //! };
 //! let out = Path::new("data/exp1");
 //! let summary = import_session(Path::new("session.aedat4"), &log, out, &config, &|| {})?;
@@ -34,6 +37,7 @@
 //! ```
 
 pub mod check;
+pub mod filtering;
 pub mod import;
 pub mod imu_sync;
 pub mod inputs;

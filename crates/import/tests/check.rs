@@ -10,7 +10,7 @@ use evtac_sim::Protocol;
 use std::path::Path;
 
 fn run(dir: &Path, inputs: Inputs) -> CheckReport {
-    check(dir, inputs, &|_| {})
+    check(dir, &inputs, &|_| {})
 }
 
 /// Each problem as (file name, line, field, problem text).

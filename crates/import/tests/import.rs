@@ -94,6 +94,7 @@ fn config(ds: &Path, no_contact_end: i64) -> ImportConfig {
         no_contact: Some(NoContact::Range(0, no_contact_end)),
         calibration: Some(ds.join("calibration.json")),
         labels: evtac_labels::LabelSource::Imu,
+        filters: Vec::new(),
     }
 }
 
@@ -159,7 +160,7 @@ fn an_imported_session_gives_back_the_simulated_trials() {
         std::fs::read(out.join("calibration.json")).unwrap(),
         std::fs::read(ds.join("calibration.json")).unwrap()
     );
-    assert_eq!(check(&out, Inputs::FROM_FILES, &|_| {}).problems, []);
+    assert_eq!(check(&out, &Inputs::FROM_FILES, &|_| {}).problems, []);
     let leftovers = std::fs::read_dir(dir.path())
         .unwrap()
         .filter(|e| {

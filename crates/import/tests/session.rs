@@ -48,9 +48,10 @@ pub fn import(dir: &Path, log: &RobotLog, name: &str) -> std::path::PathBuf {
         no_contact: Some(NoContact::File(session.join("no_contact.aedat4"))),
         calibration: Some(session.join("calibration.json")),
         labels: evtac_labels::LabelSource::Imu,
+        filters: Vec::new(),
     };
     import_session(&session.join("session.aedat4"), log, &out, &config, &|| {}).unwrap();
-    assert_eq!(check(&out, Inputs::FROM_FILES, &|_| {}).problems, []);
+    assert_eq!(check(&out, &Inputs::FROM_FILES, &|_| {}).problems, []);
     out
 }
 

@@ -231,6 +231,12 @@ pub struct Representation {
     /// The trial phases trained on (`motion`, `stop`), when the writer knows (provenance).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<String>,
+    /// The event filters the training recordings went through before the representation, as
+    /// SPECs in order (`background-activity=10ms`); absent for unfiltered events, so bundles
+    /// from before filters read the same. Features for this model must have gone through the
+    /// same ([`crate::Model::feature_provenance`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filters: Vec<String>,
 }
 
 impl Representation {
@@ -241,6 +247,7 @@ impl Representation {
             frame: CROP,
             sampling: None,
             phases: Vec::new(),
+            filters: Vec::new(),
         }
     }
 }

@@ -62,6 +62,7 @@ impl Model {
             self.representation().frame,
             self.mask(),
         )
+        .with_filters(self.representation().filters.clone())
     }
 
     /// Predictions (pitch, roll) for `features`, `N x 900` row-major.

@@ -31,6 +31,7 @@ use crate::frames::{FrameCapture, FrameSet};
 use crate::latency::LatencyStats;
 use crate::schedule::{self, Schedule};
 use evtac_events::{Event, Resolution, Roi};
+use evtac_filters::{Chain, Filter};
 use evtac_learn::{Model, Predictor, StreamingPredictor};
 use evtac_repr::{CROP, FeatureExtractor, Mask, ReprConfig, SensorTooSmall};
 use std::time::{Duration, Instant};
@@ -82,6 +83,8 @@ pub struct Counters {
     pub events_in_roi: u64,
     /// Events skipped because they were older than one already received.
     pub events_out_of_order: u64,
+    /// Events the filters removed ([`Estimator::filter_with`]).
+    pub events_filtered: u64,
     /// Event time of the first and the latest event.
     pub span_us: Option<(i64, i64)>,
 }
@@ -107,6 +110,9 @@ pub struct Estimator {
     mask: Option<Mask>,
     /// Frames taken at a lower rate than the estimates, when asked for.
     frames: Option<FrameCapture>,
+    /// The event filters every event goes through before the crop, when the model's features
+    /// were made from filtered events ([`Self::filter_with`]).
+    filter: Option<Chain>,
 }
 
 impl std::fmt::Debug for Estimator {
@@ -163,6 +169,7 @@ impl Estimator {
             representation: *representation,
             mask: mask.cloned(),
             frames: None,
+            filter: None,
         })
     }
 
@@ -199,6 +206,12 @@ impl Estimator {
     }
 
     /// The crop applied to incoming events.
+    /// Sends every event through `filter` (on the full sensor, before the crop) first, as the
+    /// model's training recordings went through it.
+    pub fn filter_with(&mut self, filter: Chain) {
+        self.filter = Some(filter);
+    }
+
     pub fn roi(&self) -> Roi {
         self.roi
     }
@@ -249,6 +262,14 @@ impl Estimator {
             self.floor = e.t;
             first.get_or_insert(e.t);
             latest = Some(e.t);
+            // A removed event still proves that time has moved on (the grid above), only the
+            // representation does not see it.
+            if let Some(filter) = &mut self.filter
+                && !filter.keep(&e)
+            {
+                self.counters.events_filtered += 1;
+                continue;
+            }
             // Left of or above the crop wraps to past its size: the crop lies on a sensor of
             // at most 65535 columns and rows, so `x0 + width` stays below 65536.
             let (x, y) = (e.x.wrapping_sub(x0), e.y.wrapping_sub(y0));

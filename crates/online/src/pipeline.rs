@@ -244,6 +244,7 @@ pub fn run_until<S: EventSource + 'static>(
     summary.events_in_roi = counters.events_in_roi;
     summary.events_dropped = dropped;
     summary.events_out_of_order = counters.events_out_of_order;
+    summary.events_filtered = counters.events_filtered;
     // Sources connect before the run starts (see `input::open`): every connection during the
     // run is a reconnection.
     summary.reconnects = connections;

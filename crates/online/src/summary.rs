@@ -52,6 +52,8 @@ pub struct Summary {
     /// Events skipped because they were older than an event already received (a stream out of
     /// time order, e.g. a camera restarted behind a reconnection).
     pub events_out_of_order: u64,
+    /// Events the filters removed before the region of interest (with `--filter`).
+    pub events_filtered: u64,
     /// Successful reconnections of a network input.
     pub reconnects: u32,
     /// Event time of the first and last event received, in microseconds.
@@ -85,6 +87,7 @@ impl Summary {
             events_in_roi: 0,
             events_dropped: 0,
             events_out_of_order: 0,
+            events_filtered: 0,
             reconnects: 0,
             span_us: None,
             wall: Duration::ZERO,
@@ -137,6 +140,9 @@ impl std::fmt::Display for Summary {
             "events: {} received, {} in the region of interest, {} dropped, {} out of order",
             self.events, self.events_in_roi, self.events_dropped, self.events_out_of_order
         )?;
+        if self.events_filtered > 0 {
+            writeln!(f, "filters: removed {} events", self.events_filtered)?;
+        }
         if let Some((first, last)) = self.span_us {
             writeln!(
                 f,

@@ -1,9 +1,10 @@
 //! `evtac.filter` and `Recording.filter`: events through a chain of filters given as the
-//! command line's SPECs (`evtac_filters`), with the events each filter removed.
+//! command line's SPECs (`evtac_filters`), with the events each filter removed;
+//! `hot-pixels=auto` learns the hot pixels from the events given (`evtac_import::filtering`).
 
 use evtac_events::Resolution;
 use evtac_events::check::EventCheck;
-use evtac_filters::{Chain, Filter, FilterSpec};
+use evtac_filters::{Filter, FilterSpec};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 
@@ -29,9 +30,13 @@ pub fn run(
     EventCheck::new(Some(resolution))
         .check(&events)
         .map_err(|e| error::value(format!("events to filter: {e}")))?;
-    let mut chain = Chain::build(&specs, resolution).map_err(error::value)?;
-    let mut kept = Vec::new();
-    chain.retain(&events, &mut kept);
+    let (kept, chain, _) = evtac_import::filtering::filter_events(
+        std::path::Path::new("the events"),
+        resolution,
+        &specs,
+        events,
+    )
+    .map_err(error::value)?;
     let removed = specs
         .iter()
         .zip(chain.filters())

@@ -64,3 +64,26 @@ def test_bad_specs_and_events_are_value_errors(aedat):
         evtac.filter(rec.events, (100, 100), ["polarity=on"])
     with pytest.raises(ValueError, match="resolution"):
         evtac.filter(rec.events, None, ["polarity=on"])
+
+
+def test_hot_pixels_auto_learns_from_the_events_as_the_cli_does(cli, tmp_path):
+    # 2 s of sparse background on a 32x32 sensor, every bin alike (all at rest), and one pixel
+    # firing every millisecond: the one hot pixel.
+    t = np.arange(0, 2_000_000, 1_000, dtype=np.int64)
+    background = np.zeros(len(t), dtype=evtac.EVENT_DTYPE)
+    background["t"], background["x"], background["y"] = t, (t // 1000) % 32, (t // 32000) % 32
+    background["p"] = 1
+    hot = np.zeros(len(t), dtype=evtac.EVENT_DTYPE)
+    hot["t"], hot["x"], hot["y"], hot["p"] = t, 7, 9, 1
+    events = np.sort(np.concatenate([background, hot]), order="t", kind="stable")
+    kept, removed = evtac.filter(events, (32, 32), ["hot-pixels=auto"], counts=True)
+    at_hot = (events["x"] == 7) & (events["y"] == 9)
+    assert removed == [("hot-pixels=auto", int(at_hot.sum()))]
+    np.testing.assert_array_equal(kept, events[~at_hot])
+    path = tmp_path / "events.npy"
+    np.save(path, events)
+    out = tmp_path / "kept.npy"
+    cli("filter", str(path), str(out), "--sensor", "32x32", "--filter", "hot-pixels=auto")
+    np.testing.assert_array_equal(kept, evtac.read(out, resolution=(32, 32)).events)
+    with pytest.raises(ValueError, match="hot-pixels=auto learns the hot pixels"):
+        evtac.filter(events[:0], (32, 32), ["hot-pixels=auto"])

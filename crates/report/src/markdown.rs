@@ -10,11 +10,13 @@ use evtac_repr::ReprKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod capture_filter;
 mod dataset_seeds;
 mod fusion;
 mod label_noise;
 mod labels;
 mod paced_latency;
+mod paired;
 mod repeat_split;
 mod tuning;
 mod verdict;
@@ -412,9 +414,16 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     if let Some(inputs) = &r.run.inputs {
         let _ = writeln!(
             md,
-            "Calibration: {}. No-contact mask: {}.\n",
+            "Calibration: {}. No-contact mask: {}.{}\n",
             inputs.calibration_text(),
-            inputs.mask_text()
+            inputs.mask_text(),
+            match inputs.filters.is_empty() {
+                true => String::new(),
+                false => format!(
+                    " Event filters on every recording, before the crop: {}.",
+                    inputs.filters_text()
+                ),
+            }
         );
     }
     let _ = writeln!(
@@ -536,6 +545,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     repeat_split::section(&mut md, r.repeat_split.as_ref());
     noise_section(&mut md, r, figures);
     md.push_str(&label_noise::section(r.label_noise.as_ref()));
+    md.push_str(&capture_filter::section(r.capture_filter.as_ref()));
 
     let _ = writeln!(
         md,

@@ -14,6 +14,7 @@
 //! seed (see [`crate::protocol::trial_seed`]), so the same seed gives the same bytes whatever
 //! the number of threads.
 
+use crate::capture::{AsSimulated, Capture};
 use evtac_events::layout::{CALIBRATION_FILE, NO_CONTACT_FILE, SIMULATOR_FILE, TRUTH_DIR};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -57,6 +58,14 @@ pub enum DatasetError {
     /// The manifest could not be written.
     #[error(transparent)]
     Manifest(#[from] ManifestError),
+    /// The capture could not save a recording (a filter that does not fit the sensor).
+    #[error("{name}: {reason}")]
+    Capture {
+        /// The recording's file name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
     /// A JSON file could not be serialised.
     #[error("cannot serialise {path}: {source}")]
     Json {
@@ -115,6 +124,10 @@ struct SimulatorRecord<'a> {
     trials: usize,
     hot_pixels: Vec<(u16, u16, f64)>,
     params: &'a SimParams,
+    /// What the capture did to the events before saving them ([`Capture::describe`]), absent
+    /// when they are saved as simulated.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    capture: Vec<String>,
 }
 
 /// The camera seed of a dataset seed.
@@ -151,9 +164,13 @@ pub(crate) struct Setup {
     pub trials: Vec<TrialSpec>,
 }
 
-/// Creates `out_dir` and its truth folder, writes the no-contact recording and the
-/// calibration, and returns the sensor and the trials of `config`.
-pub(crate) fn set_up(config: &DatasetConfig, out_dir: &Path) -> Result<Setup, DatasetError> {
+/// Creates `out_dir` and its truth folder, writes the no-contact recording (as `capture` saves
+/// it) and the calibration, and returns the sensor and the trials of `config`.
+pub(crate) fn set_up(
+    config: &DatasetConfig,
+    out_dir: &Path,
+    capture: &dyn Capture,
+) -> Result<Setup, DatasetError> {
     let truth_dir = out_dir.join(TRUTH_DIR);
     std::fs::create_dir_all(&truth_dir).map_err(|source| DatasetError::Io {
         path: truth_dir.clone(),
@@ -162,7 +179,12 @@ pub(crate) fn set_up(config: &DatasetConfig, out_dir: &Path) -> Result<Setup, Da
     let sim = Simulator::new(config.params.clone(), camera_seed(config.seed));
     let camera = &config.params.camera;
     let resolution = Resolution::new(camera.width, camera.height);
-    let rest = sim.simulate_rest(trial_seed(config.seed, usize::MAX - 1));
+    let rest = captured(
+        capture,
+        NO_CONTACT_FILE,
+        resolution,
+        sim.simulate_rest(trial_seed(config.seed, usize::MAX - 1)),
+    )?;
     write_recording(
         &out_dir.join(NO_CONTACT_FILE),
         &rest,
@@ -185,17 +207,28 @@ pub fn simulate_dataset(
     out_dir: &Path,
     on_trial_done: impl Fn(&TrialMeta) + Sync,
 ) -> Result<Manifest, DatasetError> {
+    simulate_captured(config, out_dir, &AsSimulated, on_trial_done)
+}
+
+/// [`simulate_dataset`], every recording's events saved as `capture` saves them (a filtering
+/// capture's); `simulator.json` says what it did.
+pub fn simulate_captured(
+    config: &DatasetConfig,
+    out_dir: &Path,
+    capture: &dyn Capture,
+    on_trial_done: impl Fn(&TrialMeta) + Sync,
+) -> Result<Manifest, DatasetError> {
     let Setup {
         sim,
         resolution,
         trials,
-    } = set_up(config, out_dir)?;
+    } = set_up(config, out_dir, capture)?;
     let total = config.params.timeline.total_deg;
     let metas = trials
         .par_iter()
         .map(|spec| {
-            let recording = sim.simulate(spec);
             let file = evtac_events::layout::trial_file(&spec.name);
+            let recording = captured(capture, &file, resolution, sim.simulate(spec))?;
             let truth = format!("{TRUTH_DIR}/{}.csv", spec.name);
             write_recording(
                 &out_dir.join(&file),
@@ -222,10 +255,29 @@ pub fn simulate_dataset(
             trials: manifest.trials.len(),
             hot_pixels: sim.pixel_array().hot_pixels(),
             params: &config.params,
+            capture: capture.describe(),
         },
     )?;
     manifest.write(out_dir)?;
     Ok(manifest)
+}
+
+/// `recording` with its events as `capture` saves them under the name `name`.
+fn captured(
+    capture: &dyn Capture,
+    name: &str,
+    resolution: Resolution,
+    mut recording: TrialRecording,
+) -> Result<TrialRecording, DatasetError> {
+    let events = std::mem::take(&mut recording.events);
+    recording.events =
+        capture
+            .save(name, resolution, events)
+            .map_err(|reason| DatasetError::Capture {
+                name: name.to_string(),
+                reason,
+            })?;
+    Ok(recording)
 }
 
 /// Writes a recording's events and IMU samples as an AEDAT4 file of a `resolution` sensor.

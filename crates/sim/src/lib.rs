@@ -15,6 +15,7 @@
 //! assert!(!recording.events.is_empty() && !recording.imu.is_empty());
 //! ```
 
+pub mod capture;
 pub mod dataset;
 pub mod dvs;
 pub mod imu;
@@ -26,7 +27,8 @@ pub mod sensor;
 pub mod session;
 pub mod trial;
 
-pub use dataset::{DatasetConfig, DatasetError, simulate_dataset};
+pub use capture::{AsSimulated, Capture};
+pub use dataset::{DatasetConfig, DatasetError, simulate_captured, simulate_dataset};
 pub use params::SimParams;
 pub use params_file::{ParamsError, read_params};
 pub use protocol::{Design, Motion, Protocol, Scale, TrialSpec, plan, plan_design};

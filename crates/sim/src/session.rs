@@ -153,7 +153,7 @@ pub fn simulate_session(
         sim,
         resolution,
         trials,
-    } = set_up(dataset, out_dir)?;
+    } = set_up(dataset, out_dir, &crate::capture::AsSimulated)?;
 
     // Gaps are whole IMU periods, so that the IMU keeps its rate across the whole session.
     let period_us = (1e6 / dataset.params.imu.rate_hz.max(1.0)).round().max(1.0) as i64;

@@ -28,7 +28,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let bar = crate::progress::bar(0, "reading");
     let report = args.workers.pool()?.install(|| {
-        check::check(&args.dir, args.inputs.inputs(), &|p| match p {
+        check::check(&args.dir, &args.inputs.inputs(), &|p| match p {
             CheckProgress::Recordings(n) => bar.inc_length(n),
             CheckProgress::Read => bar.inc(1),
         })

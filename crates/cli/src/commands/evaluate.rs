@@ -9,7 +9,6 @@ use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::splits::Split;
 use evtac_experiments::training;
 use evtac_learn::Model;
-use evtac_repr::{CROP, FeatureProvenance};
 use std::path::PathBuf;
 
 /// Arguments of `evtac evaluate`.
@@ -58,11 +57,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let config = model.repr_config();
     // The features are the model's representation on the model's crop, but masked with this
     // dataset's no-contact mask: a different mask is different features.
-    let made = FeatureProvenance::new(&config, CROP, cache.mask(&config)?.as_ref());
+    let made = cache.provenance(&config)?;
     if let Some(why) = made.mismatch(&model.feature_provenance()) {
         anyhow::bail!(
             "the features of {} do not match the model {}: {why} (the dataset's \
-             no_contact.aedat4, or --no-mask, gives the mask; the model was trained with another)",
+             no_contact.aedat4, or --no-mask, gives the mask, and --filter the filters; the \
+             model was trained with others)",
             args.dataset.display(),
             args.model.display()
         );

@@ -125,6 +125,10 @@ pub struct Args {
     /// label_source.json, so every command labels the dataset this way).
     #[arg(long, value_enum, default_value_t = LabelsArg::Imu, value_name = "SOURCE")]
     pub labels: LabelsArg,
+    // Every written recording (each trial, the no-contact recording) goes through these, each
+    // file on its own from its first event (the trial's --pre-ms gives them their history).
+    #[command(flatten)]
+    pub filter: crate::filtering::FilterArgs,
 }
 
 /// `--labels`: [`LabelSource`] on the command line.
@@ -447,6 +451,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
         calibration: args.calibration.clone(),
         labels: args.labels.into(),
+        filters: args.filter.filters.clone(),
     };
     let trials = parts.iter().map(|p| p.log.rows.len()).sum::<usize>();
     let sources = args
@@ -462,6 +467,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(reason) = summary.index.as_ref().and_then(|i| i.fallback()) {
         eprintln!("note: the recordings were read from their start for every trial: {reason}");
     }
+    args.filter.say_removed(&summary.removed);
     println!(
         "imported {} trials ({} events) from {sources} into {}",
         summary.trials,

@@ -143,7 +143,7 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if let Some(data) = &j.data {
                 args.extend(["--data".into(), path(data)]);
             }
-            args.extend(InputArgs::of(j.inputs).words());
+            args.extend(InputArgs::of(&j.inputs).words());
             if let Some(levels) = &j.noise_levels {
                 let levels: Vec<String> = levels.iter().map(f64::to_string).collect();
                 args.extend(["--noise-levels".into(), levels.join(",")]);
@@ -168,6 +168,12 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             }
             if !j.recheck {
                 args.push("--no-recheck".into());
+            }
+            if let Some(spec) = &j.capture_filter {
+                args.extend(["--capture-filter".into(), spec.to_string()]);
+            }
+            if !j.capture_ablation {
+                args.push("--no-capture-filter".into());
             }
         }
         Job::SensitivityPoint(j) => {
@@ -207,7 +213,7 @@ fn train_args(j: &TrainJob) -> Vec<String> {
             args.push("--train-on-stop".into());
         }
     }
-    args.extend(InputArgs::of(j.inputs).words());
+    args.extend(InputArgs::of(&j.inputs).words());
     args.extend(["--out".into(), path(&j.out), "--quiet".into()]);
     args
 }

@@ -136,6 +136,12 @@ pub struct Args {
     /// representation has. E.g. 30 for a video-like log.
     #[arg(long, value_name = "HZ", requires = "mcap")]
     pub mcap_frames: Option<f64>,
+    // Every event goes through these on the full sensor before the crop; they must be the
+    // filters the model's training recordings went through (the bundle records them), or the
+    // run is refused. `hot-pixels=auto` learns from a replayed recording; a live input has
+    // nothing to learn from beforehand.
+    #[command(flatten)]
+    pub filter: crate::filtering::FilterArgs,
 }
 
 impl Args {
@@ -296,6 +302,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     })?;
     let mut estimator = Estimator::for_model(&model, sensor, interval_us)
         .with_context(|| format!("setting up the estimator for {}", args.model.display()))?;
+    let trained = &model.representation().filters;
+    let given: Vec<String> = args.filter.filters.iter().map(|f| f.to_string()).collect();
+    if &given != trained {
+        let words = |specs: &[String]| match specs {
+            [] => "no filter".to_string(),
+            _ => specs.join(" "),
+        };
+        let flags: Vec<String> = trained.iter().map(|f| format!("--filter {f}")).collect();
+        anyhow::bail!(
+            "the model {} was trained on events through {}, and this run's go through {}: {}",
+            args.model.display(),
+            words(trained),
+            words(&given),
+            match flags.is_empty() {
+                true => "give no --filter".to_string(),
+                false => format!("give its filters ({})", flags.join(" ")),
+            }
+        );
+    }
+    if !args.filter.filters.is_empty() {
+        let chain = match &spec {
+            SourceSpec::File(path) => args.filter.chain(path, sensor)?,
+            live => evtac_filters::Chain::build(&args.filter.filters, sensor)
+                .with_context(|| format!("{live}: the {sensor} sensor"))?,
+        };
+        estimator.filter_with(chain);
+    }
     if let Some(hz) = args.mcap_frames {
         if !(hz.is_finite() && hz > 0.0 && hz <= 1e6) {
             anyhow::bail!("--mcap-frames {hz}: give frames per second, above 0 and at most 1e6");

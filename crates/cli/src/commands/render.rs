@@ -4,7 +4,8 @@
 //!
 //! The input is a recording in any format evtac reads, or with `--trial` a dataset folder and
 //! one of its trials (its no-contact mask applied to the static representation, as in
-//! training). Events are cropped to the centered 240x240 crop. Each representation setting is
+//! training). Events go through `--filter`'s filters on the full sensor, then are cropped to the
+//! centered 240x240 crop. Each representation setting is
 //! `--tau-ms` / `--window-ms` when given, else the `--model`'s (what the network was trained
 //! on), else the default. With `--model`, the angles panel shows the model's estimates (the
 //! offline prediction's, on the model's own representation and mask) beside the trial's IMU
@@ -130,7 +131,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut references: (Option<LabelSeries>, Option<LabelSeries>) = (None, None);
     let (events, masks): (_, Vec<Option<Mask>>) = match &args.trial {
         None => {
-            let events = dataset::read_cropped(&args.input)
+            // Filtered on the full sensor, before the crop, as a dataset's recordings are.
+            let events = dataset::read_filtered_cropped(&args.input, &args.inputs.filter.filters)
                 .with_context(|| format!("reading {}", args.input.display()))?;
             let masks = reprs.iter().map(model_mask).collect();
             (events, masks)

@@ -80,6 +80,15 @@ pub struct Args {
     /// seeds' spread Experiment 1 measured instead).
     #[arg(long)]
     pub no_recheck: bool,
+    /// The filter of the capture-filter ablation (Experiment 1's three paper representations
+    /// again with every recording through it, paired by seed with the unfiltered runs) instead
+    /// of the plan's (`background-activity=10ms`, the NeuroTac lab's capture filter, at
+    /// `--scale small`; none at `tiny` and `paper`). A SPEC as `--filter` takes.
+    #[arg(long, value_name = "SPEC", conflicts_with = "no_capture_filter")]
+    pub capture_filter: Option<evtac_filters::FilterSpec>,
+    /// Leave out the capture-filter ablation.
+    #[arg(long)]
+    pub no_capture_filter: bool,
     /// Worker threads.
     #[command(flatten)]
     pub workers: crate::workers::Workers,
@@ -140,6 +149,8 @@ impl Args {
             repeat_split: !self.no_repeat_split,
             grid: self.grid,
             recheck: !self.no_recheck,
+            capture_filter: self.capture_filter.clone(),
+            capture_ablation: !self.no_capture_filter,
         }
     }
 }
@@ -405,7 +416,7 @@ fn run_here(
         }
     };
     let data = Datasets {
-        inputs: job.inputs,
+        inputs: job.inputs.clone(),
         ..Datasets::in_dir(&data_dir)
     };
     anyhow::ensure!(

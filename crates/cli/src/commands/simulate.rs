@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use evtac_import::filtering::FilteringCapture;
 use evtac_sim::{
-    DatasetConfig, Protocol, SessionConfig, SimParams, read_params, simulate_dataset,
+    DatasetConfig, Protocol, SessionConfig, SimParams, read_params, simulate_captured,
     simulate_session,
 };
 
@@ -46,10 +47,21 @@ pub struct Args {
     /// With --session: the largest error of a logged time, microseconds.
     #[arg(long, default_value_t = 300, requires = "session", value_name = "US")]
     pub jitter_us: i64,
+    // Each recording (every trial, no_contact.aedat4) is saved through these, from its first
+    // event, as a filtering capture saves it; simulator.json records them. Not with --session,
+    // whose one stream `evtac filter` (or `evtac import --filter`) filters.
+    #[command(flatten)]
+    pub filter: crate::filtering::FilterArgs,
 }
 
 /// Runs `evtac simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if args.session && !args.filter.filters.is_empty() {
+        anyhow::bail!(
+            "--filter saves each trial of a dataset filtered; a --session is one stream: filter \
+             its session.aedat4 with `evtac filter`, or import it with `evtac import --filter`"
+        );
+    }
     let params = match &args.params {
         Some(path) => read_params(path).context("--params")?,
         None => SimParams::default(),
@@ -80,7 +92,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         record.trials.len()
     } else {
-        pool.install(|| simulate_dataset(&config, &args.out, |_| bar.inc(1)))
+        let capture = FilteringCapture {
+            specs: args.filter.filters.clone(),
+        };
+        pool.install(|| simulate_captured(&config, &args.out, &capture, |_| bar.inc(1)))
             .with_context(|| format!("simulating {} into {}", args.protocol, args.out.display()))?
             .trials
             .len()
@@ -89,7 +104,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // The dataset `evtac reproduce` would simulate here (default parameters, every trial) is
     // marked done as `reproduce` marks its own, so a reproduction (local or on Slurm, whose
     // simulation tasks run this command) resumes from it. A session is no such dataset.
-    if !args.session && args.params.is_none() && args.limit.is_none() {
+    if !args.session
+        && args.params.is_none()
+        && args.limit.is_none()
+        && args.filter.filters.is_empty()
+    {
         evtac_experiments::jobs::mark_done(&args.out)?;
     }
     eprintln!(

@@ -1,12 +1,14 @@
 //! `evtac stats`: what a recording says about its sensor in the simulator's terms (event rate
 //! over time, background rate and ON fraction at rest, hot pixels, the IMU's noise and bias),
-//! and with `--sim-params` a simulator parameter file for `evtac simulate --params`. The work
-//! is `evtac_import::sensor_stats`'s.
+//! and with `--sim-params` a simulator parameter file for `evtac simulate --params`, with
+//! `--hot-pixels` a mask of the hot pixels for `--filter hot-pixels=MASK`. The work is
+//! `evtac_import::sensor_stats`'s; `--filter` measures the recording as those filters leave it.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
-use evtac_import::sensor_stats::{SensorStats, fit, measure_streams};
+use evtac_import::filtering;
+use evtac_import::sensor_stats::{SensorStats, fit};
 
 /// Arguments of `evtac stats`.
 #[derive(Debug, clap::Args)]
@@ -21,11 +23,20 @@ pub struct Args {
     /// Write the event rate over time (one row per 50 ms bin) as CSV.
     #[arg(long, value_name = "FILE.csv")]
     pub rates: Option<PathBuf>,
+    /// Write the hot pixels as a mask: a uint8 rows x columns NPY array, 255 at each hot pixel
+    /// and 0 elsewhere, which `--filter hot-pixels=FILE` removes from any recording of this
+    /// sensor.
+    #[arg(long, value_name = "MASK.npy")]
+    pub hot_pixels: Option<PathBuf>,
     /// Print the statistics as one JSON object instead of text (without the bins).
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
     pub streams: crate::streams::StreamArgs,
+    // The recording's events go through these filters before they are measured (the IMU as
+    // it is): what a capture that filters them would show.
+    #[command(flatten)]
+    pub filter: crate::filtering::FilterArgs,
 }
 
 /// Runs `evtac stats`.
@@ -33,9 +44,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let len = std::fs::metadata(&args.recording)
         .with_context(|| args.recording.display().to_string())?
         .len();
+    for output in [&args.sim_params, &args.rates, &args.hot_pixels]
+        .into_iter()
+        .flatten()
+    {
+        evtac_events::output::refuse_input(output, &[&args.recording])?;
+    }
     let bar = crate::progress::bytes(2 * len, "measuring");
     let selection = args.streams.selection();
-    let stats = measure_streams(&args.recording, &selection, |bytes| bar.set_position(bytes))?;
+    let stats = filtering::measure(&args.recording, &selection, &args.filter.filters, |bytes| {
+        bar.set_position(bytes)
+    })?;
     bar.finish_and_clear();
     if let Some(path) = &args.rates {
         crate::outputs::write_text(path, &stats.rates_csv())?;
@@ -52,6 +71,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "{}: no stretch at rest (no 150 ms without motion), so nothing to measure the noise on",
         args.recording.display()
     );
+    if let Some(path) = &args.hot_pixels {
+        let (w, h) = (stats.resolution.width, stats.resolution.height);
+        let mut mask = ndarray::Array2::<u8>::zeros((usize::from(h), usize::from(w)));
+        for p in &stats.hot {
+            mask[[usize::from(p.y), usize::from(p.x)]] = 255;
+        }
+        crate::outputs::write_npy(path, &mask)?;
+        println!(
+            "\nwrote {} ({} hot pixels of {w}x{h})",
+            path.display(),
+            stats.hot.len()
+        );
+    }
     if let Some(path) = &args.sim_params {
         let fitted = fit::fit(&stats, evtac_sim::SimParams::default());
         let text = serde_json::to_string_pretty(&fitted.params)?;

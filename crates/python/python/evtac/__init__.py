@@ -224,7 +224,9 @@ def filter(
     ``specs`` are the command line's SPECs: ``background-activity=10ms`` (the NeuroTac lab's
     capture filter), ``fast-decay=HALF_LIFE[,SUBDIVISION[,THRESHOLD]]``, ``k-noise=DURATION``,
     ``polarity=on|off``, ``region=X,Y,W,H``, ``refractory=DURATION``, ``circle=CX,CY,R``,
-    ``mask=FILE`` and ``hot-pixels=FILE``. ``events`` (an :data:`EVENT_DTYPE` array, in time
+    ``mask=FILE``, ``hot-pixels=FILE`` and ``hot-pixels=auto`` (the hot pixels learned from
+    ``events``' stretches at rest, as ``evtac stats`` finds them; a ValueError when there are
+    none). ``events`` (an :data:`EVENT_DTYPE` array, in time
     order) lie on a ``resolution=(w, h)`` sensor. With ``counts=True`` also returns each
     filter's SPEC with the events it removed, ``[(spec, removed), ...]`` in order.
 

@@ -1,18 +1,7 @@
 //! The report's label-noise ablation section: Experiment 1's paper representations trained on
 //! labels with Gaussian noise added, beside the same trained on the clean labels.
 
-use evtac_experiments::results::{LabelNoise, MeanStd};
-
-use super::verdict::{self, Side, Verdict};
-
-/// A cell: the test MAE against the labels, and against the simulator's exact truth where
-/// measured ("0.309 ± 0.010 / 0.301").
-fn with_truth(r: &evtac_experiments::results::Exp1Repr) -> String {
-    match r.test_truth {
-        Some(t) => format!("{} / {:.3}", r.test.overall.display(), t.overall.mean),
-        None => r.test.overall.display(),
-    }
-}
+use evtac_experiments::results::LabelNoise;
 
 /// The section, or a line saying it was not run.
 pub fn section(ablation: Option<&LabelNoise>) -> String {
@@ -35,59 +24,7 @@ pub fn section(ablation: Option<&LabelNoise>) -> String {
          ---: | ---: |\n",
         a.sd_deg
     ));
-    let mut verdicts = Vec::new();
-    for noisy in &a.noisy {
-        let Some(clean) = a.clean.iter().find(|c| c.name == noisy.name) else {
-            continue;
-        };
-        // Paired by seed: the same initial weights and batches, only the labels differ.
-        let diffs: Vec<f64> = noisy
-            .seeds
-            .iter()
-            .zip(&noisy.runs)
-            .filter_map(|(seed, n)| {
-                let k = clean.seeds.iter().position(|s| s == seed)?;
-                Some(n.overall - clean.runs.get(k)?.overall)
-            })
-            .collect();
-        let change = MeanStd::of(&diffs);
-        md.push_str(&format!(
-            "| {} | {} | {} | {:+.3} ± {:.3} |\n",
-            noisy.name.title(),
-            with_truth(clean),
-            with_truth(noisy),
-            change.mean,
-            change.std
-        ));
-        let judged = verdict::judge(
-            &Side::of(&clean.test.overall),
-            &Side::of(&noisy.test.overall),
-        );
-        verdicts.push(format!(
-            "{} changes by {:+.3} deg, {} {}",
-            noisy.name.title(),
-            change.mean,
-            if judged.verdict == Verdict::Tied {
-                "within"
-            } else {
-                "beyond"
-            },
-            judged.spread.describe()
-        ));
-    }
-    if a.clean
-        .iter()
-        .chain(&a.noisy)
-        .any(|r| r.test_truth.is_some())
-    {
-        md.push_str(
-            "\nEach cell: mean ± std over seeds against the clean test labels / the mean against \
-             the simulator's exact truth.\n",
-        );
-    }
-    if !verdicts.is_empty() {
-        md.push_str(&format!("\n{}.\n\n", verdicts.join("; ")));
-    }
+    super::paired::rows(&mut md, &a.clean, &a.noisy);
     md
 }
 
