@@ -158,25 +158,26 @@ mod tests {
     /// command line the same job equals: both must mean the same run, every flag included.
     #[test]
     fn a_reproduce_jobs_command_line_parses_back_to_its_arguments() {
+        // Fields in another order than the job's own tests list them: the same struct, any order.
         let job = ReproduceJob {
-            scale: evtac_sim::Scale::Tiny,
-            seed: 7,
-            out: "runs/out".into(),
-            data: Some("data sets".into()),
+            capture_ablation: false,
+            capture_filter: None,
+            recheck: false,
+            grid: Some(evtac_experiments::plan::Grid::Paper),
+            repeat_split: false,
+            repeats: Some(2),
+            datasets: Some(3),
+            label_noise_deg: Some(0.0),
+            fusions: false,
+            noise_levels: Some(vec![0.0, 2.5]),
             inputs: evtac_import::inputs::Inputs::from_flags(true, true).with_filters(vec![
                 "polarity=on".parse().unwrap(),
                 "hot-pixels=auto".parse().unwrap(),
             ]),
-            noise_levels: Some(vec![0.0, 2.5]),
-            fusions: false,
-            label_noise_deg: Some(0.0),
-            datasets: Some(3),
-            repeats: Some(2),
-            repeat_split: false,
-            grid: Some(evtac_experiments::plan::Grid::Paper),
-            recheck: false,
-            capture_filter: None,
-            capture_ablation: false,
+            data: Some("data sets".into()),
+            out: "runs/out".into(),
+            seed: 7,
+            scale: evtac_sim::Scale::Tiny,
         };
         let line = crate::commands::jobs::equivalent_command("evtac", &Job::Reproduce(job.clone()));
         let Command::Reproduce(parsed) = Cli::try_parse_from(&line).unwrap().command else {

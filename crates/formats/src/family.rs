@@ -126,6 +126,26 @@ pub(crate) trait Decode: Send {
     }
 }
 
+/// [`Decode::sensor`], [`Decode::declare`] and [`Decode::consumed`] for a reader whose own
+/// `resolution`, `set_resolution` and `position` methods are them (the simple readers: CSV,
+/// NPY, EVT, AEDAT 2.0/3.1), written once rather than in each of their `impl Decode`.
+macro_rules! decode_by_inherent_methods {
+    () => {
+        fn sensor(&self) -> Option<Resolution> {
+            self.resolution()
+        }
+
+        fn declare(&mut self, resolution: Resolution) {
+            self.set_resolution(resolution);
+        }
+
+        fn consumed(&self) -> u64 {
+            self.position()
+        }
+    };
+}
+pub(crate) use decode_by_inherent_methods;
+
 /// A [`Decode`] reader of the file at `path`, its errors made the whole-file [`Error`] by
 /// `wrap`.
 pub(crate) struct Named<D: Decode> {
@@ -224,25 +244,12 @@ pub(crate) trait Family: Sync {
             })
     }
 
-    /// Opens the file at `path`, of `format` (one of [`Self::formats`]), `len` bytes long.
-    fn open(
-        &self,
-        path: &Path,
-        format: Format,
-        selection: &StreamSelection,
-        len: u64,
-    ) -> Result<Opened, Error>;
+    /// Opens the file [`Open`] names.
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error>;
 
-    /// Creates a writer of `format` into `file`, for the output `path`; `None` when the family
-    /// does not write it.
-    fn create(
-        &self,
-        _path: &Path,
-        _format: Format,
-        _file: Sunk,
-        _resolution: Option<Resolution>,
-        _source_name: Option<&str>,
-    ) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+    /// Creates the writer [`Create`] asks for; `None` when the family does not write its
+    /// format.
+    fn create(&self, _to: Create<'_>) -> Option<Result<Box<dyn FormatWriter>, Error>> {
         None
     }
 
@@ -250,6 +257,34 @@ pub(crate) trait Family: Sync {
     fn writes(&self, _format: Format) -> bool {
         false
     }
+}
+
+/// What [`Family::open`] opens: one struct rather than four arguments, so that a family's
+/// `open` takes what it needs by name (and a new field does not touch every family).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Open<'a> {
+    /// The file (or folder).
+    pub path: &'a Path,
+    /// Its format, one of the family's [`Family::formats`].
+    pub format: Format,
+    /// Which streams of a file with several to read.
+    pub selection: &'a StreamSelection,
+    /// Its size in bytes ([`Family::len`]).
+    pub len: u64,
+}
+
+/// What [`Family::create`] writes: `format` into `file`, for the output `path`.
+pub(crate) struct Create<'a> {
+    /// The output's final name.
+    pub path: &'a Path,
+    /// Its format.
+    pub format: Format,
+    /// The temporary file it is written to ([`evtac_events::output::OutputFile`]).
+    pub file: Sunk,
+    /// The sensor's size, when known.
+    pub resolution: Option<Resolution>,
+    /// The camera's name, when known.
+    pub source_name: Option<&'a str>,
 }
 
 /// A path's extension, lower case (empty when it has none).

@@ -127,7 +127,12 @@ pub(crate) fn open_as(
             ),
         });
     }
-    let opened = family.open(path, format, selection, len)?;
+    let opened = family.open(&crate::family::Open {
+        path,
+        format,
+        selection,
+        len,
+    })?;
     Ok(EventReader {
         path: path.to_path_buf(),
         format,

@@ -47,7 +47,14 @@ impl EventWriter {
             path: path.clone(),
             error,
         })?;
-        let sink = match family.create(&path, format, file, resolution, source_name) {
+        let to = crate::family::Create {
+            path: &path,
+            format,
+            file,
+            resolution,
+            source_name,
+        };
+        let sink = match family.create(to) {
             Some(sink) => sink?,
             None => return Err(Error::NotWritable { path, format }),
         };

@@ -6,10 +6,11 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
 use crate::aedat::{AedatError, AedatReader, AedatWriter, MAGIC, WriterConfig};
 use crate::check::EventCheck;
-use crate::family::{Extension, Family, FormatReader, FormatWriter, Opened, Ranged, Sunk};
+use crate::family::{
+    Create, Extension, Family, FormatReader, FormatWriter, Open, Opened, Ranged, Sunk,
+};
 use crate::{Chunk, Error, Event, Format, ImuSample, Resolution, Trigger};
 
 /// The AEDAT 4.0 family.
@@ -47,13 +48,10 @@ impl Family for Aedat4 {
         true
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        selection: &StreamSelection,
-        _len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open {
+            path, selection, ..
+        } = *at;
         let error = aedat_error(path);
         let mut r = AedatReader::open(path).map_err(error)?;
         let chosen = selection
@@ -85,14 +83,14 @@ impl Family for Aedat4 {
         format == Format::Aedat4
     }
 
-    fn create(
-        &self,
-        path: &Path,
-        _format: Format,
-        file: Sunk,
-        resolution: Option<Resolution>,
-        source_name: Option<&str>,
-    ) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+    fn create(&self, to: Create<'_>) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+        let Create {
+            path,
+            file,
+            resolution,
+            source_name,
+            ..
+        } = to;
         let Some(resolution) = resolution else {
             return Some(Err(Error::MissingResolution {
                 path: path.to_path_buf(),

@@ -4,9 +4,8 @@
 use std::fs::File;
 use std::path::Path;
 
-use crate::StreamSelection;
 use crate::aedat_legacy::{self, LegacyError, LegacyReader, Version};
-use crate::family::{Decode, Extension, Family, Named, Opened};
+use crate::family::{Decode, Extension, Family, Named, Open, Opened};
 use crate::{Chunk, Error, Format, Resolution};
 
 /// The AEDAT 3.1 / 2.0 family.
@@ -34,13 +33,8 @@ impl Family for Legacy {
         })
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        _selection: &StreamSelection,
-        _len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open { path, .. } = *at;
         let wrap = |path, error| Error::AedatLegacy { path, error };
         let r = LegacyReader::from_path(path).map_err(|e| wrap(path.to_path_buf(), e))?;
         Ok(Opened {
@@ -65,17 +59,7 @@ impl Decode for LegacyReader<File> {
         }))
     }
 
-    fn sensor(&self) -> Option<Resolution> {
-        self.resolution()
-    }
-
-    fn declare(&mut self, resolution: Resolution) {
-        self.set_resolution(resolution);
-    }
-
-    fn consumed(&self) -> u64 {
-        self.position()
-    }
+    crate::family::decode_by_inherent_methods!();
 
     /// AEDAT 2.0 holds only events. AEDAT 3.1 stores one packet per event type: cAER writes
     /// the polarity, IMU and special packets of a *packet container* one after another, each

@@ -5,9 +5,8 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
 use crate::csv::{CsvError, CsvReader, CsvWriter};
-use crate::family::{Decode, Extension, Family, FormatWriter, Named, Opened, Sunk};
+use crate::family::{Create, Decode, Extension, Family, FormatWriter, Named, Open, Opened, Sunk};
 use crate::{Chunk, Error, Event, Format, Resolution};
 
 /// The CSV family.
@@ -31,13 +30,8 @@ impl Family for Csv {
         (crate::family::extension(path) == "csv").then_some(Ok(Format::Csv))
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        _selection: &StreamSelection,
-        _len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open { path, .. } = *at;
         let r = CsvReader::from_path(path).map_err(csv_error(path))?;
         let note = r.headerless().then(|| {
             "no header line: the columns were read as t,x,y,p (microseconds, column, row, \
@@ -58,14 +52,8 @@ impl Family for Csv {
         format == Format::Csv
     }
 
-    fn create(
-        &self,
-        path: &Path,
-        _format: Format,
-        file: Sunk,
-        _resolution: Option<Resolution>,
-        _source_name: Option<&str>,
-    ) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+    fn create(&self, to: Create<'_>) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+        let Create { path, file, .. } = to;
         Some(
             CsvWriter::new(file)
                 .map(|inner| {
@@ -93,17 +81,7 @@ impl Decode for CsvReader<BufReader<File>> {
         Ok(self.next_chunk()?.map(Chunk::of_events))
     }
 
-    fn sensor(&self) -> Option<Resolution> {
-        self.resolution()
-    }
-
-    fn declare(&mut self, resolution: Resolution) {
-        self.set_resolution(resolution);
-    }
-
-    fn consumed(&self) -> u64 {
-        self.position()
-    }
+    crate::family::decode_by_inherent_methods!();
 }
 
 /// A CSV event file being written (events only: a CSV event file has no place for IMU samples

@@ -4,9 +4,8 @@
 use std::fs::File;
 use std::path::Path;
 
-use crate::StreamSelection;
 use crate::evt::{EvtError, EvtReader, EvtVersion};
-use crate::family::{Decode, Extension, Family, Named, Opened};
+use crate::family::{Decode, Extension, Family, Named, Open, Opened};
 use crate::{Chunk, Error, Format, Resolution};
 
 /// The EVT family.
@@ -43,13 +42,8 @@ impl Family for Evt {
         }))
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        _selection: &StreamSelection,
-        _len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open { path, .. } = *at;
         let r = EvtReader::from_path(path).map_err(evt_error(path))?;
         Ok(Opened {
             source: r.header().source(),
@@ -80,15 +74,5 @@ impl Decode for EvtReader<File> {
         }))
     }
 
-    fn sensor(&self) -> Option<Resolution> {
-        self.resolution()
-    }
-
-    fn declare(&mut self, resolution: Resolution) {
-        self.set_resolution(resolution);
-    }
-
-    fn consumed(&self) -> u64 {
-        self.position()
-    }
+    crate::family::decode_by_inherent_methods!();
 }

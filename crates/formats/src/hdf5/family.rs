@@ -3,8 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
-use crate::family::{Extension, Family, FormatReader, Opened, Ranged};
+use crate::family::{Extension, Family, FormatReader, Open, Opened, Ranged};
 use crate::hdf5::{Hdf5Error, Hdf5Reader};
 use crate::{Chunk, Error, Format, RangeIndex, Resolution, ScanReason};
 
@@ -38,13 +37,8 @@ impl Family for Hdf5 {
             .then_some(Ok(Format::Hdf5))
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        _selection: &StreamSelection,
-        len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open { path, len, .. } = *at;
         let r = Hdf5Reader::open(path).map_err(hdf5_error(path))?;
         Ok(Opened {
             note: Some(r.note()),

@@ -4,9 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
 use crate::check::{CheckError, EventCheck};
-use crate::family::{Extension, Family, FormatReader, Opened};
+use crate::family::{Extension, Family, FormatReader, Open, Opened};
 use crate::{Chunk, Error, Event, Format, ImuSample, Resolution, Trigger};
 
 /// The NeuroTac family.
@@ -37,13 +36,8 @@ impl Family for Neurotac {
         crate::neurotac::sniff(head).then_some(Ok(Format::Neurotac))
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        _format: Format,
-        _selection: &StreamSelection,
-        len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open { path, len, .. } = *at;
         let file = crate::neurotac::read_pair(path).map_err(|error| Error::Neurotac {
             path: path.to_path_buf(),
             error: Box::new(error),

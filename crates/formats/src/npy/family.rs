@@ -4,8 +4,9 @@
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
-use crate::family::{Decode, Extension, Family, FormatReader, FormatWriter, Named, Opened, Sunk};
+use crate::family::{
+    Create, Decode, Extension, Family, FormatReader, FormatWriter, Named, Open, Opened, Sunk,
+};
 use crate::npy::npz::{NpzError, NpzReader};
 use crate::npy::{MAGIC, NpyError, NpyReader, NpyWriter};
 use crate::{Chunk, Error, Event, Format, Resolution};
@@ -41,13 +42,10 @@ impl Family for Npy {
         (zip && crate::family::extension(path) == "npz").then_some(Ok(Format::Npz))
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        format: Format,
-        _selection: &StreamSelection,
-        len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open {
+            path, format, len, ..
+        } = *at;
         let path_buf = path.to_path_buf();
         if format == Format::Npz {
             let r = NpzReader::from_path(path).map_err(|error| Error::Npz {
@@ -75,14 +73,10 @@ impl Family for Npy {
         format == Format::Npy
     }
 
-    fn create(
-        &self,
-        path: &Path,
-        format: Format,
-        file: Sunk,
-        _resolution: Option<Resolution>,
-        _source_name: Option<&str>,
-    ) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+    fn create(&self, to: Create<'_>) -> Option<Result<Box<dyn FormatWriter>, Error>> {
+        let Create {
+            path, format, file, ..
+        } = to;
         (format == Format::Npy).then(|| {
             NpyWriter::new(file)
                 .map(|inner| {
@@ -110,17 +104,7 @@ impl Decode for NpyReader<File> {
         Ok(self.next_chunk()?.map(Chunk::of_events))
     }
 
-    fn sensor(&self) -> Option<Resolution> {
-        self.resolution()
-    }
-
-    fn declare(&mut self, resolution: Resolution) {
-        self.set_resolution(resolution);
-    }
-
-    fn consumed(&self) -> u64 {
-        self.position()
-    }
+    crate::family::decode_by_inherent_methods!();
 }
 
 struct NpzSource {

@@ -4,8 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::StreamSelection;
-use crate::family::{Extension, Family, FormatReader, Opened};
+use crate::family::{Extension, Family, FormatReader, Open, Opened};
 use crate::ros::{BagEvents, MCAP_MAGIC};
 use crate::{Chunk, Error, Format, Resolution};
 
@@ -53,13 +52,13 @@ impl Family for Ros {
         crate::ros::bag_len(path)
     }
 
-    fn open(
-        &self,
-        path: &Path,
-        format: Format,
-        selection: &StreamSelection,
-        len: u64,
-    ) -> Result<Opened, Error> {
+    fn open(&self, at: &Open<'_>) -> Result<Opened, Error> {
+        let Open {
+            path,
+            format,
+            selection,
+            len,
+        } = *at;
         let bag = crate::ros::read(path, format, selection)?;
         Ok(Opened {
             reader: Box::new(Reader {

@@ -560,16 +560,16 @@ mod tests {
             (7, 8, 1_600_000_000, 5_000, 1),
             (0, 0, 0, 0, 0),
         ];
+        // Each (x, y, seconds, nanoseconds, polarity) as the event it stands for.
+        let event = |(x, y, s, ns, p): (u16, u16, i64, u32, u8)| Event {
+            t: s * 1_000_000 + i64::from(ns / 1000),
+            x,
+            y,
+            polarity: p == 1,
+        };
         let want = |events: &[(u16, u16, i32, u32, u8)]| -> Vec<Event> {
-            events
-                .iter()
-                .map(|&(x, y, s, ns, p)| Event {
-                    t: i64::from(s) * 1_000_000 + i64::from(ns / 1000),
-                    x,
-                    y,
-                    polarity: p == 1,
-                })
-                .collect()
+            let wide = |&(x, y, s, ns, p): &(u16, u16, i32, u32, u8)| (x, y, i64::from(s), ns, p);
+            events.iter().map(wide).map(event).collect()
         };
         for n in 0..=all.len() {
             let events = &all[..n];
@@ -587,12 +587,7 @@ mod tests {
             event_array(&ros1_array(&ros1), Encoding::Ros1, &mut out).unwrap();
             let unsigned: Vec<Event> = ros1
                 .iter()
-                .map(|&(x, y, s, ns, p)| Event {
-                    t: i64::from(s) * 1_000_000 + i64::from(ns / 1000),
-                    x,
-                    y,
-                    polarity: p == 1,
-                })
+                .map(|&(x, y, s, ns, p)| event((x, y, i64::from(s), ns, p)))
                 .collect();
             assert_eq!(out, unsigned, "ROS 1, {n} events");
         }

@@ -292,14 +292,7 @@ mod tests {
         t.runs = vec![run(100.0, 0.0, 0.50), run(1000.0, 0.0, 0.30)];
         let kind = t.repr;
         let exp1 = r.exp1.iter_mut().find(|e| e.name == kind).expect("ran");
-        exp1.val_runs = [0.30, 0.31, 0.29]
-            .iter()
-            .map(|&m| Mae {
-                overall: m,
-                pitch: m,
-                roll: m,
-            })
-            .collect();
+        exp1.val_runs = same_axes(&[0.30, 0.31, 0.29]);
         let text = margin_sentence(&t, &r, "tau").expect("a margin");
         assert!(
             text.contains("0.200 deg higher on validation, beyond"),
@@ -314,17 +307,21 @@ mod tests {
         );
     }
 
+    /// One MAE per value, the same on both axes.
+    fn same_axes(maes: &[f64]) -> Vec<Mae> {
+        maes.iter()
+            .map(|&m| Mae {
+                overall: m,
+                pitch: m,
+                roll: m,
+            })
+            .collect()
+    }
+
     #[test]
     fn the_recheck_says_whether_the_choice_stands_beyond_the_seeds_spread() {
         let rechecked = |time_ms, maes: &[f64]| {
-            let val_runs: Vec<Mae> = maes
-                .iter()
-                .map(|&m| Mae {
-                    overall: m,
-                    pitch: m,
-                    roll: m,
-                })
-                .collect();
+            let val_runs = same_axes(maes);
             Recheck {
                 time_ms,
                 threshold: 2.0,

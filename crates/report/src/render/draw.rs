@@ -143,15 +143,14 @@ pub fn draw_frame<DB: DrawingBackend>(
             continue;
         };
         text(format!("{} frame", repr.kind), (x, y - TITLE + 2))?;
+        // A binary frame: white where the representation is set.
+        let set = |px: usize, py: usize| repr.frame.get(py * w + px).is_some_and(|&v| v != 0);
         draw_image(
             area,
             (x, y),
             (w, h),
             1,
-            |px, py| {
-                let set = repr.frame.get(py * w + px).is_some_and(|&v| v != 0);
-                if set { WHITE } else { BLACK }
-            },
+            |px, py| if set(px, py) { WHITE } else { BLACK },
             path,
         )?;
         if layout.features {
