@@ -94,3 +94,20 @@ fn a_missing_folder_is_named_in_its_row() {
     );
     assert!(row.contains("the folder does not exist"), "{out}");
 }
+
+#[test]
+fn filters_are_refused_rather_than_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = evtac()
+        .arg("check")
+        .arg(dir.path())
+        .args(["--filter", "polarity=on"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("check reads the dataset's files as they are"),
+        "{err}"
+    );
+}

@@ -26,6 +26,14 @@ pub struct Args {
 
 /// Runs `evtac check`; exits with status 1 when the dataset has problems.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    // The flag comes with the dataset inputs, but no check reads events through filters: it
+    // is refused rather than accepted and ignored.
+    if !args.inputs.filter.filters.is_empty() {
+        anyhow::bail!(
+            "check reads the dataset's files as they are, not through filters: give --filter to \
+             the command that reads the events (train, tune, evaluate, render, reproduce)"
+        );
+    }
     let bar = crate::progress::bar(0, "reading");
     let report = args.workers.pool()?.install(|| {
         check::check(&args.dir, &args.inputs.inputs(), &|p| match p {
