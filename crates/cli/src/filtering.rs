@@ -9,6 +9,7 @@ use std::path::Path;
 
 use evtac_events::{Event, Resolution};
 use evtac_filters::{Chain, FilterSpec};
+use evtac_formats::StreamSelection;
 pub use evtac_import::filtering::removed;
 use evtac_import::filtering::{Learned, filter_events};
 
@@ -27,11 +28,16 @@ pub struct FilterArgs {
 }
 
 impl FilterArgs {
-    /// The chain of these filters for the recording at `path` on `sensor`, an error naming the
-    /// recording and the SPEC that does not fit it. `hot-pixels=auto` reads the file once here
-    /// to learn its hot pixels.
-    pub fn chain(&self, path: &Path, sensor: Resolution) -> anyhow::Result<Chain> {
-        let learned = Learned::from_file(path, &Default::default(), &self.filters)?;
+    /// The chain of these filters for the streams `streams` picks of the recording at `path` on
+    /// `sensor` (given, or the file's own), an error naming the recording and the SPEC that does
+    /// not fit it. `hot-pixels=auto` reads the file once here to learn its hot pixels.
+    pub fn chain(
+        &self,
+        path: &Path,
+        streams: &StreamSelection,
+        sensor: Resolution,
+    ) -> anyhow::Result<Chain> {
+        let learned = Learned::from_file(path, streams, Some(sensor), &self.filters)?;
         say_learned(path, &learned);
         Ok(learned.chain(path, sensor, &self.filters)?)
     }

@@ -20,14 +20,15 @@ pub struct Learned {
 
 impl Learned {
     /// Learned from the recording at `path` (the streams `streams` picks), read again only
-    /// when `specs` learn.
+    /// when `specs` learn; `sensor` is the sensor's size when the file does not state it.
     pub fn from_file(
         path: &Path,
         streams: &StreamSelection,
+        sensor: Option<Resolution>,
         specs: &[FilterSpec],
     ) -> Result<Self, StatsError> {
         let hot_pixels = match specs.iter().any(FilterSpec::learns) {
-            true => Some(sensor_stats::learn_hot_pixels(path, streams)?),
+            true => Some(sensor_stats::learn_hot_pixels(path, streams, sensor)?),
             false => None,
         };
         Ok(Self { hot_pixels })
@@ -78,9 +79,9 @@ pub fn measure(
     specs: &[FilterSpec],
     on_bytes: impl FnMut(u64),
 ) -> Result<sensor_stats::SensorStats, StatsError> {
-    let learned = Learned::from_file(path, streams, specs)?;
+    let learned = Learned::from_file(path, streams, None, specs)?;
     let chain = |sensor| learned.chain(path, sensor, specs);
-    sensor_stats::measure_through(path, streams, chain, on_bytes)
+    sensor_stats::measure_through(path, streams, None, chain, on_bytes)
 }
 
 /// `events`, read from `path` on `sensor`, through `specs` (the same events when there are
@@ -123,7 +124,7 @@ pub fn filter_in_place(path: &Path, specs: &[FilterSpec]) -> Result<(Removed, u6
     let sensor = reader
         .resolution()
         .ok_or_else(|| StatsError::NoResolution(path.to_path_buf()))?;
-    let learned = Learned::from_file(path, &streams, specs)?;
+    let learned = Learned::from_file(path, &streams, Some(sensor), specs)?;
     let mut chain = learned.chain(path, sensor, specs)?;
     let mut writer = evtac_formats::EventWriter::create(path, Some(sensor), reader.source())?;
     let (mut kept, mut written) = (Vec::new(), 0u64);

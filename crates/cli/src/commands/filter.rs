@@ -65,7 +65,8 @@ pub fn filter(args: &Args) -> anyhow::Result<Counts> {
         bail!("no filter: give at least one --filter SPEC (evtac filter --help lists them)");
     }
     refuse_input(&args.files.output, &[&args.files.input])?;
-    let mut reader = evtac_formats::open_with(&args.files.input, &args.streams.selection())?;
+    let streams = args.streams.selection();
+    let mut reader = evtac_formats::open_with(&args.files.input, &streams)?;
     if let Some(resolution) = args.sensor.sensor {
         reader.set_resolution(resolution)?;
     }
@@ -76,7 +77,7 @@ pub fn filter(args: &Args) -> anyhow::Result<Counts> {
             reader.format()
         );
     };
-    let chain = args.filters.chain(&args.files.input, sensor)?;
+    let chain = args.filters.chain(&args.files.input, &streams, sensor)?;
     let mut writer = EventWriter::create(&args.files.output, Some(sensor), reader.source())?;
     let bar = crate::progress::bytes(reader.file_len(), "filtering");
     let mut counts = Counts::default();

@@ -323,7 +323,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     if !args.filter.filters.is_empty() {
         let chain = match &spec {
-            SourceSpec::File(path) => args.filter.chain(path, sensor)?,
+            SourceSpec::File(path) => args.filter.chain(path, &args.streams.selection(), sensor)?,
             live => evtac_filters::Chain::build(&args.filter.filters, sensor)
                 .with_context(|| format!("{live}: the {sensor} sensor"))?,
         };

@@ -126,21 +126,25 @@ pub fn measure_streams(
     on_bytes: impl FnMut(u64),
 ) -> Result<SensorStats, StatsError> {
     let none = |_| Ok(evtac_filters::Chain::new(Vec::new()));
-    measure_through(path, streams, none, on_bytes)
+    measure_through(path, streams, None, none, on_bytes)
 }
 
 /// [`measure_streams`] of the recording's events through the chain `chain` builds for its
 /// sensor, afresh for each pass so that both see the same events (the IMU as it is): what a
 /// recording filtered so would show. [`crate::filtering::measure`] builds it from SPECs.
+/// `sensor` is the sensor's size for a file that does not state it (NPY, CSV); the file's own
+/// wins when it does.
 pub fn measure_through(
     path: &Path,
     streams: &StreamSelection,
+    sensor: Option<Resolution>,
     chain: impl Fn(Resolution) -> Result<evtac_filters::Chain, StatsError>,
     mut on_bytes: impl FnMut(u64),
 ) -> Result<SensorStats, StatsError> {
     let mut reader = evtac_formats::open_with(path, streams)?;
     let resolution = reader
         .resolution()
+        .or(sensor)
         .ok_or_else(|| StatsError::NoResolution(path.to_path_buf()))?;
     let (mut filter, mut kept) = (chain(resolution)?, Vec::new());
     let len = reader.file_len();
@@ -193,12 +197,14 @@ pub fn measure_through(
 
 /// The hot pixels (column, row) of the recording at `path` that `hot-pixels=auto` removes: those
 /// [`measure_streams`] finds (two passes over the file), or an error when it has no stretch at
-/// rest to learn them from.
+/// rest to learn them from. `sensor` is the sensor's size for a file that does not state it.
 pub fn learn_hot_pixels(
     path: &Path,
     streams: &StreamSelection,
+    sensor: Option<Resolution>,
 ) -> Result<Vec<(u16, u16)>, StatsError> {
-    let stats = measure_streams(path, streams, |_| {})?;
+    let none = |_| Ok(evtac_filters::Chain::new(Vec::new()));
+    let stats = measure_through(path, streams, sensor, none, |_| {})?;
     let hot = (stats.rest_s > 0.0).then_some(stats.hot);
     pixels_of(path, hot)
 }
