@@ -8,69 +8,14 @@
 //! evtac and the Python baseline, with ratios.
 
 use criterion::{BenchmarkId, Criterion, Throughput};
-use evtac_events::{Event, Resolution};
+use evtac_events::Event;
 use evtac_repr::{FeatureExtractor, ReprConfig};
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use std::time::Instant;
 
-const FRAME: Resolution = Resolution::new(240, 240);
-const RATE_HZ: f64 = 300_000.0;
-const DURATION_US: i64 = 3_000_000;
-const STEP_US: i64 = 1_000;
-const T0: i64 = 1_000_000;
-
-/// A NeuroTac-like stream: a 14 x 14 grid of pins, those under a slowly moving contact region
-/// emit events around their edges (85 % of events), plus uniform background noise; Poisson
-/// arrivals at `RATE_HZ`, integer-microsecond timestamps (so many share a timestamp).
-fn synthetic_stream(seed: u64) -> Vec<Event> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let pins: Vec<(f64, f64)> = (0..14)
-        .flat_map(|i| {
-            (0..14).map(move |j| (10.0 + 17.0 * f64::from(i), 10.0 + 17.0 * f64::from(j)))
-        })
-        .collect();
-    let mut events = Vec::with_capacity((RATE_HZ * DURATION_US as f64 / 1e6 * 1.05) as usize);
-    let mut t = T0 as f64;
-    let end = (T0 + DURATION_US) as f64;
-    let mut active = Vec::with_capacity(pins.len());
-    let mut active_at = i64::MIN;
-    loop {
-        t += -(1.0 - rng.random::<f64>()).ln() * 1e6 / RATE_HZ;
-        if t >= end {
-            break;
-        }
-        let ti = t as i64;
-        // The contact region circles around the centre once per 2 s.
-        if ti - active_at >= 1_000 {
-            active_at = ti;
-            let phase = (ti - T0) as f64 / 2e6 * std::f64::consts::TAU;
-            let (cx, cy) = (120.0 + 40.0 * phase.cos(), 120.0 + 40.0 * phase.sin());
-            active.clear();
-            active.extend(
-                pins.iter()
-                    .filter(|(px, py)| (px - cx).hypot(py - cy) < 70.0)
-                    .copied(),
-            );
-        }
-        let (x, y) = if rng.random_bool(0.85) && !active.is_empty() {
-            let (px, py) = active[rng.random_range(0..active.len())];
-            let angle = rng.random::<f64>() * std::f64::consts::TAU;
-            let r = 3.0 + rng.random::<f64>() * 1.5;
-            (px + r * angle.cos(), py + r * angle.sin())
-        } else {
-            (rng.random::<f64>() * 240.0, rng.random::<f64>() * 240.0)
-        };
-        events.push(Event {
-            t: ti,
-            x: (x.clamp(0.0, 239.0)) as u16,
-            y: (y.clamp(0.0, 239.0)) as u16,
-            polarity: rng.random_bool(0.5),
-        });
-    }
-    events
-}
+#[path = "common/stream.rs"]
+mod stream;
+use stream::{DURATION_US, FRAME, STEP_US, samples, synthetic_stream};
 
 fn configs() -> [(&'static str, ReprConfig); 3] {
     let ReprConfig::Combined {
@@ -85,12 +30,6 @@ fn configs() -> [(&'static str, ReprConfig); 3] {
         ("dynamic", ReprConfig::Dynamic(dynamic_part)),
         ("combined", ReprConfig::default()),
     ]
-}
-
-fn samples() -> Vec<i64> {
-    (1..=DURATION_US / STEP_US)
-        .map(|k| T0 + k * STEP_US)
-        .collect()
 }
 
 /// One pass at 1 ms sampling: per sample, push that millisecond's events, advance, and copy the
@@ -150,39 +89,9 @@ fn stats(lat_ns: &mut [u64], events: usize) -> Row {
 
 fn python_baseline(events: &[Event], samples: &[i64]) -> Option<Vec<(String, Row)>> {
     let python = evtac_testkit::python()?;
-    let dir = tempfile::tempdir().ok()?;
-    let path = dir.path().join("events.bin");
-    let mut bytes = Vec::with_capacity(events.len() * 13);
-    bytes.extend(events.iter().flat_map(|e| e.t.to_le_bytes()));
-    bytes.extend(events.iter().flat_map(|e| e.x.to_le_bytes()));
-    bytes.extend(events.iter().flat_map(|e| e.y.to_le_bytes()));
-    bytes.extend(events.iter().map(|e| u8::from(e.polarity)));
-    std::fs::write(&path, bytes).ok()?;
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/baseline.py");
-    let out = std::process::Command::new(python)
-        .arg(script)
-        .arg(&path)
-        .args(
-            [
-                events.len() as i64,
-                i64::from(FRAME.width),
-                i64::from(FRAME.height),
-                T0,
-                STEP_US,
-                samples.len() as i64,
-            ]
-            .map(|v| v.to_string()),
-        )
-        .output()
-        .ok()?;
-    if !out.status.success() {
-        eprintln!(
-            "baseline.py failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        return None;
-    }
-    let rows = String::from_utf8_lossy(&out.stdout)
+    let stdout = stream::run_reference(&python, script, events, samples)?;
+    let rows = stdout
         .lines()
         .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
         .filter_map(|v| {

@@ -368,27 +368,15 @@ impl FeatureExtractor {
     /// Queues events in crop coordinates, in time order (also after earlier pushes). The whole
     /// chunk is checked first: on error nothing is queued.
     pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
-        self.last_pushed =
-            crate::check::check_events(events, Some(self.resolution), self.last_pushed)?;
-        self.pending.extend(events);
-        Ok(())
+        let (pending, last) = (&mut self.pending, &mut self.last_pushed);
+        crate::check::queue_events(pending, last, self.resolution, events, None)
     }
 
     /// Queues events in full-sensor coordinates, cropping them with `roi` on the way (events
     /// outside it are dropped). `roi.size` must be the frame size.
     pub fn push_with_roi(&mut self, events: &[Event], roi: &Roi) -> Result<(), ReprError> {
-        if roi.size != self.resolution {
-            return Err(ReprError::RoiSize {
-                roi_width: roi.size.width,
-                roi_height: roi.size.height,
-                width: self.resolution.width,
-                height: self.resolution.height,
-            });
-        }
-        self.last_pushed = crate::check::check_events(events, None, self.last_pushed)?;
-        self.pending
-            .extend(events.iter().filter_map(|&e| roi.map(e)));
-        Ok(())
+        let (pending, last) = (&mut self.pending, &mut self.last_pushed);
+        crate::check::queue_events(pending, last, self.resolution, events, Some(roi))
     }
 
     /// Applies every queued event with `t <= t_k`, moves the windows to end at `t_k`, and

@@ -17,6 +17,10 @@
 //! [`ReprKind`] is the one list of kinds (and of learned fusions, `stacked` and `late`, whose
 //! features are both frames side by side), with their names on the command line and in reports.
 //!
+//! Beyond the paper ([`dense`]): time surfaces, polarity histograms and voxel grids as tonic 1.7
+//! computes them, real-valued frames of several channels pooled 8x8 per channel, run by
+//! [`DenseExtractor`].
+//!
 //! [`FeatureExtractor`] runs any number of [`ReprConfig`]s over one event stream in one pass,
 //! sharing accumulators and windows between configs that can share them.
 //!
@@ -52,6 +56,7 @@ mod check;
 pub mod combine;
 pub mod config;
 mod crop;
+pub mod dense;
 mod error;
 pub mod expf;
 pub mod extractor;
@@ -70,6 +75,10 @@ pub use config::{
     ThresholdSpace,
 };
 pub use crop::{CROP, SensorTooSmall, centered_crop};
+pub use dense::{
+    DenseConfig, DenseExtractor, HistogramConfig, TimeSurfaceConfig, VoxelGridConfig,
+    extract_dense_features,
+};
 pub use error::ReprError;
 pub use extractor::{FeatureExtractor, extract_features};
 pub use kind::{ReprKind, UnknownKind, kind_name};

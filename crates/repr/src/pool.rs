@@ -36,11 +36,7 @@ impl Pool8 {
     /// An all-zero frame of `resolution`, whose sides must be non-zero multiples of 8.
     pub fn new(resolution: Resolution) -> Result<Self, ReprError> {
         let (w, h) = poolable_sides(resolution)?;
-        let cells_x = w / CELL;
-        let cell_of = (0..w * h)
-            .map(|p| ((p / w / CELL) * cells_x + (p % w) / CELL) as u32)
-            .collect();
-        let cells = cells_x * (h / CELL);
+        let (cell_of, cells) = cell_map(resolution)?;
         Ok(Self {
             resolution,
             cell_of,
@@ -111,6 +107,18 @@ impl Pool8 {
         self.counts.fill(0);
         self.features.fill(0.0);
     }
+}
+
+/// The cell of every pixel of a `resolution` frame (row-major over cells, as the features are)
+/// and the number of cells: a lookup is cheaper than two divisions per event. [`Pool8`] and the
+/// real-valued kinds ([`crate::dense`]) pool through it.
+pub(crate) fn cell_map(resolution: Resolution) -> Result<(Vec<u32>, usize), ReprError> {
+    let (w, h) = poolable_sides(resolution)?;
+    let cells_x = w / CELL;
+    let cell_of = (0..w * h)
+        .map(|p| ((p / w / CELL) * cells_x + (p % w) / CELL) as u32)
+        .collect();
+    Ok((cell_of, cells_x * (h / CELL)))
 }
 
 /// The frame's sides in pixels, if both are non-zero multiples of [`CELL`] (the one check

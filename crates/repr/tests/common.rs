@@ -49,3 +49,34 @@ pub fn random_batches(seed: u64, n: usize, batches: usize) -> Vec<usize> {
     cuts.sort_unstable();
     cuts
 }
+
+/// Events as the Python references read them: N int64 times, N uint16 x, N uint16 y, N uint8
+/// polarities, back to back.
+pub fn encode(events: &[Event]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(events.len() * 13);
+    out.extend(events.iter().flat_map(|e| e.t.to_le_bytes()));
+    out.extend(events.iter().flat_map(|e| e.x.to_le_bytes()));
+    out.extend(events.iter().flat_map(|e| e.y.to_le_bytes()));
+    out.extend(events.iter().map(|e| u8::from(e.polarity)));
+    out
+}
+
+/// 8x8 means, in float64, of each channel of a channel-major `res` frame.
+pub fn pool_channels(frame: &[f64], res: Resolution) -> Vec<f64> {
+    let (w, h) = (usize::from(res.width), usize::from(res.height));
+    let mut out = Vec::new();
+    for channel in frame.chunks(w * h) {
+        for cy in 0..h / 8 {
+            for cx in 0..w / 8 {
+                let mut sum = 0.0;
+                for y in cy * 8..cy * 8 + 8 {
+                    for x in cx * 8..cx * 8 + 8 {
+                        sum += channel[y * w + x];
+                    }
+                }
+                out.push(sum / 64.0);
+            }
+        }
+    }
+    out
+}

@@ -4,7 +4,7 @@
 //! 8-bit frames must be identical. Skipped locally without the reference Python (see
 //! `evtac_testkit::python`); required under CI.
 
-use crate::common::{random_batches, random_stream};
+use crate::common::{encode, random_batches, random_stream};
 use evtac_events::{Event, Resolution};
 use evtac_repr::{
     Comparison, Decay, FeatureExtractor, Polarity, ReprConfig, StaticAccumulator, StaticConfig,
@@ -52,15 +52,6 @@ struct Case {
     config: StaticConfig,
     events: Vec<Event>,
     cuts: Vec<usize>,
-}
-
-fn encode(events: &[Event]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(events.len() * 13);
-    out.extend(events.iter().flat_map(|e| e.t.to_le_bytes()));
-    out.extend(events.iter().flat_map(|e| e.x.to_le_bytes()));
-    out.extend(events.iter().flat_map(|e| e.y.to_le_bytes()));
-    out.extend(events.iter().map(|e| u8::from(e.polarity)));
-    out
 }
 
 fn bits(v: &[f32]) -> Vec<u32> {

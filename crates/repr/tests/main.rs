@@ -2,6 +2,8 @@
 
 mod bad_input;
 mod common;
+mod dense_reference;
 mod dv_differential;
 mod expf;
 mod reference;
+mod tonic_differential;
