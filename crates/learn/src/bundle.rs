@@ -722,6 +722,7 @@ fn parse_history(path: &Path, text: &str) -> Result<Vec<EpochRecord>, Error> {
             val_mae_pitch: v[2],
             val_mae_roll: v[3],
             seconds: v[4],
+            validation_seconds: None,
         });
     }
     Ok(out)
@@ -757,6 +758,7 @@ mod tests {
                     val_mae_pitch: 1.0,
                     val_mae_roll: 2.0,
                     seconds: 0.125,
+                    validation_seconds: None,
                 }],
             },
             TrainConfig {

@@ -194,6 +194,9 @@ pub struct EpochRecord {
     pub val_mae_roll: f64,
     /// Wall-clock seconds of the epoch (training and validation).
     pub seconds: f64,
+    /// Of those, the validation's (the rest are the training steps). `None` for epochs read
+    /// back from a `history.csv`, which keeps the epoch's total only.
+    pub validation_seconds: Option<f64>,
 }
 
 /// The result of [`train`].
@@ -264,7 +267,9 @@ pub fn train(
             }
             loss_sum += f64::from(loss) * batch.len() as f64;
         }
+        let validating = Instant::now();
         let mae = metrics::mae(&trainer.predict(&val.features)?, &val.labels)?;
+        let validation_seconds = Some(validating.elapsed().as_secs_f64());
         let record = EpochRecord {
             epoch,
             train_loss: loss_sum / train.len() as f64,
@@ -272,6 +277,7 @@ pub fn train(
             val_mae_pitch: mae.pitch,
             val_mae_roll: mae.roll,
             seconds: started.elapsed().as_secs_f64(),
+            validation_seconds,
         };
         // Strictly lower only: ties keep the earlier epoch, and a NaN never replaces a number.
         let improved = best

@@ -162,8 +162,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bar.set_style(style);
     }
     let started = std::time::Instant::now();
+    // What each part took: the features (built or read from the cache, with the dataset's
+    // loading) end where the first epoch began; the epochs say what their steps and their
+    // validation took.
+    let (mut training_started, mut steps_s, mut validation_s) = (None, 0.0, 0.0);
     let val = evtac_experiments::training::run_job(&job, &|_| fbar.inc(1), |r| {
         fbar.finish_and_clear();
+        training_started.get_or_insert_with(|| {
+            std::time::Instant::now() - std::time::Duration::from_secs_f64(r.seconds)
+        });
+        let validation = r.validation_seconds.unwrap_or(0.0);
+        (steps_s, validation_s) = (steps_s + r.seconds - validation, validation_s + validation);
         bar.set_message(format!(
             "loss {:.4} val MAE {:.3} deg",
             r.train_loss, r.val_mae
@@ -173,10 +182,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     .with_context(|| format!("training into {}", args.out.display()))?;
     bar.finish_and_clear();
     if !args.quiet {
+        let features_s = training_started.map_or(0.0, |t| (t - started).as_secs_f64());
         eprintln!(
-            "trained {} epochs in {:.1} s: best validation MAE {:.3} deg (pitch {:.3}, roll {:.3}); model in {}",
+            "features {features_s:.1} s ({trials} trials, built or from the cache); trained {} \
+             epochs in {:.1} s (steps {steps_s:.1} s, validation {validation_s:.1} s): best \
+             validation MAE {:.3} deg (pitch {:.3}, roll {:.3}); model in {}",
             args.epochs,
-            started.elapsed().as_secs_f64(),
+            steps_s + validation_s,
             val.overall,
             val.pitch,
             val.roll,

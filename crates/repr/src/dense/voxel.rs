@@ -27,7 +27,7 @@ use super::{Channels, Placed};
 use crate::ReprError;
 
 /// The most bins a voxel grid may have (the features grow by 900 per bin).
-pub const MAX_BINS: u32 = 64;
+const MAX_BINS: u32 = 64;
 
 /// Settings of a voxel grid.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -35,7 +35,7 @@ pub const MAX_BINS: u32 = 64;
 pub struct VoxelGridConfig {
     /// The window before each sample time, in milliseconds (a whole number of microseconds).
     pub window_ms: f64,
-    /// Temporal bins (tonic's `n_time_bins`), 1 to [`MAX_BINS`].
+    /// Temporal bins (tonic's `n_time_bins`), 1 to 64.
     pub bins: u32,
 }
 
