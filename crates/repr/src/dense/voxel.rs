@@ -14,7 +14,11 @@
 //! in the events' times. For the events of interval `j` (`j <= ts < j + 1`) keep `S0 = sum w`
 //! and `P = sum w t`; with `Q = P - t0 S0 = sum w (t - t0)`,
 //! `bin_j = (1 + j) S0_j - (j - 1) S0_{j-1} + B (Q_{j-1} - Q_j) / W`.
-//! The sums are integers (exact in i64/i128), kept per cell and interval, and the `B - 1`
+//! The sums are integers, kept per cell and interval in wrapping i64 arithmetic: `P` of
+//! timestamps since the epoch overflows, but `Q` and `B (Q_{j-1} - Q_j)` are exact modulo 2^64
+//! and their true values fit an i64 (below `B W` times the window's events in a cell: 2^63 only
+//! past 10^8 events per cell in a 1000 s window of 64 bins), so the wrapped results are the
+//! exact ones. The `B - 1`
 //! boundaries between intervals are cursors into the window's events that only move forward:
 //! an event crosses each once. Frames are built on request from the window's events in tonic's
 //! own order of operations (all left shares, then all right shares, float64).
@@ -79,9 +83,10 @@ pub(super) struct VoxelGrid {
     base: u64,
     /// `cursor[j]` (j >= 1): the index of the first event in interval `j` or later.
     cursor: Vec<u64>,
-    /// Per interval and cell: the sum of weights, and of weights times times.
+    /// Per interval and cell: the sum of weights, and of weights times times (wrapping, see
+    /// the module docs).
     s0: Vec<i64>,
-    p: Vec<i128>,
+    p: Vec<i64>,
 }
 
 impl VoxelGrid {
@@ -105,7 +110,7 @@ impl VoxelGrid {
         let at = j * self.cells + e.cell as usize;
         let w = i64::from(e.w) * sign;
         self.s0[at] += w;
-        self.p[at] += i128::from(w) * i128::from(e.t);
+        self.p[at] = self.p[at].wrapping_add(w.wrapping_mul(e.t));
     }
 }
 
@@ -155,20 +160,17 @@ impl Channels for VoxelGrid {
     }
 
     fn features(&self, t_k: i64, out: &mut [f32]) {
-        let t0 = i128::from(t_k) - i128::from(self.window_us);
-        let (b, w) = (self.bins as i128, self.window_us as f64);
+        let t0 = t_k.wrapping_sub(self.window_us);
+        let (b, w) = (self.bins as i64, self.window_us as f64);
         for c in 0..self.cells {
             // Interval j-1's sums, carried from the previous bin (none before bin 0).
-            let (mut s0_prev, mut q_prev) = (0i64, 0i128);
+            let (mut s0_prev, mut q_prev) = (0i64, 0i64);
             for j in 0..self.bins {
                 let at = j * self.cells + c;
                 let s0 = self.s0[at];
-                let q = self.p[at] - t0 * i128::from(s0);
+                let q = self.p[at].wrapping_sub(t0.wrapping_mul(s0));
                 let whole = (1 + j as i64) * s0 - (j as i64 - 1) * s0_prev;
-                // `B (Q_{j-1} - Q_j)` fits an i64 but for absurd windows; i128 -> f64 is a
-                // library call, i64 -> f64 one instruction (this is most of a sample's time).
-                let num = b * (q_prev - q);
-                let num = i64::try_from(num).map_or(num as f64, |v| v as f64);
+                let num = q_prev.wrapping_sub(q).wrapping_mul(b) as f64;
                 out[at] = ((whole as f64 + num / w) / 64.0) as f32;
                 (s0_prev, q_prev) = (s0, q);
             }
