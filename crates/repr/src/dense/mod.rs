@@ -329,3 +329,37 @@ pub(crate) fn whole_us(field: &'static str, ms: f64) -> Result<i64, ReprError> {
     }
     Ok(us as i64)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn configs_round_trip_through_json_tagged_by_kind() {
+        let configs = [
+            DenseConfig::TimeSurface(TimeSurfaceConfig {
+                tau_ms: 50.0,
+                threshold: Some(0.25),
+            }),
+            DenseConfig::Histogram(HistogramConfig { window_ms: 100.0 }),
+            DenseConfig::VoxelGrid(VoxelGridConfig {
+                window_ms: 100.0,
+                bins: 5,
+            }),
+        ];
+        for config in configs {
+            let json = serde_json::to_string(&config).expect("serializes");
+            assert_eq!(
+                serde_json::from_str::<DenseConfig>(&json).ok(),
+                Some(config)
+            );
+        }
+        let json = r#"{"kind":"voxel-grid","window_ms":100.0,"bins":5}"#;
+        assert_eq!(
+            serde_json::from_str::<DenseConfig>(json).ok(),
+            Some(configs[2])
+        );
+        let unknown = r#"{"kind":"histogram","window_ms":1.0,"bins":3}"#;
+        assert!(serde_json::from_str::<DenseConfig>(unknown).is_err());
+    }
+}
