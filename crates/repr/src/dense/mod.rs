@@ -86,9 +86,10 @@ impl DenseConfig {
         }
     }
 
-    fn engine(&self, pixels: usize, cells: usize) -> Box<dyn Channels> {
+    fn engine(&self, cell_of: &[u32], cells: usize) -> Box<dyn Channels> {
+        let pixels = cell_of.len();
         match *self {
-            Self::TimeSurface(c) => Box::new(surface::TimeSurface::new(c, pixels, cells)),
+            Self::TimeSurface(c) => Box::new(surface::TimeSurface::new(c, cell_of, cells)),
             Self::Histogram(c) => Box::new(histogram::Histogram::new(c, pixels, cells)),
             Self::VoxelGrid(c) => Box::new(voxel::VoxelGrid::new(c, cells)),
         }
@@ -169,7 +170,7 @@ impl DenseExtractor {
         Ok(Self {
             config,
             resolution: frame,
-            engine: config.engine(frame.pixels(), cells),
+            engine: config.engine(&cell_of, cells),
             cell_of,
             cells,
             pending: VecDeque::new(),

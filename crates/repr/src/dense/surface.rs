@@ -114,7 +114,7 @@ pub(super) struct TimeSurface {
     /// The latest event time per channel and pixel ([`NEVER`] for none).
     last: Vec<i64>,
     /// The cell of each pixel (for the exact recomputation).
-    cell_of_pixel: Vec<u32>,
+    cell_of: Vec<u32>,
     mode: Mode,
 }
 
@@ -135,7 +135,8 @@ enum Mode {
 }
 
 impl TimeSurface {
-    pub(super) fn new(config: TimeSurfaceConfig, pixels: usize, cells: usize) -> Self {
+    pub(super) fn new(config: TimeSurfaceConfig, cell_of: &[u32], cells: usize) -> Self {
+        let pixels = cell_of.len();
         let mode = match config.set_below_age() {
             Some(set_below) => Mode::Binarized {
                 set_below,
@@ -155,7 +156,7 @@ impl TimeSurface {
             pixels,
             cells,
             last: vec![NEVER; 2 * pixels],
-            cell_of_pixel: vec![u32::MAX; pixels],
+            cell_of: cell_of.to_vec(),
             mode,
         }
     }
@@ -175,7 +176,7 @@ impl TimeSurface {
             for p in 0..self.pixels {
                 let t = self.last[channel * self.pixels + p];
                 if t != NEVER {
-                    let cell = self.cell_of_pixel[p] as usize;
+                    let cell = self.cell_of[p] as usize;
                     sums[channel * self.cells + cell] += ((t - t_ref) as f64 / self.tau_us).exp();
                 }
             }
@@ -189,7 +190,6 @@ impl Channels for TimeSurface {
     fn enter(&mut self, events: &[Placed]) {
         for e in events {
             let (channel, pixel) = (usize::from(e.on), e.pixel as usize);
-            self.cell_of_pixel[pixel] = e.cell;
             let slot = channel * self.pixels + pixel;
             let old = std::mem::replace(&mut self.last[slot], e.t);
             let refresh = match &mut self.mode {
