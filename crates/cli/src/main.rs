@@ -160,6 +160,7 @@ mod tests {
     fn a_reproduce_jobs_command_line_parses_back_to_its_arguments() {
         // Fields in another order than the job's own tests list them: the same struct, any order.
         let job = ReproduceJob {
+            beyond: true,
             capture_ablation: false,
             capture_filter: None,
             recheck: false,

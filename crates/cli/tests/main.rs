@@ -1,5 +1,6 @@
 //! Integration tests of the `evtac` binary: one test binary, one module per subcommand.
 
+mod beyond;
 mod check;
 mod common;
 mod convert;

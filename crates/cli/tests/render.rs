@@ -213,3 +213,41 @@ fn a_png_sheet_with_the_defaults_spreads_24_frames_over_the_trial() {
     assert!(said.contains("24 frames"), "{said}");
     assert!(out.is_file());
 }
+
+#[test]
+fn time_surface_and_voxel_grid_panels_draw_their_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let panels = "events,time-surface,voxel-grid";
+    let out = render(dir.path(), "r.png", &["--panels", panels]);
+    let decoder = png::Decoder::new(std::io::BufReader::new(File::open(&out).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    // Three panels of 250 pixels; the three frames in a 2 x 2 grid, row by row.
+    let size = (10 + 3 * 250, SIZE.1);
+    assert_eq!(
+        (info.width as usize, info.height as usize),
+        (2 * size.0, 2 * size.1)
+    );
+    let at = |frame: usize, column: usize, (x, y): (usize, usize)| {
+        let (left, top) = ((frame % 2) * size.0, (frame / 2) * size.1);
+        let (x, y) = (left + 10 + column * 250 + x, top + 48 + y);
+        let i = 3 * (y * 2 * size.0 + x);
+        [buf[i], buf[i + 1], buf[i + 2]]
+    };
+    // The time surface (default tau 100 ms) at the ON pixel: nothing before the event, then
+    // exp(-50 ms / 100 ms) and exp(-150 ms / 100 ms) of full red at the frames' ends.
+    let level = |v: f64| (v * 255.0).round() as u8;
+    assert_eq!(at(0, 1, (50, 60)), [0, 0, 0]);
+    assert_eq!(at(1, 1, (50, 60)), [level((-0.5f64).exp()), 0, 0]);
+    assert_eq!(at(2, 1, (50, 60)), [level((-1.5f64).exp()), 0, 0]);
+    // The OFF pixel, its latest event 10 ms before each frame's end (events at the end itself
+    // wait for the next sample, as tonic's slices do): blue.
+    assert_eq!(at(0, 1, (100, 100)), [0, 0, level((-0.1f64).exp())]);
+    // The voxel grid (default 640 ms window, 5 bins) sums its signed bins: the OFF pixel's
+    // ten or more events outweigh the single ON event, which shows red at a tenth or less.
+    let [r, g, b] = at(1, 2, (100, 100));
+    assert_eq!((r, g, b), (0, 0, 255));
+    let [r, _, b] = at(1, 2, (50, 60));
+    assert!(r > 0 && r < 40 && b == 0, "{r} {b}");
+}

@@ -298,3 +298,140 @@ fn filters_apply_before_the_representation_and_are_recorded_beside_the_features(
     assert!(err.contains("region=20,0,16,24"), "{err}");
     assert!(!bad.exists(), "nothing written");
 }
+
+/// `represent` of a kind the paper did not choose on the same stream as the library, with the
+/// settings its flags name.
+fn dense_case(dir: &Path, flags: &[&str], what: &str, config: ReprConfig) {
+    let (events_path, samples_path) = (dir.join("e.csv"), dir.join("s.txt"));
+    let events = stream(32, 24);
+    write_csv(&events_path, &events);
+    let samples = write_samples(&samples_path, &[50, 5_000, 9_000, 9_000, 21_000]);
+    let out = dir.join(format!("{what}.npy"));
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let mut args: Vec<String> = [
+        "represent",
+        &s(&events_path),
+        "--samples",
+        &s(&samples_path),
+    ]
+    .map(String::from)
+    .to_vec();
+    args.extend(["--sensor", "32x24", "--roi", "none", "--what", what, "-o"].map(String::from));
+    args.push(s(&out));
+    args.extend(flags.iter().map(|f| f.to_string()));
+    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let frame = Resolution::new(32, 24);
+    let mut fx = evtac_repr::FeatureExtractor::new(&[config], frame, None).unwrap();
+    let (mut want, mut values) = (Vec::new(), Vec::new());
+    fx.run(&events, &samples, |_, fx| {
+        if what == "frames" {
+            fx.frame_values_into(0, &mut values);
+            want.extend_from_slice(&values);
+        } else {
+            want.extend_from_slice(fx.features(0));
+        }
+    })
+    .unwrap();
+    let channels = config.frames();
+    if what == "frames" {
+        let got: ndarray::Array4<f32> = ndarray_npy::read_npy(&out).unwrap();
+        assert_eq!(got.dim(), (5, channels, 24, 32), "{flags:?}");
+        assert_eq!(got.iter().copied().collect::<Vec<_>>(), want, "{flags:?}");
+    } else {
+        let got: Array2<f32> = ndarray_npy::read_npy(&out).unwrap();
+        assert_eq!(got.dim(), (5, channels * 12), "{flags:?}");
+        assert_eq!(got.iter().copied().collect::<Vec<_>>(), want, "{flags:?}");
+        let made = std::fs::read_to_string(dir.join(format!("{what}.npy.json"))).unwrap();
+        assert!(made.contains(config.kind_name()), "{made}");
+    }
+    assert!(
+        want.iter().any(|&v| v != 0.0),
+        "{flags:?}: the case sees events"
+    );
+}
+
+#[test]
+fn time_surfaces_histograms_and_voxel_grids_are_the_librarys_with_their_flags() {
+    use evtac_repr::{HistogramConfig, TimeSurfaceConfig, VoxelGridConfig};
+    let dir = tempfile::tempdir().unwrap();
+    let surface = ReprConfig::TimeSurface(TimeSurfaceConfig {
+        tau_ms: 2.0,
+        threshold: None,
+    });
+    let binarized = ReprConfig::TimeSurface(TimeSurfaceConfig {
+        tau_ms: 2.0,
+        threshold: Some(0.25),
+    });
+    let histogram = ReprConfig::Histogram(HistogramConfig { window_ms: 3.0 });
+    let voxel = ReprConfig::VoxelGrid(VoxelGridConfig {
+        window_ms: 3.0,
+        bins: 3,
+    });
+    let cases: [(&[&str], ReprConfig); 4] = [
+        (&["--repr", "time-surface", "--tau-ms", "2"], surface),
+        (
+            &[
+                "--repr",
+                "time-surface",
+                "--tau-ms",
+                "2",
+                "--threshold",
+                "0.25",
+            ],
+            binarized,
+        ),
+        (&["--repr", "histogram", "--window-ms", "3"], histogram),
+        (
+            &["--repr", "voxel-grid", "--window-ms", "3", "--bins", "3"],
+            voxel,
+        ),
+    ];
+    for (flags, config) in cases {
+        for what in ["frames", "features"] {
+            dense_case(dir.path(), flags, what, config);
+        }
+    }
+}
+
+#[test]
+fn settings_a_kind_does_not_take_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (events_path, samples_path) = (dir.path().join("e.csv"), dir.path().join("s.txt"));
+    write_csv(&events_path, &stream(32, 24));
+    write_samples(&samples_path, &[5_000]);
+    let out = dir.path().join("x.npy");
+    let mask = dir.path().join("mask.npy");
+    ndarray_npy::write_npy(&mask, &Array2::<u8>::zeros((24, 32))).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let base = [
+        "represent".to_string(),
+        s(&events_path),
+        "--samples".into(),
+        s(&samples_path),
+        "--sensor".into(),
+        "32x24".into(),
+        "--roi".into(),
+        "none".into(),
+        "-o".into(),
+        s(&out),
+    ];
+    let cases: [(&[&str], &str); 5] = [
+        (&["--repr", "histogram", "--bins", "3"], "bins"),
+        (&["--repr", "combined", "--bins", "3"], "--bins 3"),
+        (&["--repr", "time-surface", "--eta", "0.2"], "--eta"),
+        (&["--repr", "time-surface", "--threshold", "2"], "threshold"),
+        (&["--repr", "voxel-grid", "--bins", "0"], "bins"),
+    ];
+    for (flags, named) in cases {
+        let mut args: Vec<&str> = base.iter().map(String::as_str).collect();
+        args.extend(flags);
+        let err = crate::common::run_err(&args);
+        assert!(err.contains(named), "{flags:?}: {err}");
+    }
+    let mut args: Vec<&str> = base.iter().map(String::as_str).collect();
+    let mask = s(&mask);
+    args.extend(["--repr", "histogram", "--mask", &mask]);
+    let err = crate::common::run_err(&args);
+    assert!(err.contains("--mask") && err.contains("histogram"), "{err}");
+    assert!(!out.exists());
+}

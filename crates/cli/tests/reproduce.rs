@@ -212,7 +212,7 @@ fn tiny_reproduction_writes_the_report_with_every_figure() {
         results["choices"].as_array().map(Vec::len),
         Some(expected.len())
     );
-    let reprs = evtac_repr::ReprKind::ALL.len();
+    let reprs = evtac_repr::ReprKind::BINARY.len();
     assert_eq!(results["exp1"].as_array().map(Vec::len), Some(reprs));
     // Experiment 1 at every noise level of the plan, for every representation; x1 is
     // Experiment 1 itself, and no noise means no background events.
@@ -501,7 +501,7 @@ fn no_fusions_trains_the_papers_three_representations_only() {
                 .filter(|j| matches!(j, Job::Train(t) if t.spec.repr.kind() == kind))
                 .count()
         };
-        ReprKind::ALL.map(count)
+        ReprKind::BINARY.map(count)
     };
     let all = export(&[]);
     let paper = export(&["--no-fusions"]);

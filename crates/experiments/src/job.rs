@@ -206,6 +206,10 @@ pub struct ReproduceJob {
     /// leaves it out). Absent from older jobs files: it does.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub capture_ablation: bool,
+    /// Whether Experiment 1 also compares the representations the paper did not choose
+    /// (`--beyond`, [`Plan::beyond`]). Absent from older jobs files: no.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub beyond: bool,
 }
 
 impl ReproduceJob {
@@ -231,6 +235,7 @@ impl ReproduceJob {
             plan.noise_levels = levels.clone();
         }
         plan.fusions = self.fusions;
+        plan.beyond = self.beyond;
         plan.repeat_split = self.repeat_split;
         if let Some(grid) = self.grid {
             plan = plan.with_grid(grid);
@@ -483,6 +488,7 @@ mod tests {
                 recheck: false,
                 capture_filter: Some("k-noise=2ms".parse().unwrap()),
                 capture_ablation: true,
+                beyond: true,
             }),
             Job::SensitivityPoint(SensitivityPointJob {
                 scale: Scale::Small,

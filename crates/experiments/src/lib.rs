@@ -63,6 +63,7 @@ pub mod choices;
 pub mod context;
 pub mod dataset;
 pub mod dataset_seeds;
+pub mod dense_grid;
 mod error;
 mod examples;
 pub mod exp1;

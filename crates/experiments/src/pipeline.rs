@@ -144,7 +144,14 @@ pub fn reproduce(
     let exp1_sim = ds1.simulator()?;
     let on2 = match &data.exp2 {
         Some(dir) => {
-            let on2 = on_exp2(dir, data.inputs.clone(), &on1.reprs, &run)?;
+            // Experiment 2 compares the binary kinds (the paper's and the fusions).
+            let binary: Vec<ReprConfig> = on1
+                .reprs
+                .iter()
+                .filter(|c| c.dense_part().is_none())
+                .copied()
+                .collect();
+            let on2 = on_exp2(dir, data.inputs.clone(), &binary, &run)?;
             datasets.push((Protocol::Exp2, on2.trials));
             stages.done(Timed::Exp2)?;
             Some(on2)
@@ -177,7 +184,7 @@ pub fn reproduce(
             datasets,
             inputs: Some(data.inputs.clone()),
         },
-        tuning: vec![on1.st, on1.dt],
+        tuning: [vec![on1.st, on1.dt], on1.beyond].concat(),
         exp1: on1.e1,
         exp2: e2,
         exp3_speed: e3s,
@@ -213,6 +220,8 @@ pub fn reproduce(
 struct OnExp1 {
     st: Tuning,
     dt: Tuning,
+    /// The tunings of the kinds the paper did not choose ([`Plan::beyond`]).
+    beyond: Vec<Tuning>,
     reprs: Vec<ReprConfig>,
     e1: Vec<Exp1Repr>,
     noise: Vec<NoisePoint>,
@@ -236,11 +245,19 @@ fn on_exp1(
     stages.done(Timed::TuningStatic)?;
     let dt = tuning::tune(cache1, splits1, Kind::Dynamic, run)?;
     stages.done(Timed::TuningDynamic)?;
-    let reprs = exp1::of_plan(run.plan, st.chosen_config, dt.chosen_config);
+    let beyond = tuning::tune_beyond(cache1, splits1, run)?;
+    if !beyond.is_empty() {
+        stages.done(Timed::TuningBeyond)?;
+    }
+    let binary = exp1::of_plan(run.plan, st.chosen_config, dt.chosen_config);
+    // Experiment 1 compares the kinds beyond the paper too; the studies that train it again
+    // at other noise or in the ablations keep to the binary ones.
+    let mut reprs = binary.clone();
+    reprs.extend(beyond.iter().map(|t| t.chosen_config));
 
     let e1 = exp1::run(cache1, splits1, &reprs, run)?;
     stages.done(Timed::Exp1)?;
-    let noise = noise::run(ds1, &e1, &reprs, run, out)?;
+    let noise = noise::run(ds1, &e1, &binary, run, out)?;
     if !noise.is_empty() {
         stages.done(Timed::Exp1OtherNoise)?;
     }
@@ -263,6 +280,7 @@ fn on_exp1(
     Ok(OnExp1 {
         st,
         dt,
+        beyond,
         reprs,
         e1,
         noise,
@@ -387,7 +405,11 @@ fn fig2_and_sensor(
         return Ok((None, None));
     };
     // The paper's three frames (the fusions' are the static and dynamic ones).
-    let paper_reprs: Vec<_> = reprs.iter().filter(|c| c.frames() == 1).copied().collect();
+    let paper_reprs: Vec<_> = reprs
+        .iter()
+        .filter(|c| c.frames() == 1 && c.dense_part().is_none())
+        .copied()
+        .collect();
     let example = repr_example::example(cache1, meta, &paper_reprs)?;
     // The tilt at the example's sample (commanded: constant speed from onset).
     let theta = example.as_ref().map_or(meta.total_deg / 2.0, |e| {
@@ -429,10 +451,19 @@ fn latencies(
     Ok((lat, paced))
 }
 
-/// Whether every tuning run of both representations is finished in `out`.
+/// The kinds `plan` tunes: static and dynamic, then those beyond the paper it compares.
+fn tuned_kinds(plan: &Plan) -> Vec<Kind> {
+    let beyond = plan.beyond_kinds().iter().filter_map(|&r| Kind::of_repr(r));
+    [Kind::Static, Kind::Dynamic]
+        .into_iter()
+        .chain(beyond)
+        .collect()
+}
+
+/// Whether every tuning run of every tuned representation is finished in `out`.
 pub fn tunings_finished(plan: &Plan, out: &Path) -> bool {
     let models = out.join("models");
-    [Kind::Static, Kind::Dynamic].into_iter().all(|kind| {
+    tuned_kinds(plan).into_iter().all(|kind| {
         tuning::grid(plan, kind)
             .iter()
             .all(|p| exp1::finished(&tuning::run_dir(&models, kind, &p.config)))
@@ -451,7 +482,7 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
     let mut jobs = Vec::new();
     let mut tuned = Vec::new();
     let mut rechecks = Vec::new();
-    for kind in [Kind::Static, Kind::Dynamic] {
+    for kind in tuned_kinds(plan) {
         let mut best: Option<(f64, ReprConfig)> = None;
         let mut ranked = Vec::new();
         let mut all_done = true;
@@ -471,12 +502,20 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
             }
         }
         if all_done && let Some((_, c)) = best {
-            tuned.push(c);
+            tuned.push((kind, c));
             let top = tuning::top(&ranked, plan);
             rechecks.extend(tuning::recheck_jobs(&ds1, kind, &top, plan, seed, &models));
         }
     }
-    if let [s, d] = tuned[..] {
+    let chosen = |kind: Kind| tuned.iter().find(|(k, _)| *k == kind).map(|&(_, c)| c);
+    // Experiment 1 on the kinds beyond the paper once every one of them is tuned.
+    let beyond: Vec<ReprConfig> = tuned
+        .iter()
+        .filter(|(k, _)| !matches!(k, Kind::Static | Kind::Dynamic))
+        .map(|&(_, c)| c)
+        .collect();
+    let beyond_tuned = beyond.len() == plan.beyond_kinds().len();
+    if let (Some(s), Some(d)) = (chosen(Kind::Static), chosen(Kind::Dynamic)) {
         // The recheck of the best settings runs in the same round as Experiments 1 and 2, once
         // both grids are done, so a round never mixes the grids with what follows them.
         jobs.extend(
@@ -487,6 +526,9 @@ pub fn export_jobs(data: &Datasets, plan: &Plan, seed: u64, out: &Path) -> Resul
         );
         let reprs = exp1::of_plan(plan, s, d);
         let mut train = exp1::jobs(&ds1, &reprs, plan, seed, &models);
+        if beyond_tuned {
+            train.extend(exp1::jobs(&ds1, &beyond, plan, seed, &models));
+        }
         train.extend(label_noise::jobs(&ds1, &reprs, plan, seed, &models));
         train.extend(capture_filter::jobs((&ds1, &reprs), plan, seed, &models)?);
         if let Some(d2) = &data.exp2 {

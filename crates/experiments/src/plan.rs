@@ -10,6 +10,7 @@
 //! a cross through the paper's chosen settings (one parameter varied while the other is fixed,
 //! as the paper's tuning figure shows). The report states the plan it ran.
 
+pub use crate::dense_grid::DenseGrids;
 use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use evtac_sim::Scale;
 use serde::{Deserialize, Serialize};
@@ -21,14 +22,55 @@ pub enum Kind {
     Static,
     /// Window x threshold.
     Dynamic,
+    /// Tau x threshold (0: continuous), [`DenseGrids`].
+    TimeSurface,
+    /// Window.
+    Histogram,
+    /// Window x bins.
+    VoxelGrid,
 }
 
 impl Kind {
+    /// Every kind with a grid: the paper's two, then the real-valued kinds.
+    pub const ALL: [Kind; 5] = [
+        Kind::Static,
+        Kind::Dynamic,
+        Kind::TimeSurface,
+        Kind::Histogram,
+        Kind::VoxelGrid,
+    ];
+
     /// The representation tuned.
     pub fn repr(self) -> ReprKind {
         match self {
             Kind::Static => ReprKind::Static,
             Kind::Dynamic => ReprKind::Dynamic,
+            Kind::TimeSurface => ReprKind::TimeSurface,
+            Kind::Histogram => ReprKind::Histogram,
+            Kind::VoxelGrid => ReprKind::VoxelGrid,
+        }
+    }
+
+    /// The kind that tunes `repr`, if any (the fusions and the OR are not tuned: they take the
+    /// static and dynamic choices).
+    pub fn of_repr(repr: ReprKind) -> Option<Kind> {
+        Self::ALL.into_iter().find(|k| k.repr() == repr)
+    }
+
+    /// The name of the grid's first axis: `tau_ms` or `window_ms`.
+    pub fn time_name(self) -> &'static str {
+        match self {
+            Kind::Static | Kind::TimeSurface => "tau_ms",
+            Kind::Dynamic | Kind::Histogram | Kind::VoxelGrid => "window_ms",
+        }
+    }
+
+    /// The name of the grid's second axis: `threshold` (0 for a continuous time surface; a
+    /// histogram's is always 0) or a voxel grid's `bins`.
+    pub fn threshold_name(self) -> &'static str {
+        match self {
+            Kind::VoxelGrid => "bins",
+            Kind::Static | Kind::Dynamic | Kind::TimeSurface | Kind::Histogram => "threshold",
         }
     }
 
@@ -114,6 +156,17 @@ pub struct Plan {
     /// Absent from older plans: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capture_filter: Option<evtac_filters::FilterSpec>,
+    /// The grids of the real-valued kinds the paper did not choose (`evtac tune --repr
+    /// time-surface`, `histogram`, `voxel-grid`). Absent from older plans: `small`'s.
+    #[serde(default)]
+    pub dense_grids: DenseGrids,
+    /// Whether Experiment 1 also compares the representations the paper did not choose (time
+    /// surface, histogram, voxel grid), each tuned on its grid ([`Plan::dense_grids`]) and
+    /// trained with the plan's seeds on every dataset (`evtac reproduce --beyond`). They are
+    /// not trained in Experiment 2, at other noise, or in the ablations. Absent from older
+    /// plans: no.
+    #[serde(default)]
+    pub beyond: bool,
 }
 
 /// The NeuroTac lab's capture filter: its `NeuroTac` capture class passes every recording
@@ -254,6 +307,8 @@ impl Plan {
                 recheck_seeds: 0,
                 // The paper's plan is hours already; `small` runs the ablation by default.
                 capture_filter: None,
+                dense_grids: DenseGrids::for_scale(scale),
+                beyond: false,
             },
             Scale::Small => Plan {
                 scale,
@@ -271,6 +326,7 @@ impl Plan {
                 // standard deviation worth comparing with the training seeds'.
                 datasets: 5,
                 capture_filter: Some(lab_capture_filter()),
+                dense_grids: DenseGrids::for_scale(scale),
                 ..Plan::paper_grids(Scale::Paper)
             },
             Scale::Tiny => Plan {
@@ -287,6 +343,7 @@ impl Plan {
                 latency_trials: 2,
                 // Two, so that every test of a tiny run goes through a second dataset.
                 datasets: 2,
+                dense_grids: DenseGrids::for_scale(scale),
                 ..Plan::paper_grids(Scale::Paper)
             },
         }
@@ -303,11 +360,23 @@ impl Plan {
         })
     }
 
-    /// Representations trained per seed in Experiments 1 and 2 and the noise study: the
+    /// The representations the paper did not choose that Experiment 1 compares: all three with
+    /// [`Plan::beyond`], else none.
+    pub fn beyond_kinds(&self) -> &'static [ReprKind] {
+        if self.beyond { &ReprKind::BEYOND } else { &[] }
+    }
+
+    /// Representations trained per seed in Experiment 1 on every dataset: the paper's three,
+    /// the two learned fusions unless left out, and the kinds beyond the paper when asked for.
+    pub fn exp1_representations(&self) -> usize {
+        self.representations() + self.beyond_kinds().len()
+    }
+
+    /// Representations trained per seed in Experiment 2 and the noise study: the
     /// paper's three, and the two learned fusions unless left out.
     pub fn representations(&self) -> usize {
         if self.fusions {
-            ReprKind::ALL.len()
+            ReprKind::PAPER.len() + ReprKind::FUSIONS.len()
         } else {
             ReprKind::PAPER.len()
         }

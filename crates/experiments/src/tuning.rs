@@ -29,10 +29,25 @@ pub use crate::plan::Kind;
 pub struct GridPoint {
     /// Tau or window, ms.
     pub time_ms: f64,
-    /// Threshold.
+    /// Threshold ([`Kind::threshold_name`]: a voxel grid's bins).
     pub threshold: f64,
     /// The config.
     pub config: ReprConfig,
+}
+
+/// The tunings of the representations the paper did not choose that `plan` compares
+/// ([`Plan::beyond_kinds`]), in report order, each run (or resumed) by [`tune`].
+pub fn tune_beyond(
+    cache: &FeatureCache<'_>,
+    splits: &Splits,
+    run: &RunContext<'_>,
+) -> Result<Vec<Tuning>, Error> {
+    run.plan
+        .beyond_kinds()
+        .iter()
+        .filter_map(|&repr| Kind::of_repr(repr))
+        .map(|kind| tune(cache, splits, kind, run))
+        .collect()
 }
 
 /// The grid of `kind` under `plan`.
@@ -54,6 +69,16 @@ pub fn grid(plan: &Plan, kind: Kind) -> Vec<GridPoint> {
                 time_ms: t,
                 threshold: f64::from(th),
                 config: plan::dynamic_config(t, th),
+            })
+            .collect(),
+        Kind::TimeSurface | Kind::Histogram | Kind::VoxelGrid => plan
+            .dense_grids
+            .points(kind.repr())
+            .into_iter()
+            .map(|(time_ms, threshold, config)| GridPoint {
+                time_ms,
+                threshold,
+                config,
             })
             .collect(),
     }
@@ -231,29 +256,22 @@ pub fn tune(
     Ok(Tuning {
         recheck,
         repr: kind.repr(),
-        time_name: match kind {
-            Kind::Static => "tau_ms".into(),
-            Kind::Dynamic => "window_ms".into(),
-        },
+        time_name: kind.time_name().into(),
         runs,
         chosen_time_ms: best.time_ms,
         chosen_threshold: best.threshold,
         chosen_config: best.config,
-        curve_time_ms: if plan.full_grid {
-            best.time_ms
-        } else {
-            match kind {
-                Kind::Static => plan.static_center.0,
-                Kind::Dynamic => plan.dynamic_center.0,
-            }
+        // A cross's curves pass through its center; full grids (the real-valued kinds' always
+        // are) through the best point.
+        curve_time_ms: match kind {
+            Kind::Static if !plan.full_grid => plan.static_center.0,
+            Kind::Dynamic if !plan.full_grid => plan.dynamic_center.0,
+            _ => best.time_ms,
         },
-        curve_threshold: if plan.full_grid {
-            best.threshold
-        } else {
-            match kind {
-                Kind::Static => f64::from(plan.static_center.1),
-                Kind::Dynamic => f64::from(plan.dynamic_center.1),
-            }
+        curve_threshold: match kind {
+            Kind::Static if !plan.full_grid => f64::from(plan.static_center.1),
+            Kind::Dynamic if !plan.full_grid => f64::from(plan.dynamic_center.1),
+            _ => best.threshold,
         },
     })
 }

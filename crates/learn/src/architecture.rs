@@ -8,6 +8,7 @@
 //! | [`Architecture::Mlp`] | 900 (static, dynamic or combined) | 900-256-128-64-2, the paper's |
 //! | [`Architecture::Stacked`] | 1800 (static then dynamic) | 1800-256-128-64-2 |
 //! | [`Architecture::Late`] | 1800 (static then dynamic) | two 900-128 branches, concatenated to 256, then the paper's head 256-128-64-2 |
+//! | [`Architecture::Channels`] | `C x 900` (a real-valued kind's channels: 2 polarities, or a voxel grid's bins) | `C x 900`-256-128-64-2 |
 //!
 //! All three are stored and run as one four-layer MLP `inputs-256-128-64-2`. Late fusion is that
 //! network with a block-diagonal first layer: the static inputs feed hidden units `0..128`, the
@@ -27,8 +28,11 @@ use evtac_repr::ReprConfig;
 
 /// Features of one pooled frame: 30 x 30 cells of the paper's 240 x 240 crop.
 pub const INPUTS: usize = 900;
-/// The most features any architecture reads: two pooled frames.
-pub const MAX_INPUTS: usize = 2 * INPUTS;
+/// The most pooled frames (channels) a network reads side by side: a voxel grid of up to 8 bins.
+pub const MAX_FRAMES: usize = 8;
+/// The most features any architecture reads: [`MAX_FRAMES`] pooled frames (7200). The
+/// kernels' per-sample buffers are this long, on the stack, and index features as `u16`.
+pub const MAX_INPUTS: usize = MAX_FRAMES * INPUTS;
 /// Number of outputs: (pitch, roll) in degrees.
 pub const OUTPUTS: usize = 2;
 /// The hidden layers' widths, the paper's: 256, 128 and 64.
@@ -39,6 +43,8 @@ pub const LAYERS: usize = HIDDEN.len() + 1;
 pub const BRANCH: usize = HIDDEN[0] / 2;
 
 /// The network behind a representation (see the module docs).
+///
+/// Serialized as `"mlp"`, `"stacked"`, `"late"`, or `{"channels": C}`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Architecture {
@@ -49,6 +55,9 @@ pub enum Architecture {
     Stacked,
     /// Late fusion: a 900-128 branch per frame, concatenated, then the head 256-128-64-2.
     Late,
+    /// The paper's MLP over the `C` pooled channels of a real-valued representation (time
+    /// surface, histogram: 2; voxel grid: its bins), side by side: `C x 900`-256-128-64-2.
+    Channels(usize),
 }
 
 impl Architecture {
@@ -62,24 +71,43 @@ impl Architecture {
             ReprConfig::Static(_) | ReprConfig::Dynamic(_) | ReprConfig::Combined { .. } => {
                 Self::Mlp
             }
+            ReprConfig::TimeSurface(_) | ReprConfig::Histogram(_) | ReprConfig::VoxelGrid(_) => {
+                Self::Channels(config.frames())
+            }
         }
     }
 
-    /// Its name, as `config.json` spells it (`mlp`, `stacked`, `late`).
+    /// Its name, as `config.json` spells it (`mlp`, `stacked`, `late`, `channels`).
     pub fn name(self) -> &'static str {
         match self {
             Self::Mlp => "mlp",
             Self::Stacked => "stacked",
             Self::Late => "late",
+            Self::Channels(_) => "channels",
         }
     }
 
-    /// Features per sample: 900, or 1800 for two frames.
+    /// Features per sample: 900, 1800 for two frames, `C x 900` for `C` channels.
     pub fn inputs(self) -> usize {
         match self {
             Self::Mlp => INPUTS,
-            Self::Stacked | Self::Late => MAX_INPUTS,
+            Self::Stacked | Self::Late => 2 * INPUTS,
+            Self::Channels(c) => c * INPUTS,
         }
+    }
+
+    /// Whether the architecture is one evtac's kernels run: at most [`MAX_INPUTS`] features
+    /// (`Channels` of 1 to [`MAX_FRAMES`]).
+    pub fn is_supported(self) -> bool {
+        (1..=MAX_INPUTS).contains(&self.inputs())
+    }
+
+    /// Whether `self` and `other` are the same network (the same layer sizes and the same
+    /// first-layer blocks): a two-channel network and a stacked one are, and a file of weights
+    /// does not say which it was trained for.
+    pub fn same_network(self, other: Self) -> bool {
+        self.layer_sizes() == other.layer_sizes()
+            && self.first_layer_blocks() == other.first_layer_blocks()
     }
 
     /// Layer widths from input to output, as stored (`inputs-256-128-64-2`).
@@ -91,25 +119,21 @@ impl Architecture {
     /// branch's frame (units below [`BRANCH`] the static frame, the others the dynamic one).
     pub fn first_layer_inputs(self, unit: usize) -> Range<usize> {
         match self {
-            Self::Mlp | Self::Stacked => 0..self.inputs(),
+            Self::Mlp | Self::Stacked | Self::Channels(_) => 0..self.inputs(),
             Self::Late if unit < BRANCH => 0..INPUTS,
-            Self::Late => INPUTS..MAX_INPUTS,
+            Self::Late => INPUTS..2 * INPUTS,
         }
     }
 
     /// The first layer's (units, inputs) blocks: which units read which inputs, every weight
     /// outside them zero (one block for the MLPs; late fusion's two branches).
-    pub fn first_layer_blocks(self) -> &'static [(Range<usize>, Range<usize>)] {
-        const MLP: [(Range<usize>, Range<usize>); 1] = [(0..HIDDEN[0], 0..INPUTS)];
-        const STACKED: [(Range<usize>, Range<usize>); 1] = [(0..HIDDEN[0], 0..MAX_INPUTS)];
-        const LATE: [(Range<usize>, Range<usize>); 2] = [
-            (0..BRANCH, 0..INPUTS),
-            (BRANCH..HIDDEN[0], INPUTS..MAX_INPUTS),
-        ];
+    pub fn first_layer_blocks(self) -> Vec<(Range<usize>, Range<usize>)> {
         match self {
-            Self::Mlp => &MLP,
-            Self::Stacked => &STACKED,
-            Self::Late => &LATE,
+            Self::Mlp | Self::Stacked | Self::Channels(_) => vec![(0..HIDDEN[0], 0..self.inputs())],
+            Self::Late => vec![
+                (0..BRANCH, 0..INPUTS),
+                (BRANCH..HIDDEN[0], INPUTS..2 * INPUTS),
+            ],
         }
     }
 
@@ -124,7 +148,7 @@ impl Architecture {
     /// `2x(900-128)-256-128-64-2` for late fusion.
     pub fn describe(self) -> String {
         match self {
-            Self::Mlp | Self::Stacked => {
+            Self::Mlp | Self::Stacked | Self::Channels(_) => {
                 let s = self.layer_sizes().map(|w| w.to_string());
                 s.join("-")
             }
@@ -170,6 +194,23 @@ mod tests {
             assert_eq!(arch.inputs(), config.frames() * INPUTS);
         }
         assert_eq!(Architecture::Mlp.describe(), "900-256-128-64-2");
+        let voxel = ReprConfig::VoxelGrid(evtac_repr::VoxelGridConfig {
+            window_ms: 100.0,
+            bins: 5,
+        });
+        let channels = Architecture::for_repr(&voxel);
+        assert_eq!(channels, Architecture::Channels(5));
+        assert_eq!(channels.describe(), "4500-256-128-64-2");
+        assert!(channels.is_supported() && !Architecture::Channels(9).is_supported());
+        let histogram = ReprConfig::Histogram(evtac_repr::HistogramConfig { window_ms: 10.0 });
+        let two = Architecture::for_repr(&histogram);
+        assert!(two.same_network(Architecture::Stacked) && !two.same_network(Architecture::Late));
+        let json = serde_json::to_string(&channels).unwrap();
+        assert_eq!(json, r#"{"channels":5}"#);
+        assert_eq!(
+            serde_json::from_str::<Architecture>(&json).unwrap(),
+            channels
+        );
         assert_eq!(Architecture::Late.describe(), "2x(900-128)-256-128-64-2");
     }
 

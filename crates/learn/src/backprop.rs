@@ -169,7 +169,7 @@ impl Scratch {
                 let mut k = 0;
                 for (i, (&v, count)) in row.iter().zip(counts.iter_mut()).enumerate() {
                     let nonzero = usize::from(v != 0.0);
-                    // `width <= MAX_INPUTS` (1800) fits in u16; `k <= i < width`.
+                    // `width <= MAX_INPUTS` (7200) fits in u16; `k <= i < width`.
                     index[k] = i as u16;
                     value[k] = v;
                     *count += nonzero;
@@ -241,14 +241,14 @@ pub(crate) fn step(
     // Each block of the first layer from its inputs only (late fusion: a branch per frame).
     let blocks = net.architecture.first_layer_blocks();
     if dense {
-        for block in blocks {
+        for block in &blocks {
             panels::grouped_forward(&l0.weights, &l0.bias, (x, n), h1, block.clone(), true);
         }
     } else {
         for (s, h) in h1.chunks_exact_mut(H1).enumerate() {
             let nz = scratch.row_start[s]..scratch.row_start[s + 1];
             let (index, value) = (&scratch.index[nz.clone()], &scratch.value[nz]);
-            for (units, block_inputs) in blocks {
+            for (units, block_inputs) in &blocks {
                 // The sample's entries in the block's inputs (`index` is ascending).
                 let from = index.partition_point(|&i| usize::from(i) < block_inputs.start);
                 let to = index.partition_point(|&i| usize::from(i) < block_inputs.end);

@@ -44,7 +44,7 @@ use serde::{Deserialize, Serialize};
 
 use evtac_repr::{CROP, Mask, ReprConfig};
 
-use crate::architecture::{BRANCH, HIDDEN, INPUTS, OUTPUTS};
+use crate::architecture::{BRANCH, HIDDEN, INPUTS, MAX_INPUTS, OUTPUTS};
 use crate::metrics::Mae;
 use crate::model::{self, Architecture, LAYERS, LayerParameters, Parameters};
 use crate::predictor::{self, Predictor};
@@ -504,7 +504,8 @@ impl ModelBundle {
         })?;
         let config = raw.typed(&config_path)?;
         let needed = Architecture::for_repr(&config.representation.config);
-        if parameters.architecture != needed {
+        let mut parameters = parameters;
+        if !parameters.architecture.same_network(needed) {
             return Err(Error::Architecture {
                 path: dir.to_path_buf(),
                 weights: parameters.architecture,
@@ -512,6 +513,8 @@ impl ModelBundle {
                 needed,
             });
         }
+        // The file's weights do not tell a two-channel network from a stacked one.
+        parameters.architecture = needed;
 
         let mask_path = dir.join(MASK_FILE);
         let mask = if mask_path.is_file() {
@@ -560,7 +563,7 @@ fn read_mask(path: &Path, frame: evtac_events::Resolution) -> Result<Mask, Error
 /// the head (see the module docs).
 fn linear_names(architecture: Architecture) -> Vec<(String, usize, usize)> {
     match architecture {
-        Architecture::Mlp | Architecture::Stacked => {
+        Architecture::Mlp | Architecture::Stacked | Architecture::Channels(_) => {
             let sizes = architecture.layer_sizes();
             (0..LAYERS)
                 .map(|i| (format!("layers.{i}"), sizes[i], sizes[i + 1]))
@@ -591,6 +594,16 @@ pub fn load_weights(path: &Path) -> Result<Parameters, Error> {
         match st.tensor("layers.0.weight").map(|v| v.shape().to_vec()) {
             Ok(shape) if shape == [HIDDEN[0], Architecture::Stacked.inputs()] => {
                 Architecture::Stacked
+            }
+            // Three or more pooled frames: a real-valued kind's channels (two read as
+            // `Stacked`, the same network).
+            Ok(shape)
+                if shape.len() == 2
+                    && shape[0] == HIDDEN[0]
+                    && shape[1].is_multiple_of(INPUTS)
+                    && (3 * INPUTS..=MAX_INPUTS).contains(&shape[1]) =>
+            {
+                Architecture::Channels(shape[1] / INPUTS)
             }
             // Anything else is read as the paper's MLP, whose checks name what is wrong.
             _ => Architecture::Mlp,

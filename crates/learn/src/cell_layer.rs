@@ -10,10 +10,9 @@
 //! z_j = f32( f64(bias_j) + (sum_i count_i * q_ij) * 2^-s / 64 )
 //! ```
 //!
-//! The sum has at most 1800 terms (two pooled frames side by side) of at most `64 * 2^30`, so
-//! it and every partial sum are integers below `2^47` in magnitude: exact in `f64`, whatever
-//! the order of the terms. That
-//! is the point: adding `(new - old) * q_i` for the cells that changed since the previous
+//! The sum has at most 7200 terms (`MAX_INPUTS`: eight pooled frames side by side) of at most
+//! `64 * 2^30`, so it and every partial sum are integers below `2^49` in magnitude: exact in
+//! `f64`, whatever the order of the terms. That is the point: adding `(new - old) * q_i` for the cells that changed since the previous
 //! sample gives the same bits as summing every cell from scratch, so a live estimator only
 //! touches the rows of the few cells that changed (50-85 of 900 per millisecond at 3 M
 //! events/s) instead of streaming all 0.9 MB of weights through the cache for every estimate
@@ -33,8 +32,8 @@ const H1: usize = LAYER_SIZES[1];
 /// Cells pooled per feature: a feature is `count / CELL_PIXELS`.
 pub const CELL_PIXELS: u8 = 64;
 
-/// The largest fixed-point weight magnitude, `2^30`: with counts up to 64 and 1800 inputs, sums
-/// stay below `2^47`, well inside `f64`'s 53-bit integers.
+/// The largest fixed-point weight magnitude, `2^30`: with counts up to 64 and 7200 inputs, sums
+/// stay below `2^49`, well inside `f64`'s 53-bit integers.
 const Q_MAX: f64 = (1u64 << 30) as f64;
 
 /// Writes the pooled cell counts behind `features` (`count = x * 64`) into the first

@@ -19,8 +19,11 @@ pub enum Error {
         /// Features per row.
         width: usize,
     },
-    /// The row width is neither one pooled frame (900) nor two (1800).
-    #[error("{width} features per sample: evtac's networks read {INPUTS} or {MAX_INPUTS}")]
+    /// The row width is not a whole number of pooled frames (900 each), 1 to 8 of them.
+    #[error(
+        "{width} features per sample: evtac's networks read a multiple of {INPUTS} (one per \
+         pooled frame or channel), at most {MAX_INPUTS}"
+    )]
     Width {
         /// Features per row given.
         width: usize,
@@ -109,7 +112,7 @@ impl FeatureSet {
 
     /// Checks the width, the row structure and that every value is finite.
     pub fn validate(&self) -> Result<(), Error> {
-        if self.width != INPUTS && self.width != MAX_INPUTS {
+        if self.width == 0 || !self.width.is_multiple_of(INPUTS) || self.width > MAX_INPUTS {
             return Err(Error::Width { width: self.width });
         }
         if !self.features.len().is_multiple_of(self.width) {

@@ -143,7 +143,7 @@ impl Parameters {
                 weight: units
                     .clone()
                     .flat_map(|u| {
-                        first.weight[u * MAX_INPUTS..][inputs.clone()]
+                        first.weight[u * 2 * INPUTS..][inputs.clone()]
                             .iter()
                             .copied()
                     })
@@ -231,11 +231,11 @@ impl Parameters {
 /// Late fusion's block-diagonal first layer (`[256, 1800]`) from its two branches (static,
 /// dynamic; each `[BRANCH, 900]`): every cross-branch weight zero.
 pub(crate) fn join_branches(branches: &[LayerParameters; 2]) -> LayerParameters {
-    let mut weight = vec![0.0; HIDDEN[0] * MAX_INPUTS];
+    let mut weight = vec![0.0; HIDDEN[0] * 2 * INPUTS];
     let mut bias = Vec::with_capacity(HIDDEN[0]);
     for (b, branch) in branches.iter().enumerate() {
         for (u, row) in branch.weight.chunks_exact(INPUTS).enumerate() {
-            weight[(b * BRANCH + u) * MAX_INPUTS + b * INPUTS..][..INPUTS].copy_from_slice(row);
+            weight[(b * BRANCH + u) * 2 * INPUTS + b * INPUTS..][..INPUTS].copy_from_slice(row);
         }
         bias.extend_from_slice(&branch.bias);
     }
@@ -284,7 +284,7 @@ mod tests {
         assert_ne!(s.weight, d.weight);
         assert_eq!(join_branches(&[s.clone(), d.clone()]), p.layers[0]);
         // The network is the branches' ReLU outputs, concatenated, through the head.
-        let x: Vec<f32> = (0..MAX_INPUTS)
+        let x: Vec<f32> = (0..2 * INPUTS)
             .map(|i| ((i * 13) % 65) as f32 / 64.0)
             .collect();
         let branch = |b: &LayerParameters, x: &[f32]| -> Vec<f64> {
@@ -322,7 +322,7 @@ mod tests {
         }
         // A cross-branch weight is refused, naming it.
         let mut bad = p.clone();
-        bad.layers[0].weight[3 * MAX_INPUTS + 1000] = 0.5;
+        bad.layers[0].weight[3 * 2 * INPUTS + 1000] = 0.5;
         let msg = bad.validate().expect_err("cross-branch").to_string();
         assert!(msg.contains("[3, 1000]") && msg.contains("static"), "{msg}");
         // The stacked network is dense over 1800 inputs, drawn with fan-in 1800.

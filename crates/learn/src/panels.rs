@@ -211,7 +211,7 @@ fn sparse_relu_forward(layer: &Dense, x: &[f32], out: &mut [f32]) {
     // Branch-free compaction: every value is written, the cursor advances past non-zeros only.
     let mut n = 0;
     for (i, &v) in x.iter().enumerate() {
-        // `fan_in <= MAX_INPUTS` (1800) fits in u16; `n <= i`.
+        // `fan_in <= MAX_INPUTS` (7200) fits in u16; `n <= i`.
         index[n] = i as u16;
         value[n] = v;
         n += usize::from(v != 0.0);

@@ -85,7 +85,7 @@ impl Predictor {
         self.architecture
     }
 
-    /// Features per sample: 900, or 1800 for the two-frame networks.
+    /// Features per sample: 900, 1800 for the two-frame networks, `C x 900` for `C` channels.
     pub fn inputs(&self) -> usize {
         self.layers[0].fan_in
     }
@@ -201,21 +201,29 @@ mod tests {
         ));
     }
 
-    /// The two-frame networks, on pooled and on other features, against the f64 reference;
-    /// late fusion's zero cross-branch weights take part in neither path's result.
+    /// The two-frame networks and those over several channels (up to [`MAX_INPUTS`]), on pooled
+    /// and on other features, against the f64 reference; late fusion's zero cross-branch
+    /// weights take part in neither path's result.
     #[test]
     fn two_frame_networks_match_the_f64_reference() {
-        for architecture in [Architecture::Stacked, Architecture::Late] {
+        let wide = [
+            Architecture::Stacked,
+            Architecture::Late,
+            Architecture::Channels(5),
+            Architecture::Channels(MAX_INPUTS / INPUTS),
+        ];
+        for architecture in wide {
+            let width = architecture.inputs();
             let params = Parameters::init_for(architecture, 12);
             let p = Predictor::new(&params).expect("valid");
-            assert_eq!((p.inputs(), p.architecture()), (MAX_INPUTS, architecture));
-            let pooled: Vec<f32> = (0..2 * MAX_INPUTS)
+            assert_eq!((p.inputs(), p.architecture()), (width, architecture));
+            let pooled: Vec<f32> = (0..2 * width)
                 .map(|i| ((i * 11) % 65) as f32 / 64.0)
                 .collect();
             let off_grid: Vec<f32> = pooled.iter().map(|v| v * 0.9).collect();
             for x in [&pooled, &off_grid] {
                 let got = p.predict(x).expect("rows");
-                for (row, g) in x.chunks_exact(MAX_INPUTS).zip(&got) {
+                for (row, g) in x.chunks_exact(width).zip(&got) {
                     assert_eq!(*g, p.predict_one(row));
                     let r = params.forward_f64(row);
                     for k in 0..OUTPUTS {
@@ -225,7 +233,7 @@ mod tests {
             }
             assert!(matches!(
                 p.predict(&pooled[..INPUTS]),
-                Err(Error::RaggedFeatures { width: 1800, .. })
+                Err(Error::RaggedFeatures { width: w, .. }) if w == width
             ));
         }
     }

@@ -73,7 +73,7 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
         /// Any sequence of samples, pooled or not, gives what the predictor gives each alone,
-        /// for each network (the two-frame ones read 1800 cells).
+        /// for each network (the two-frame ones read 1800 cells, the widest `MAX_INPUTS`).
         #[test]
         fn a_stream_predicts_what_each_sample_alone_does(
             seed in 0u64..4,
@@ -81,6 +81,8 @@ mod tests {
                 Just(Architecture::Mlp),
                 Just(Architecture::Stacked),
                 Just(Architecture::Late),
+                Just(Architecture::Channels(3)),
+                Just(Architecture::Channels(MAX_INPUTS / crate::model::INPUTS)),
             ],
             steps in proptest::collection::vec(
                 (proptest::collection::vec((0usize..MAX_INPUTS, 0u8..=64), 0..120), any::<bool>()),

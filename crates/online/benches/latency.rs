@@ -1,5 +1,6 @@
-//! Per-estimate latency at 1 ms intervals, for each representation, at a realistic event rate
-//! (300k events/s, a NeuroTac in contact) and at 10x that.
+//! Per-estimate latency at 1 ms intervals, for each representation (the paper's, the learned
+//! fusions, and the time surface, histogram and voxel grid at their default settings), at a
+//! realistic event rate (300k events/s, a NeuroTac in contact) and at 10x that.
 //!
 //! Two measurements per case:
 //! - criterion, `estimate/<repr>/<rate>/<arrival>`: one iteration is one 1 ms interval of events
@@ -46,7 +47,10 @@ const ARRIVALS: [(&str, i64); 2] = [("1ms-packets", 1000), ("100us-packets", 100
 fn estimate(c: &mut Criterion) {
     evtac_learn::flush_denormals();
     let mut group = c.benchmark_group("estimate");
-    for (name, repr) in support::representations() {
+    let kinds = support::representations()
+        .into_iter()
+        .chain(support::beyond_representations());
+    for (name, repr) in kinds {
         let dir = tempfile::tempdir().expect("a temporary folder");
         support::seeded_bundle(dir.path(), 1, &repr, None);
         let model = Model::load(dir.path()).expect("the bundle loads");

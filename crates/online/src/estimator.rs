@@ -54,12 +54,25 @@ pub enum Error {
     /// to start over).
     #[error("frames must be asked for before the first events are processed")]
     FramesTooLate,
+    /// Frames were asked for from a model of a real-valued representation (time surface,
+    /// histogram, voxel grid): the logged frames are binary images of the paper's kinds.
+    #[error(
+        "the model's {kind} representation is real-valued: its frames are not logged as binary \
+         images (--mcap-frames takes static, dynamic, combined, stacked and late models; \
+         `evtac represent --what frames` writes a {kind}'s frames)"
+    )]
+    FramesNotBinary {
+        /// The representation's kind.
+        kind: &'static str,
+    },
 }
 
 /// One estimate of the contact angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
-    /// The grid time the estimate is for: it reflects every event with `t <= t_us` and no other.
+    /// The grid time the estimate is for: it reflects every event with `t <= t_us` and no other
+    /// (`t < t_us` for the real-valued kinds, evaluated at tonic's slice ends as offline:
+    /// `evtac_repr::dense`).
     pub t_us: i64,
     /// Pitch in degrees.
     pub pitch_deg: f32,
@@ -180,6 +193,11 @@ impl Estimator {
     pub fn capture_frames(&mut self, every_us: i64) -> Result<(), Error> {
         if self.counters.events > 0 {
             return Err(Error::FramesTooLate);
+        }
+        if self.representation.dense_part().is_some() {
+            return Err(Error::FramesNotBinary {
+                kind: self.representation.kind_name(),
+            });
         }
         self.extractor = FeatureExtractor::new(
             std::slice::from_ref(&self.representation),

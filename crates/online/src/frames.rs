@@ -111,6 +111,9 @@ fn frames_of(extractor: &FeatureExtractor, config: &ReprConfig, mask: Option<&Ma
         height: (pixels.len() / usize::from(size.width.max(1))) as u32,
         pixels,
     };
+    if config.dense_part().is_some() {
+        return Vec::new();
+    }
     let whole = extractor.frame(0);
     match config {
         ReprConfig::Static(_) => vec![frame(Part::Static, whole.to_vec())],
@@ -134,6 +137,10 @@ fn frames_of(extractor: &FeatureExtractor, config: &ReprConfig, mask: Option<&Ma
             }
             frames.push(frame(Part::Combined, whole.to_vec()));
             frames
+        }
+        // Refused when frames are asked for (`Estimator::capture_frames`): not binary.
+        ReprConfig::TimeSurface(_) | ReprConfig::Histogram(_) | ReprConfig::VoxelGrid(_) => {
+            Vec::new()
         }
         // The static part's frame above the dynamic part's.
         ReprConfig::Stacked { .. } | ReprConfig::Late { .. } => {

@@ -99,6 +99,9 @@ fn frames_equal_offline_frames_and_change_no_estimate() {
                     let or: Vec<u8> = s.iter().zip(&d).map(|(a, b)| a | b).collect();
                     assert!(whole == or);
                 }
+                ReprConfig::TimeSurface(_)
+                | ReprConfig::Histogram(_)
+                | ReprConfig::VoxelGrid(_) => panic!("{name}: frames of a real-valued kind"),
                 ReprConfig::Stacked { .. } | ReprConfig::Late { .. } => {
                     assert_eq!(parts(set), [Part::Static, Part::Dynamic]);
                     assert!(*get(Part::Static) == whole[..240 * 240]);

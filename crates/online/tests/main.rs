@@ -1,5 +1,6 @@
 //! Integration tests of `evtac-online`: one binary, one module per concern.
 
+mod dense;
 mod frames;
 mod live;
 mod mcap_log;

@@ -1,21 +1,22 @@
-//! `Representation`: static, dynamic or combined frames and pooled features, as
-//! `evtac represent` builds them (the same crop, mask and `FeatureExtractor`), either in one
+//! `Representation`: static, dynamic or combined frames and pooled features (or a time surface's,
+//! a histogram's or a voxel grid's real-valued frames), as `evtac represent` builds them (the same crop, mask and `FeatureExtractor`), either in one
 //! call over a whole recording (`features`, `frames`, `potentials`) or incrementally (`push`,
 //! `advance_to`), which gives the same numbers for any chunking.
 //!
 //! Settings come as a JSON object with the fields of `evtac_repr::StaticConfig` and
-//! `DynamicConfig` (those of the CLI's options, with the CLI's defaults); a setting that the
-//! kind does not take, or an unknown one, is a `ValueError` naming it.
+//! `DynamicConfig` (those of the CLI's options, with the CLI's defaults), or for the real-valued
+//! kinds those of `evtac_repr::DenseSettings` (`tau_ms`, `threshold`, `window_ms`, `bins`); a
+//! setting that the kind does not take, or an unknown one, is a `ValueError` naming it.
 
 use std::sync::{Mutex, MutexGuard};
 
 use evtac_events::check::EventCheck;
 use evtac_events::{Event, Resolution, Roi};
 use evtac_repr::{
-    CROP, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, ReprConfig, ReprKind,
-    StaticConfig,
+    CROP, DenseSettings, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, ReprConfig,
+    ReprKind, StaticConfig,
 };
-use ndarray::{Array2, Array3};
+use ndarray::{Array2, Array3, Array4};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use serde_json::{Map, Value};
@@ -40,11 +41,48 @@ const STATIC_SETTINGS: &[&str] = &[
 /// The settings of the dynamic part, as `DynamicConfig` names them.
 const DYNAMIC_SETTINGS: &[&str] = &["window_ms", "count_threshold"];
 
+/// The settings of the real-valued kinds, as `DenseSettings` names them.
+const DENSE_SETTINGS: &[&str] = &["tau_ms", "threshold", "window_ms", "bins"];
+
+/// A real-valued kind's config from `settings`: each one a number the kind takes.
+fn parse_dense(kind: ReprKind, settings: Map<String, Value>) -> PyResult<ReprConfig> {
+    let mut dense = DenseSettings::default();
+    for (key, value) in settings {
+        let number = value
+            .as_f64()
+            .ok_or_else(|| error::value(format!("`{key}` must be a number, not {value}")))?;
+        match key.as_str() {
+            "tau_ms" => dense.tau_ms = Some(number),
+            "threshold" => dense.threshold = Some(number),
+            "window_ms" => dense.window_ms = Some(number),
+            "bins" => {
+                let bins = value.as_u64().and_then(|b| u32::try_from(b).ok());
+                dense.bins = Some(bins.ok_or_else(|| {
+                    error::value(format!(
+                        "`bins` must be a positive whole number, not {value}"
+                    ))
+                })?);
+            }
+            _ => {
+                return Err(error::value(format!(
+                    "unknown setting `{key}` of a {} representation; its settings are among: {}",
+                    kind.name(),
+                    DENSE_SETTINGS.join(", ")
+                )));
+            }
+        }
+    }
+    kind.dense_config(dense).map_err(error::value)
+}
+
 /// The config of a `kind` representation with `settings` (a JSON object), the rest defaults.
 pub fn parse_config(kind: &str, settings: &str) -> PyResult<ReprConfig> {
     let settings: Map<String, Value> = serde_json::from_str(settings)
         .map_err(|e| error::value(format!("settings must be a JSON object: {e}")))?;
     let kind: ReprKind = kind.parse().map_err(error::value)?;
+    if kind.is_dense() {
+        return parse_dense(kind, settings);
+    }
     let (has_static, has_dynamic) = kind.parts();
     let (mut st, mut dy) = (Map::new(), Map::new());
     for (key, value) in settings {
@@ -143,6 +181,12 @@ impl Representation {
         roi: Roi,
         mask: Option<Mask>,
     ) -> PyResult<Self> {
+        if mask.is_some() && config.dense_part().is_some() {
+            return Err(error::value(format!(
+                "a no-contact mask applies to the static part: a {} representation has none",
+                config.kind_name()
+            )));
+        }
         if let Some(mask) = &mask
             && mask.resolution() != roi.size
         {
@@ -210,10 +254,15 @@ impl Representation {
     }
 
     /// `(height, width)` of a frame: the crop's, twice as high for stacked and late (the
-    /// static frame above the dynamic one).
+    /// static frame above the dynamic one); a real-valued kind's channels are a dimension of
+    /// their own.
     fn frame_dims(&self) -> (usize, usize) {
+        let stacked = match self.config.dense_part() {
+            Some(_) => 1,
+            None => self.config.frames(),
+        };
         (
-            usize::from(self.roi.size.height) * self.config.frames(),
+            usize::from(self.roi.size.height) * stacked,
             usize::from(self.roi.size.width),
         )
     }
@@ -280,17 +329,36 @@ impl Representation {
     }
 
     /// Binary frames at each of `times`: uint8 `(N, height, width)`, 0 or 1 (stacked and late:
-    /// `(N, 2 * height, width)`, the static frame above the dynamic one).
+    /// `(N, 2 * height, width)`, the static frame above the dynamic one); for a time surface,
+    /// histogram or voxel grid float32 `(N, channels, height, width)`, tonic's layout.
     fn frames<'py>(
         &self,
         py: Python<'py>,
         events: PyReadonlyArray1<'py, u8>,
         times: PyReadonlyArray1<'py, i64>,
-    ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (h, w) = self.frame_dims();
+        if self.config.dense_part().is_some() {
+            let c = self.config.frames();
+            let (events, times) = (
+                events.as_slice().map_err(error::value)?,
+                times.as_slice().map_err(error::value)?,
+            );
+            let out = py.detach(|| -> PyResult<Vec<f32>> {
+                let mut out = Vec::with_capacity(times.len() * c * h * w);
+                let mut values = Vec::new();
+                self.run(events, times, |_, fx| {
+                    fx.frame_values_into(0, &mut values);
+                    out.extend_from_slice(&values);
+                })?;
+                Ok(out)
+            })?;
+            let out = Array4::from_shape_vec((times.len(), c, h, w), out).map_err(error::value)?;
+            return Ok(out.into_pyarray(py).into_any());
+        }
         let (n, out) = self.sampled(py, &events, &times, h * w, |fx| fx.frame(0))?;
         let out = Array3::from_shape_vec((n, h, w), out).map_err(error::value)?;
-        Ok(out.into_pyarray(py))
+        Ok(out.into_pyarray(py).into_any())
     }
 
     /// The static accumulator's potentials at each of `times`: float32 `(N, height, width)`.
@@ -335,13 +403,22 @@ impl Representation {
         Ok(features.into_pyarray(py))
     }
 
-    /// The incremental state's current binary frame (a copy): uint8 `(height, width)`.
-    fn frame<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u8>>> {
+    /// The incremental state's current binary frame (a copy): uint8 `(height, width)`; for a
+    /// real-valued kind float32 `(channels, height, width)`.
+    fn frame<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let (h, w) = self.frame_dims();
+        if self.config.dense_part().is_some() {
+            let mut values = Vec::new();
+            self.state()?.frame_values_into(0, &mut values);
+            let c = self.config.frames();
+            let out = Array3::from_shape_vec((c, h, w), values).map_err(error::value)?;
+            return Ok(out.into_pyarray(py).into_any());
+        }
         let frame = self.state()?.frame(0).to_vec();
         Ok(Array2::from_shape_vec((h, w), frame)
             .map_err(error::value)?
-            .into_pyarray(py))
+            .into_pyarray(py)
+            .into_any())
     }
 
     /// Forgets the incremental state (queued events, potentials, windows, sample time).
@@ -362,7 +439,8 @@ impl Representation {
         serde_json::to_string(&self.config).map_err(error::value)
     }
 
-    /// `static`, `dynamic`, `combined`, `stacked` or `late`.
+    /// `static`, `dynamic`, `combined`, `stacked`, `late`, `time-surface`, `histogram` or
+    /// `voxel-grid`.
     #[getter]
     fn kind(&self) -> &'static str {
         self.config.kind_name()
@@ -394,7 +472,11 @@ impl Representation {
     /// The no-contact mask (a copy, uint8 `(height, width)`, 1 = masked), or `None`.
     #[getter]
     fn mask<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<u8>>>> {
-        let (h, w) = self.frame_dims();
+        // The crop's size: a stacked frame is twice as high, its mask is not.
+        let (h, w) = (
+            usize::from(self.roi.size.height),
+            usize::from(self.roi.size.width),
+        );
         self.mask
             .as_ref()
             .map(|m| {

@@ -163,3 +163,57 @@ def test_bad_arguments_are_value_errors(recording):
         rep.push(e[:10])
     with pytest.raises(ValueError, match="mask is 10x10 but the frame is 240x240"):
         evtac.Representation("static", mask=np.zeros((10, 10)))
+
+
+# The kinds the paper did not choose: (kind, Python settings, `evtac represent` options, channels)
+DENSE_CASES = [
+    ("time-surface", {"tau_ms": 20}, ["--tau-ms", "20"], 2),
+    ("time-surface", {"tau_ms": 20, "threshold": 0.4},
+     ["--tau-ms", "20", "--threshold", "0.4"], 2),
+    ("histogram", {"window_ms": 15}, ["--window-ms", "15"], 2),
+    ("voxel-grid", {"window_ms": 15, "bins": 3}, ["--window-ms", "15", "--bins", "3"], 3),
+]
+
+
+@pytest.mark.parametrize("kind,settings,options,channels", DENSE_CASES)
+def test_time_surfaces_histograms_and_voxel_grids_are_the_clis(
+        cli, tmp_path, aedat, recording, times, kind, settings, options, channels):
+    rep = evtac.Representation(kind, sensor=recording.resolution, **settings)
+    assert rep.kind == kind and rep.feature_len == channels * 900
+    features = rep.features(recording.events, times)
+    expected = _cli_output(cli, tmp_path, aedat, times, kind, options, "features")
+    assert features.dtype == np.float32 and features.shape == (len(times), channels * 900)
+    assert features.tobytes() == expected.tobytes()
+    assert features.any()
+    frames = rep.frames(recording.events, times)
+    expected = _cli_output(cli, tmp_path, aedat, times, kind, options, "frames")
+    assert frames.dtype == np.float32 and frames.shape == (len(times), channels, 240, 240)
+    assert frames.tobytes() == expected.tobytes()
+    # The features are each channel's 8x8 means of the frame.
+    pooled = frames.reshape(len(times), channels, 30, 8, 30, 8).mean(axis=(3, 5))
+    np.testing.assert_allclose(features, pooled.reshape(len(times), -1), atol=1e-6)
+    # Incremental: the same numbers, and the current frame with its channels.
+    events = recording.events
+    rows, pushed = [], 0
+    for t in times:
+        end = max(pushed, int(np.searchsorted(events["t"], t, side="left")))
+        rep.push(events[pushed:end])
+        pushed = end
+        rows.append(rep.advance_to(t))
+    assert np.stack(rows).tobytes() == features.tobytes()
+    assert rep.frame().tobytes() == frames[-1].tobytes()
+
+
+def test_real_valued_kinds_refuse_settings_and_masks_they_do_not_take(recording):
+    with pytest.raises(ValueError, match="unknown setting `eta` of a time-surface"):
+        evtac.Representation("time-surface", eta=0.2)
+    with pytest.raises(ValueError, match="bins"):
+        evtac.Representation("histogram", bins=3)
+    with pytest.raises(ValueError, match="`bins` must be a positive whole number"):
+        evtac.Representation("voxel-grid", bins=2.5)
+    with pytest.raises(ValueError, match="threshold"):
+        evtac.Representation("time-surface", threshold=1.5)
+    with pytest.raises(ValueError, match="static part: a histogram representation has none"):
+        evtac.Representation("histogram", mask=np.zeros((240, 240), np.uint8))
+    rep = evtac.Representation("voxel-grid", bins=4)
+    assert rep.config == {"kind": "voxel-grid", "window_ms": 640.0, "bins": 4}

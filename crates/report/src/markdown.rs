@@ -10,6 +10,7 @@ use evtac_repr::ReprKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod beyond;
 mod capture_filter;
 mod dataset_seeds;
 mod fusion;
@@ -491,12 +492,13 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
         },
         if truth { " ---: | ---: | ---: |" } else { "" }
     );
-    // The paper's three always (its numbers beside ours), then the learned fusions run.
-    let fusions = ReprKind::in_order(r.exp1.iter().map(|e| e.name));
+    // The paper's three always (its numbers beside ours), then the learned fusions and the
+    // kinds beyond the paper that ran.
+    let others = ReprKind::in_order(r.exp1.iter().map(|e| e.name));
     let names = PAPER_TABLE
         .iter()
         .map(|p| p.0)
-        .chain(fusions.into_iter().filter(|n| n.is_fusion()));
+        .chain(others.into_iter().filter(|n| !ReprKind::PAPER.contains(n)));
     for name in names {
         let ours = r.exp1.iter().find(|e| e.name == name);
         let s = ours.map(|e| e.test).unwrap_or_default();
@@ -627,6 +629,7 @@ pub fn markdown(r: &Results, figures: &[&str]) -> String {
     figure(&mut md, figures, 3, None);
     figure(&mut md, figures, 4, None);
     fusion::section(&mut md, r);
+    beyond::section(&mut md, r);
 
     let _ = writeln!(
         md,

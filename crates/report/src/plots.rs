@@ -49,12 +49,15 @@ static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 pub(crate) const FAMILY: &str = "sans-serif";
 
 /// Colors of the three representations, used in every figure.
-const REPR_COLORS: [RGBColor; 5] = [
+const REPR_COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
 ];
 /// Colors of Experiment 2's three training settings.
 const SETTING_COLORS: [RGBColor; 3] = [

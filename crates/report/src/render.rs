@@ -42,7 +42,7 @@ mod sheet;
 
 pub use angles::{Angles, estimate_times};
 pub use draw::{Layout, Scene, draw_frame, layout};
-pub use frames::{Frame, ReprFrame, Timing, for_each_frame};
+pub use frames::{Frame, Pixels, ReprFrame, Timing, for_each_frame};
 pub use gif::GifWriter;
 pub use mp4::Mp4Writer;
 pub use sheet::{MAX_SHEET_FRAMES, SHEET_DEFAULT_FRAMES, SheetWriter};
@@ -63,6 +63,12 @@ pub enum Panel {
     Dynamic,
     /// The combined representation's binary frame.
     Combined,
+    /// A time surface's two polarity channels (ON red, OFF blue).
+    TimeSurface,
+    /// A polarity histogram's counts (ON red, OFF blue, scaled to the frame's largest).
+    Histogram,
+    /// A voxel grid's bins summed (positive red, negative blue, scaled to the largest).
+    VoxelGrid,
     /// The 30x30 pooled features of each representation drawn, in a row below the frames.
     Features,
     /// A model's pitch and roll estimates over the rendered span, beside the labels, with a
@@ -79,14 +85,17 @@ impl Panel {
         Panel::Combined,
     ];
 
-    /// The panel called `name` (`events`, `static`, `dynamic`, `combined`, `features`,
-    /// `angles`).
+    /// The panel called `name` (`events`, `static`, `dynamic`, `combined`, `time-surface`,
+    /// `histogram`, `voxel-grid`, `features`, `angles`).
     pub fn parse(name: &str) -> Result<Panel, Error> {
         match name.trim().to_ascii_lowercase().as_str() {
             "events" => Ok(Panel::Events),
             "static" => Ok(Panel::Static),
             "dynamic" => Ok(Panel::Dynamic),
             "combined" => Ok(Panel::Combined),
+            "time-surface" => Ok(Panel::TimeSurface),
+            "histogram" => Ok(Panel::Histogram),
+            "voxel-grid" => Ok(Panel::VoxelGrid),
             "features" => Ok(Panel::Features),
             "angles" => Ok(Panel::Angles),
             _ => Err(Error::UnknownPanel {
@@ -101,8 +110,26 @@ impl Panel {
             Panel::Static => Some(ReprKind::Static),
             Panel::Dynamic => Some(ReprKind::Dynamic),
             Panel::Combined => Some(ReprKind::Combined),
+            Panel::TimeSurface => Some(ReprKind::TimeSurface),
+            Panel::Histogram => Some(ReprKind::Histogram),
+            Panel::VoxelGrid => Some(ReprKind::VoxelGrid),
             Panel::Events | Panel::Features | Panel::Angles => None,
         }
+    }
+
+    /// The frame panel of a representation kind, if it has one (the fusions have none: their
+    /// frames are the static and dynamic ones).
+    pub fn of_kind(kind: ReprKind) -> Option<Panel> {
+        [
+            Panel::Static,
+            Panel::Dynamic,
+            Panel::Combined,
+            Panel::TimeSurface,
+            Panel::Histogram,
+            Panel::VoxelGrid,
+        ]
+        .into_iter()
+        .find(|p| p.repr_kind() == Some(kind))
     }
 }
 

@@ -19,6 +19,7 @@
 //! comparisons are available for reproducing other readings.
 
 use crate::ReprError;
+use crate::dense::{DenseConfig, HistogramConfig, TimeSurfaceConfig, VoxelGridConfig};
 use serde::{Deserialize, Serialize};
 
 /// How a pixel's potential relaxes towards the neutral potential between its events
@@ -327,6 +328,15 @@ pub enum ReprConfig {
         /// The dynamic part.
         dynamic_part: DynamicConfig,
     },
+    /// A per-polarity time surface, as tonic computes it (a kind the paper did not choose:
+    /// [`crate::dense`]).
+    #[serde(rename = "time-surface")]
+    TimeSurface(TimeSurfaceConfig),
+    /// Per-polarity event counts over a window, as tonic's `to_frame_numpy`.
+    Histogram(HistogramConfig),
+    /// A signed bilinear voxel grid over a window, as tonic's `to_voxel_grid_numpy`.
+    #[serde(rename = "voxel-grid")]
+    VoxelGrid(VoxelGridConfig),
 }
 
 impl Default for ReprConfig {
@@ -347,7 +357,9 @@ impl ReprConfig {
             | Self::Combined { static_part: s, .. }
             | Self::Stacked { static_part: s, .. }
             | Self::Late { static_part: s, .. } => Some(s),
-            Self::Dynamic(_) => None,
+            Self::Dynamic(_) | Self::TimeSurface(_) | Self::Histogram(_) | Self::VoxelGrid(_) => {
+                None
+            }
         }
     }
 
@@ -364,16 +376,46 @@ impl ReprConfig {
             | Self::Late {
                 dynamic_part: d, ..
             } => Some(d),
-            Self::Static(_) => None,
+            Self::Static(_) | Self::TimeSurface(_) | Self::Histogram(_) | Self::VoxelGrid(_) => {
+                None
+            }
+        }
+    }
+
+    /// The settings of a kind the paper did not choose (time surface, histogram, voxel grid),
+    /// as [`crate::DenseExtractor`] takes them; `None` for the binary kinds.
+    pub fn dense_part(&self) -> Option<DenseConfig> {
+        match *self {
+            Self::TimeSurface(c) => Some(DenseConfig::TimeSurface(c)),
+            Self::Histogram(c) => Some(DenseConfig::Histogram(c)),
+            Self::VoxelGrid(c) => Some(DenseConfig::VoxelGrid(c)),
+            Self::Static(_)
+            | Self::Dynamic(_)
+            | Self::Combined { .. }
+            | Self::Stacked { .. }
+            | Self::Late { .. } => None,
+        }
+    }
+
+    /// The config of a real-valued kind's settings.
+    pub fn from_dense(dense: DenseConfig) -> Self {
+        match dense {
+            DenseConfig::TimeSurface(c) => Self::TimeSurface(c),
+            DenseConfig::Histogram(c) => Self::Histogram(c),
+            DenseConfig::VoxelGrid(c) => Self::VoxelGrid(c),
         }
     }
 
     /// How many pooled frames the features hold side by side: 2 for [`ReprConfig::Stacked`]
-    /// and [`ReprConfig::Late`] (static, then dynamic), 1 otherwise.
+    /// and [`ReprConfig::Late`] (static, then dynamic), the channels of a real-valued kind
+    /// ([`DenseConfig::channels`]: 2 polarities, or a voxel grid's bins), 1 otherwise.
     pub fn frames(&self) -> usize {
         match self {
             Self::Stacked { .. } | Self::Late { .. } => 2,
             Self::Static(_) | Self::Dynamic(_) | Self::Combined { .. } => 1,
+            Self::TimeSurface(_) | Self::Histogram(_) | Self::VoxelGrid(_) => {
+                self.dense_part().map_or(1, |d| d.channels())
+            }
         }
     }
 
@@ -389,6 +431,9 @@ impl ReprConfig {
             s.validate()?;
         }
         if let Some(d) = self.dynamic_part() {
+            d.validate()?;
+        }
+        if let Some(d) = self.dense_part() {
             d.validate()?;
         }
         Ok(())
@@ -415,6 +460,10 @@ impl ReprConfig {
                 static_part,
                 dynamic_part,
             } => format!("v1_stacked_{}+{}", static_part.key(), dynamic_part.key()),
+            Self::TimeSurface(_) | Self::Histogram(_) | Self::VoxelGrid(_) => {
+                let dense = self.dense_part().map(|d| d.cache_key()).unwrap_or_default();
+                format!("v1_{dense}")
+            }
         }
     }
 }

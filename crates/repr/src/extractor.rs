@@ -48,11 +48,19 @@
 //! - An event pushed after a sample time it precedes (`t <= t_k` already sampled) cannot change
 //!   that sample: it is applied at the next `advance_to`. Push every event up to `t_k` before
 //!   calling `advance_to(t_k)` for exact results; output is then the same for any chunking.
+//!
+//! # The real-valued kinds
+//! Time surfaces, histograms and voxel grids ([`crate::dense`]) share nothing with the binary
+//! planes: each such config gets its own [`DenseExtractor`], fed the same events and advanced
+//! at the same sample times, with tonic's slice-end semantics (a sample at `t_k` sees the events
+//! before it; see [`crate::dense`]). Their frames are real-valued and several channels deep, so
+//! they are read with [`FeatureExtractor::frame_values_into`], not [`FeatureExtractor::frame`].
 
 use crate::ReprError;
 use crate::accumulator::{BATCH, StaticAccumulator};
 use crate::combine::StaticThreshold;
 use crate::config::{AccumulatorParams, ReprConfig};
+use crate::dense::DenseExtractor;
 use crate::mask::Mask;
 use crate::pool::Pool8;
 use crate::window::SlidingWindow;
@@ -119,6 +127,13 @@ struct Output {
     pool: Pool8,
 }
 
+/// Where config `i`'s output lives: among the binary outputs, or the real-valued extractors.
+#[derive(Clone, Copy)]
+enum Route {
+    Binary(usize),
+    Dense(usize),
+}
+
 /// Streaming representations at sample times, for one or more [`ReprConfig`]s at once.
 ///
 /// ```
@@ -144,6 +159,9 @@ pub struct FeatureExtractor {
     splanes: Vec<StaticPlane>,
     dplanes: Vec<DynamicPlane>,
     outputs: Vec<Output>,
+    denses: Vec<DenseExtractor>,
+    /// One per config, in the configs' order.
+    routes: Vec<Route>,
     masks: Vec<Mask>,
     pending: VecDeque<Event>,
     last_pushed: Option<i64>,
@@ -218,6 +236,8 @@ impl FeatureExtractor {
             splanes: Vec::new(),
             dplanes: Vec::new(),
             outputs: Vec::new(),
+            denses: Vec::new(),
+            routes: Vec::new(),
             masks: Vec::new(),
             pending: VecDeque::new(),
             last_pushed: None,
@@ -225,8 +245,16 @@ impl FeatureExtractor {
             prepared: None,
         };
         let n = frame.pixels();
-        for (i, (config, mask)) in configs.iter().zip(masks).enumerate() {
+        for (config, mask) in configs.iter().zip(masks) {
             config.validate()?;
+            if let Some(dense) = config.dense_part() {
+                // The mask is the static part's; a real-valued kind has none.
+                fx.routes.push(Route::Dense(fx.denses.len()));
+                fx.denses.push(DenseExtractor::new(dense, frame)?);
+                continue;
+            }
+            let i = fx.outputs.len();
+            fx.routes.push(Route::Binary(i));
             let mask = match mask {
                 Some(m) => {
                     if m.resolution() != frame {
@@ -304,7 +332,7 @@ impl FeatureExtractor {
                 (Some(s), Some(d)) => Kind::Combined(s, d),
                 (Some(s), None) => Kind::Static(s),
                 (None, Some(d)) => Kind::Dynamic(d),
-                (None, None) => unreachable!("a ReprConfig has a static or a dynamic part"),
+                (None, None) => unreachable!("a binary ReprConfig has a static or a dynamic part"),
             };
             let pooled = match kind {
                 Kind::Stacked(..) => stacked_frame(frame)?,
@@ -352,7 +380,7 @@ impl FeatureExtractor {
     /// # Panics
     /// When `i >= self.len()`.
     pub fn feature_len(&self, i: usize) -> usize {
-        self.outputs[i].pool.features().len()
+        self.features(i).len()
     }
 
     /// The latest sample time given to [`Self::advance_to`], if any.
@@ -369,14 +397,22 @@ impl FeatureExtractor {
     /// chunk is checked first: on error nothing is queued.
     pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
         let (pending, last) = (&mut self.pending, &mut self.last_pushed);
-        crate::check::queue_events(pending, last, self.resolution, events, None)
+        crate::check::queue_events(pending, last, self.resolution, events, None)?;
+        for dense in &mut self.denses {
+            dense.push(events)?;
+        }
+        Ok(())
     }
 
     /// Queues events in full-sensor coordinates, cropping them with `roi` on the way (events
     /// outside it are dropped). `roi.size` must be the frame size.
     pub fn push_with_roi(&mut self, events: &[Event], roi: &Roi) -> Result<(), ReprError> {
         let (pending, last) = (&mut self.pending, &mut self.last_pushed);
-        crate::check::queue_events(pending, last, self.resolution, events, Some(roi))
+        crate::check::queue_events(pending, last, self.resolution, events, Some(roi))?;
+        for dense in &mut self.denses {
+            dense.push_with_roi(events, roi)?;
+        }
+        Ok(())
     }
 
     /// Applies every queued event with `t <= t_k`, moves the windows to end at `t_k`, and
@@ -384,6 +420,9 @@ impl FeatureExtractor {
     /// time given to [`Self::prepare`]).
     pub fn advance_to(&mut self, t_k: i64) -> Result<(), ReprError> {
         self.prepare(t_k)?;
+        for dense in &mut self.denses {
+            dense.advance_to(t_k)?;
+        }
         self.refresh_static_planes(true);
         self.sample_time = Some(t_k);
         Ok(())
@@ -445,6 +484,9 @@ impl FeatureExtractor {
     pub fn push_and_prepare(&mut self, events: &[Event], t_next: i64) -> Result<(), ReprError> {
         self.last_pushed =
             crate::check::check_events(events, Some(self.resolution), self.last_pushed)?;
+        for dense in &mut self.denses {
+            dense.push(events)?;
+        }
         if let Err(err) = self.check_prepared(t_next) {
             // As `push` then a failing `prepare`: the events stay queued.
             self.pending.extend(events);
@@ -637,8 +679,14 @@ impl FeatureExtractor {
     ///
     /// # Panics
     /// When `i >= self.len()`.
+    ///
+    /// For the real-valued kinds, their channels side by side (each channel's cells, channel
+    /// after channel: [`DenseExtractor::features`]).
     pub fn features(&self, i: usize) -> &[f32] {
-        self.outputs[i].pool.features()
+        match self.routes[i] {
+            Route::Binary(o) => self.outputs[o].pool.features(),
+            Route::Dense(d) => self.denses[d].features(),
+        }
     }
 
     /// The binary frame (0/1 per pixel, row-major) of output `i` at the latest sample time; for
@@ -646,9 +694,54 @@ impl FeatureExtractor {
     /// height).
     ///
     /// # Panics
-    /// When `i >= self.len()`.
+    /// When `i >= self.len()`, or when output `i` is of a real-valued kind (time surface,
+    /// histogram, voxel grid: [`ReprConfig::dense_part`]), whose frames are not binary: read
+    /// those with [`Self::frame_values_into`].
     pub fn frame(&self, i: usize) -> &[u8] {
-        self.outputs[i].pool.frame()
+        match self.routes[i] {
+            Route::Binary(o) => self.outputs[o].pool.frame(),
+            Route::Dense(_) => panic!(
+                "FeatureExtractor::frame: output {i} is a real-valued {} frame; read it with \
+                 frame_values_into",
+                self.configs[i].kind()
+            ),
+        }
+    }
+
+    /// The frame of output `i` as `f32` values into `out`, resized to
+    /// [`Self::frame_values_len`]: a binary frame as 0 and 1, a real-valued kind's channels
+    /// (`channels x height x width`, tonic's layout and values) otherwise.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn frame_values_into(&self, i: usize, out: &mut Vec<f32>) {
+        out.resize(self.frame_values_len(i), 0.0);
+        match self.routes[i] {
+            Route::Binary(o) => {
+                for (v, &b) in out.iter_mut().zip(self.outputs[o].pool.frame()) {
+                    *v = f32::from(b);
+                }
+            }
+            Route::Dense(d) => {
+                // The buffer has the length the extractor checks for.
+                if let Err(err) = self.denses[d].frame_into(out) {
+                    unreachable!("frame buffer sized by frame_values_len: {err}");
+                }
+            }
+        }
+    }
+
+    /// The number of values [`Self::frame_values_into`] writes for output `i`: the pixels of
+    /// its frame (twice the crop for stacked and late), times the channels of a real-valued
+    /// kind.
+    ///
+    /// # Panics
+    /// When `i >= self.len()`.
+    pub fn frame_values_len(&self, i: usize) -> usize {
+        match self.routes[i] {
+            Route::Binary(o) => self.outputs[o].pool.frame().len(),
+            Route::Dense(d) => self.denses[d].channels() * self.resolution.pixels(),
+        }
     }
 
     /// The potential surface behind output `i` (static and combined configs), row-major;
@@ -658,7 +751,10 @@ impl FeatureExtractor {
     /// # Panics
     /// When `i >= self.len()`.
     pub fn potentials(&self, i: usize) -> Option<&[f32]> {
-        match self.outputs[i].kind {
+        let Route::Binary(o) = self.routes[i] else {
+            return None;
+        };
+        match self.outputs[o].kind {
             Kind::Static(s) | Kind::Combined(s, _) | Kind::Stacked(s, _) => {
                 let slot = &self.accs[self.splanes[s].acc];
                 (!slot.deferred).then(|| slot.acc.potentials())
@@ -672,7 +768,10 @@ impl FeatureExtractor {
     /// # Panics
     /// When `i >= self.len()`.
     pub fn counts(&self, i: usize) -> Option<&[u32]> {
-        match self.outputs[i].kind {
+        let Route::Binary(o) = self.routes[i] else {
+            return None;
+        };
+        match self.outputs[o].kind {
             Kind::Dynamic(d) | Kind::Combined(_, d) | Kind::Stacked(_, d) => {
                 Some(self.windows[self.dplanes[d].window].window.counts())
             }
@@ -697,6 +796,9 @@ impl FeatureExtractor {
         }
         for out in &mut self.outputs {
             out.pool.clear();
+        }
+        for dense in &mut self.denses {
+            dense.reset();
         }
         self.pending.clear();
         self.last_pushed = None;

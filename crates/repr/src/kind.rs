@@ -9,9 +9,12 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::ReprError;
 use crate::config::{DynamicConfig, ReprConfig, StaticConfig};
+use crate::dense::{HistogramConfig, TimeSurfaceConfig, VoxelGridConfig};
 
-/// A representation kind: the paper's three, then evtac's two learned fusions.
+/// A representation kind: the paper's three, evtac's two learned fusions, then the real-valued
+/// kinds the paper did not choose.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ReprKind {
     /// Exponential-decay accumulator, masked and thresholded.
@@ -25,24 +28,45 @@ pub enum ReprKind {
     /// Both frames pooled side by side into a network with one branch per frame, joined before
     /// the head (learned late fusion).
     Late,
+    /// Per-polarity time surface (tonic's), continuous or binarized.
+    TimeSurface,
+    /// Per-polarity event counts over a window (tonic's frame with `time_window`).
+    Histogram,
+    /// Signed bilinear voxel grid of B bins over a window (tonic's).
+    VoxelGrid,
 }
 
 impl ReprKind {
-    /// Every kind, in report order: the paper's three, then the learned fusions.
-    pub const ALL: [Self; 5] = [
+    /// Every kind, in report order: the paper's three, the learned fusions, then the kinds the
+    /// paper did not choose.
+    pub const ALL: [Self; 8] = [
+        Self::Static,
+        Self::Dynamic,
+        Self::Combined,
+        Self::Stacked,
+        Self::Late,
+        Self::TimeSurface,
+        Self::Histogram,
+        Self::VoxelGrid,
+    ];
+    /// The paper's three kinds.
+    pub const PAPER: [Self; 3] = [Self::Static, Self::Dynamic, Self::Combined];
+    /// evtac's learned fusions of the static and dynamic frames (not in the paper).
+    pub const FUSIONS: [Self; 2] = [Self::Stacked, Self::Late];
+    /// The real-valued kinds the paper did not choose (`crate::dense`), each tuned on its own
+    /// grid: Experiment 1's "beyond the paper" rows.
+    pub const BEYOND: [Self; 3] = [Self::TimeSurface, Self::Histogram, Self::VoxelGrid];
+    /// The kinds built from a static and a dynamic part: the paper's three and the fusions.
+    pub const BINARY: [Self; 5] = [
         Self::Static,
         Self::Dynamic,
         Self::Combined,
         Self::Stacked,
         Self::Late,
     ];
-    /// The paper's three kinds.
-    pub const PAPER: [Self; 3] = [Self::Static, Self::Dynamic, Self::Combined];
-    /// evtac's learned fusions of the static and dynamic frames (not in the paper).
-    pub const FUSIONS: [Self; 2] = [Self::Stacked, Self::Late];
 
     /// The name on the command line, in configs and in folder names: `static`, `dynamic`,
-    /// `combined`, `stacked`, `late`.
+    /// `combined`, `stacked`, `late`, `time-surface`, `histogram`, `voxel-grid`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Static => "static",
@@ -50,6 +74,9 @@ impl ReprKind {
             Self::Combined => "combined",
             Self::Stacked => "stacked",
             Self::Late => "late",
+            Self::TimeSurface => "time-surface",
+            Self::Histogram => "histogram",
+            Self::VoxelGrid => "voxel-grid",
         }
     }
 
@@ -61,6 +88,9 @@ impl ReprKind {
             Self::Combined => "Combined",
             Self::Stacked => "Stacked",
             Self::Late => "Late",
+            Self::TimeSurface => "Time surface",
+            Self::Histogram => "Histogram",
+            Self::VoxelGrid => "Voxel grid",
         }
     }
 
@@ -78,16 +108,31 @@ impl ReprKind {
                 "Both frames pooled side by side into one 900-128 branch per frame, joined \
                  before the head (learned late fusion)"
             }
+            Self::TimeSurface => {
+                "Per-polarity time surface exp(-age/tau) (tonic's), continuous or binarized \
+                 (--tau-ms, --threshold)"
+            }
+            Self::Histogram => "Per-polarity event counts over a window (tonic's; --window-ms)",
+            Self::VoxelGrid => {
+                "Signed voxel grid of B bins over a window (tonic's; --window-ms, --bins)"
+            }
         }
     }
 
-    /// Whether the kind has a static part and a dynamic part.
+    /// Whether the kind has a static part and a dynamic part (the real-valued kinds have
+    /// neither: [`Self::is_dense`]).
     pub fn parts(self) -> (bool, bool) {
         match self {
             Self::Static => (true, false),
             Self::Dynamic => (false, true),
             Self::Combined | Self::Stacked | Self::Late => (true, true),
+            Self::TimeSurface | Self::Histogram | Self::VoxelGrid => (false, false),
         }
+    }
+
+    /// Whether the kind is real-valued, one the paper did not choose ([`Self::BEYOND`]).
+    pub fn is_dense(self) -> bool {
+        Self::BEYOND.contains(&self)
     }
 
     /// Whether the kind is one of evtac's learned fusions ([`Self::FUSIONS`]).
@@ -96,7 +141,7 @@ impl ReprKind {
     }
 
     /// This kind's config from a static and a dynamic part (a part the kind does not have is
-    /// ignored).
+    /// ignored; a real-valued kind has neither and takes its default settings).
     pub fn config(self, static_part: StaticConfig, dynamic_part: DynamicConfig) -> ReprConfig {
         match self {
             Self::Static => ReprConfig::Static(static_part),
@@ -113,7 +158,77 @@ impl ReprKind {
                 static_part,
                 dynamic_part,
             },
+            Self::TimeSurface => ReprConfig::TimeSurface(TimeSurfaceConfig::default()),
+            Self::Histogram => ReprConfig::Histogram(HistogramConfig::default()),
+            Self::VoxelGrid => ReprConfig::VoxelGrid(VoxelGridConfig::default()),
         }
+    }
+
+    /// A real-valued kind's config from the settings given (`None` keeps the kind's default:
+    /// time surface tau 100 ms, continuous; windows 640 ms; 5 bins), checked. A setting the
+    /// kind does not take is an error naming it, as is a binary kind.
+    pub fn dense_config(self, settings: DenseSettings) -> Result<ReprConfig, ReprError> {
+        let refuse = |field: &'static str, value: String| {
+            Err(ReprError::InvalidConfig {
+                field,
+                value,
+                reason: match self {
+                    Self::TimeSurface => "a time surface takes tau_ms and threshold",
+                    Self::Histogram => "a histogram takes window_ms",
+                    Self::VoxelGrid => "a voxel grid takes window_ms and bins",
+                    _ => "only time-surface, histogram and voxel-grid take these settings",
+                },
+            })
+        };
+        let DenseSettings {
+            tau_ms,
+            threshold,
+            window_ms,
+            bins,
+        } = settings;
+        let config = match self {
+            Self::TimeSurface => {
+                if let Some(w) = window_ms {
+                    return refuse("window_ms", w.to_string());
+                }
+                if let Some(b) = bins {
+                    return refuse("bins", b.to_string());
+                }
+                let d = TimeSurfaceConfig::default();
+                ReprConfig::TimeSurface(TimeSurfaceConfig {
+                    tau_ms: tau_ms.unwrap_or(d.tau_ms),
+                    threshold: threshold.or(d.threshold),
+                })
+            }
+            Self::Histogram | Self::VoxelGrid => {
+                if let Some(t) = tau_ms {
+                    return refuse("tau_ms", t.to_string());
+                }
+                if let Some(t) = threshold {
+                    return refuse("threshold", t.to_string());
+                }
+                if self == Self::Histogram {
+                    if let Some(b) = bins {
+                        return refuse("bins", b.to_string());
+                    }
+                    let d = HistogramConfig::default();
+                    ReprConfig::Histogram(HistogramConfig {
+                        window_ms: window_ms.unwrap_or(d.window_ms),
+                    })
+                } else {
+                    let d = VoxelGridConfig::default();
+                    ReprConfig::VoxelGrid(VoxelGridConfig {
+                        window_ms: window_ms.unwrap_or(d.window_ms),
+                        bins: bins.unwrap_or(d.bins),
+                    })
+                }
+            }
+            Self::Static | Self::Dynamic | Self::Combined | Self::Stacked | Self::Late => {
+                return refuse("kind", self.name().to_string());
+            }
+        };
+        config.validate()?;
+        Ok(config)
     }
 
     /// The kind whose [`Self::title`] is `title`.
@@ -131,6 +246,20 @@ impl ReprKind {
     }
 }
 
+/// The settings of a real-valued kind as a front end takes them (the CLI's `--tau-ms`,
+/// `--threshold`, `--window-ms`, `--bins`; Python's keywords), for [`ReprKind::dense_config`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DenseSettings {
+    /// A time surface's decay constant, ms.
+    pub tau_ms: Option<f64>,
+    /// A time surface's binarization threshold, in (0, 1).
+    pub threshold: Option<f64>,
+    /// A histogram's or voxel grid's window, ms.
+    pub window_ms: Option<f64>,
+    /// A voxel grid's bins.
+    pub bins: Option<u32>,
+}
+
 /// Shows the [`ReprKind::title`] (`Static`), as reports and tables print kinds; width and
 /// alignment apply (`{:<9}`). Command lines and paths use [`ReprKind::name`].
 impl fmt::Display for ReprKind {
@@ -141,7 +270,10 @@ impl fmt::Display for ReprKind {
 
 /// A name that is not a representation kind.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown representation kind `{0}` (static, dynamic, combined, stacked or late)")]
+#[error(
+    "unknown representation kind `{0}` (static, dynamic, combined, stacked, late, \
+     time-surface, histogram or voxel-grid)"
+)]
 pub struct UnknownKind(pub String);
 
 impl FromStr for ReprKind {
@@ -197,6 +329,9 @@ impl ReprConfig {
             Self::Combined { .. } => ReprKind::Combined,
             Self::Stacked { .. } => ReprKind::Stacked,
             Self::Late { .. } => ReprKind::Late,
+            Self::TimeSurface(_) => ReprKind::TimeSurface,
+            Self::Histogram(_) => ReprKind::Histogram,
+            Self::VoxelGrid(_) => ReprKind::VoxelGrid,
         }
     }
 }
@@ -238,9 +373,12 @@ mod tests {
             [Static, Combined, Late]
         );
         assert_eq!(
-            ReprKind::PAPER.len() + ReprKind::FUSIONS.len(),
+            ReprKind::PAPER.len() + ReprKind::FUSIONS.len() + ReprKind::BEYOND.len(),
             ReprKind::ALL.len()
         );
+        assert_eq!(ReprKind::in_order(ReprKind::BEYOND), ReprKind::BEYOND);
+        assert!(ReprKind::BEYOND.iter().all(|k| k.is_dense()));
+        assert!(ReprKind::BINARY.iter().all(|k| !k.is_dense()));
         assert!(ReprKind::FUSIONS.iter().all(|k| k.is_fusion()));
         assert!(!ReprKind::PAPER.iter().any(|k| k.is_fusion()));
     }

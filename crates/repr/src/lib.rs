@@ -81,7 +81,7 @@ pub use dense::{
 };
 pub use error::ReprError;
 pub use extractor::{FeatureExtractor, extract_features};
-pub use kind::{ReprKind, UnknownKind, kind_name};
+pub use kind::{DenseSettings, ReprKind, UnknownKind, kind_name};
 pub use mask::Mask;
 pub use pool::{Pool8, pool8};
 pub use provenance::FeatureProvenance;

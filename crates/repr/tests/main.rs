@@ -2,6 +2,7 @@
 
 mod bad_input;
 mod common;
+mod dense_kinds;
 mod dense_reference;
 mod dv_differential;
 mod expf;

@@ -13,6 +13,7 @@ use crate::inputs::InputArgs;
 use anyhow::{Context, bail};
 use evtac_experiments::job::{self, Job, TrainJob};
 use evtac_experiments::jobs::command_line;
+use evtac_repr::ReprConfig;
 use evtac_sim::Scale;
 
 /// Arguments of `evtac jobs`.
@@ -151,6 +152,9 @@ pub fn equivalent_command(exe: &str, job: &Job) -> Vec<String> {
             if !j.fusions {
                 args.push("--no-fusions".into());
             }
+            if j.beyond {
+                args.push("--beyond".into());
+            }
             if let Some(sd) = j.label_noise_deg {
                 args.extend(["--label-noise-deg".into(), sd.to_string()]);
             }
@@ -203,6 +207,24 @@ fn train_args(j: &TrainJob) -> Vec<String> {
     if let Some(d) = spec.repr.dynamic_part() {
         args.extend(["--window-ms".into(), d.window_ms.to_string()]);
         args.extend(["--count-threshold".into(), d.count_threshold.to_string()]);
+    }
+    match spec.repr {
+        ReprConfig::TimeSurface(c) => {
+            args.extend(["--tau-ms".into(), c.tau_ms.to_string()]);
+            if let Some(x) = c.threshold {
+                args.extend(["--threshold".into(), x.to_string()]);
+            }
+        }
+        ReprConfig::Histogram(c) => args.extend(["--window-ms".into(), c.window_ms.to_string()]),
+        ReprConfig::VoxelGrid(c) => {
+            args.extend(["--window-ms".into(), c.window_ms.to_string()]);
+            args.extend(["--bins".into(), c.bins.to_string()]);
+        }
+        ReprConfig::Static(_)
+        | ReprConfig::Dynamic(_)
+        | ReprConfig::Combined { .. }
+        | ReprConfig::Stacked { .. }
+        | ReprConfig::Late { .. } => {}
     }
     args.extend(["--epochs".into(), spec.epochs.to_string()]);
     args.extend(["--seed".into(), spec.seed.to_string()]);

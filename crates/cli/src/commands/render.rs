@@ -9,7 +9,9 @@
 //! `--tau-ms` / `--window-ms` when given, else the `--model`'s (what the network was trained
 //! on), else the default. With `--model`, the angles panel shows the model's estimates (the
 //! offline prediction's, on the model's own representation and mask) beside the trial's IMU
-//! labels and, for simulated data, the truth.
+//! labels and, for simulated data, the truth. The real-valued kinds' panels (`time-surface`,
+//! `histogram`, `voxel-grid`) draw the `--model`'s settings when it is of that kind (its panel is
+//! then added), else the kind's defaults.
 
 use anyhow::Context;
 use evtac_experiments::dataset::{self, Dataset};
@@ -52,9 +54,9 @@ pub struct Args {
     /// [default: 1].
     #[arg(long)]
     pub speed: Option<f64>,
-    /// Panels, comma-separated: events, static, dynamic, combined, features (the pooled
-    /// features of each frame panel, in a second row), angles (the model's estimates over
-    /// time; added whenever --model is given).
+    /// Panels, comma-separated: events, static, dynamic, combined, time-surface, histogram,
+    /// voxel-grid (ON red, OFF blue), features (the pooled features of each frame panel, in a
+    /// second row), angles (the model's estimates over time; added whenever --model is given).
     #[arg(
         long,
         value_delimiter = ',',
@@ -97,10 +99,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ),
         None => None,
     };
+    let model_cfg = model.as_ref().map(Model::repr_config);
+    // A model of a real-valued kind shows its own frame.
+    if let Some(panel) = model_cfg
+        .filter(|c| c.dense_part().is_some())
+        .and_then(|c| Panel::of_kind(c.kind()))
+        && !panels.contains(&panel)
+    {
+        panels.push(panel);
+    }
     if model.is_some() && !panels.contains(&Panel::Angles) {
         panels.push(Panel::Angles);
     }
-    let model_cfg = model.as_ref().map(Model::repr_config);
     let mut static_cfg = model_cfg
         .and_then(|c| c.static_part().copied())
         .unwrap_or_default();
@@ -113,10 +123,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(window) = args.window_ms {
         dynamic_cfg.window_ms = window;
     }
-    let reprs = evtac_experiments::exp1::paper_representations(
+    let mut reprs = evtac_experiments::exp1::paper_representations(
         ReprConfig::Static(static_cfg),
         ReprConfig::Dynamic(dynamic_cfg),
     );
+    for kind in panels.iter().filter_map(|p| p.repr_kind()) {
+        if kind.is_dense() {
+            reprs.push(match model_cfg {
+                Some(c) if c.kind() == kind => c,
+                _ => kind.config(Default::default(), Default::default()),
+            });
+        }
+    }
     for c in &reprs {
         c.validate()?;
     }

@@ -1,5 +1,6 @@
-//! `evtac represent`: static, dynamic, combined, stacked or late binary frames, potentials or pooled features of
-//! a recording at the sample times listed in a text file, written as NPY.
+//! `evtac represent`: static, dynamic, combined, stacked or late binary frames, potentials or
+//! pooled features of a recording at the sample times listed in a text file, written as NPY; or
+//! the real-valued frames and pooled features of a time surface, histogram or voxel grid.
 //!
 //! Events are cropped to the ROI (default: the centered 240x240 crop of the paper) and fed once,
 //! in time order, to `evtac_repr::FeatureExtractor`. `--mask` takes either an `.npy` mask (uint8
@@ -12,10 +13,10 @@ use anyhow::{Context, bail, ensure};
 use evtac_events::{Event, Resolution, Roi};
 use evtac_learn::Model;
 use evtac_repr::{
-    Comparison, Decay, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask, Polarity,
-    ReprConfig, ReprKind, StaticConfig, ThresholdSpace,
+    Comparison, Decay, DenseSettings, DynamicConfig, FeatureExtractor, FeatureProvenance, Mask,
+    Polarity, ReprConfig, ReprKind, StaticConfig, ThresholdSpace,
 };
-use ndarray::{Array2, Array3};
+use ndarray::{Array2, Array3, Array4};
 
 use crate::outputs::write_npy;
 use std::path::{Path, PathBuf};
@@ -23,10 +24,13 @@ use std::path::{Path, PathBuf};
 /// What to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum What {
-    /// Binary frames: uint8 N x H x W, 0 or 1.
+    /// Binary frames: uint8 N x H x W, 0 or 1 (stacked and late: N x 2H x W, the static frame
+    /// above the dynamic one). Time surfaces, histograms and voxel grids: float32
+    /// N x C x H x W, channels in tonic's order (OFF then ON; voxel bins in time order).
     Frames,
-    /// 8x8 mean-pooled features: float32 N x (H/8 * W/8), 900 for 240x240 (1800 for stacked and
-    /// late).
+    /// 8x8 mean-pooled features: float32 N x (C * H/8 * W/8), 900 per channel for 240x240
+    /// (1800 for stacked and late, the two polarities of a time surface or histogram; 900 per
+    /// voxel bin).
     Features,
     /// The static accumulator's potentials: float32 N x H x W (every kind with a static part).
     Potential,
@@ -114,15 +118,17 @@ pub struct Args {
     /// Static: decay function [default: exponential].
     #[arg(long, value_enum, group = "settings")]
     pub decay: Option<DecayArg>,
-    /// Static: decay time constant in milliseconds [default: 1000].
+    /// Static: decay time constant in milliseconds [default: 1000]. Time surface: its tau
+    /// [default: 100].
     #[arg(long, group = "settings")]
     pub tau_ms: Option<f64>,
     /// Static: event contribution eta [default: 0.15].
     #[arg(long, group = "settings")]
     pub eta: Option<f32>,
     /// Static: threshold in event contributions; set when value > threshold x eta [default: 2].
+    /// Time surface: binarize, 1 where the value is > this, in (0, 1) [default: continuous].
     #[arg(long, group = "settings")]
-    pub threshold: Option<f32>,
+    pub threshold: Option<f64>,
     /// Static: where the threshold applies [default: potential].
     #[arg(long, value_enum, group = "settings")]
     pub threshold_space: Option<Space>,
@@ -144,9 +150,12 @@ pub struct Args {
     /// Static: dv-processing's synchronous decay (every pixel decays at each sample).
     #[arg(long, group = "settings")]
     pub synchronous_decay: bool,
-    /// Dynamic: window length in milliseconds [default: 640].
+    /// Dynamic, histogram, voxel grid: window length in milliseconds [default: 640].
     #[arg(long, group = "settings")]
     pub window_ms: Option<f64>,
+    /// Voxel grid: temporal bins [default: 5].
+    #[arg(long, group = "settings")]
+    pub bins: Option<u32>,
     /// Dynamic: set when the window's event count is > this [default: 0].
     #[arg(long, group = "settings")]
     pub count_threshold: Option<u32>,
@@ -173,7 +182,7 @@ impl Args {
                 None => d.polarity,
             },
             synchronous_decay: self.synchronous_decay,
-            threshold: self.threshold.unwrap_or(d.threshold),
+            threshold: self.threshold.map_or(d.threshold, |t| t as f32),
             threshold_space: match self.threshold_space {
                 Some(Space::Potential) => ThresholdSpace::Potential,
                 Some(Space::U8) => ThresholdSpace::U8,
@@ -195,9 +204,46 @@ impl Args {
         }
     }
 
-    fn config(&self) -> ReprConfig {
-        self.repr
-            .config(self.static_config(), self.dynamic_config())
+    /// The flags given that only the static and dynamic parts take.
+    fn binary_only_flags(&self) -> Vec<&'static str> {
+        let given = [
+            ("--decay", self.decay.is_some()),
+            ("--eta", self.eta.is_some()),
+            ("--threshold-space", self.threshold_space.is_some()),
+            ("--cmp", self.cmp.is_some()),
+            ("--min-potential", self.min_potential.is_some()),
+            ("--max-potential", self.max_potential.is_some()),
+            ("--neutral-potential", self.neutral_potential.is_some()),
+            ("--polarity", self.polarity.is_some()),
+            ("--synchronous-decay", self.synchronous_decay),
+            ("--count-threshold", self.count_threshold.is_some()),
+        ];
+        given
+            .into_iter()
+            .filter_map(|(flag, on)| on.then_some(flag))
+            .collect()
+    }
+
+    fn config(&self) -> anyhow::Result<ReprConfig> {
+        let flags = self.binary_only_flags();
+        ensure!(
+            !self.repr.is_dense() || flags.is_empty(),
+            "{} set the static or dynamic part; --repr {} has neither",
+            flags.join(", "),
+            self.repr.name()
+        );
+        let settings = DenseSettings {
+            tau_ms: self.tau_ms,
+            threshold: self.threshold,
+            window_ms: self.window_ms,
+            bins: self.bins,
+        };
+        match crate::kinds::dense_config(self.repr, settings)? {
+            Some(config) => Ok(config),
+            None => Ok(self
+                .repr
+                .config(self.static_config(), self.dynamic_config())),
+        }
     }
 }
 
@@ -210,9 +256,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ),
         None => None,
     };
-    let config = model
-        .as_ref()
-        .map_or_else(|| args.config(), Model::repr_config);
+    let config = match &model {
+        Some(m) => m.repr_config(),
+        None => args.config()?,
+    };
     config.validate()?;
     let inputs: Vec<&Path> = [&args.events, &args.samples]
         .into_iter()
@@ -251,28 +298,45 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(path)) => Some(read_mask(path, &args, &config, frame)?),
     };
 
+    if mask.is_some() && config.dense_part().is_some() {
+        bail!(
+            "--mask applies to the static part: --repr {} has none",
+            config.kind_name()
+        );
+    }
     let mut fx = FeatureExtractor::new(&[config], frame, mask.as_ref())?;
     let (n, h, w) = (
         samples.len(),
         usize::from(frame.height),
         usize::from(frame.width),
     );
-    // Stacked and late frames are the static frame above the dynamic one.
-    let frame_h = h * config.frames();
+    // Stacked and late frames are the static frame above the dynamic one; a real-valued kind's
+    // are its channels, one after the other.
+    let dense = config.dense_part().is_some();
+    let (frame_h, channels) = if dense {
+        (h, config.frames())
+    } else {
+        (h * config.frames(), 1)
+    };
     let per_sample = match args.what {
         What::Features => fx.feature_len(0),
-        What::Frames => frame_h * w,
+        What::Frames => channels * frame_h * w,
         What::Potential => h * w,
     };
     let mut bytes = Vec::new();
     let mut floats = Vec::new();
     match args.what {
-        What::Frames => bytes.reserve(n * per_sample),
-        What::Features | What::Potential => floats.reserve(n * per_sample),
+        What::Frames if !dense => bytes.reserve(n * per_sample),
+        What::Frames | What::Features | What::Potential => floats.reserve(n * per_sample),
     }
     let bar = crate::progress::bar(n as u64, "represent");
+    let mut values = Vec::new();
     fx.run(&cropped, &samples, |_, fx| {
         match args.what {
+            What::Frames if dense => {
+                fx.frame_values_into(0, &mut values);
+                floats.extend_from_slice(&values);
+            }
             What::Frames => bytes.extend_from_slice(fx.frame(0)),
             What::Features => floats.extend_from_slice(fx.features(0)),
             What::Potential => floats.extend_from_slice(fx.potentials(0).unwrap_or_default()),
@@ -291,6 +355,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
     let out = &args.output;
     match args.what {
+        What::Frames if dense => {
+            let shape = (n, channels, frame_h, w);
+            write_npy(out, &Array4::from_shape_vec(shape, floats)?)?;
+        }
         What::Frames => write_npy(out, &Array3::from_shape_vec((n, frame_h, w), bytes)?)?,
         What::Potential => write_npy(out, &Array3::from_shape_vec((n, h, w), floats)?)?,
         What::Features => {

@@ -47,6 +47,12 @@ pub struct Args {
     /// `--scale paper` and the recheck of the best settings, instead of 435).
     #[arg(long)]
     pub no_fusions: bool,
+    /// Also compare the representations the paper did not choose in Experiment 1: time
+    /// surfaces, polarity histograms and voxel grids (tonic's), each tuned on its own grid and
+    /// trained with every seed on every dataset, with their latency (the "beyond the paper"
+    /// rows). Not trained in Experiment 2, at other noise or in the ablations.
+    #[arg(long)]
+    pub beyond: bool,
     /// Standard deviation (degrees) of the noise the label-noise ablation adds to Experiment
     /// 1's training labels (the paper's three representations trained again on them); 0 skips
     /// the ablation. Default: the plan's, 0.04 (the spread of the paper's label check).
@@ -151,6 +157,7 @@ impl Args {
             recheck: !self.no_recheck,
             capture_filter: self.capture_filter.clone(),
             capture_ablation: !self.no_capture_filter,
+            beyond: self.beyond,
         }
     }
 }

@@ -8,28 +8,35 @@ use evtac_experiments::jobs;
 use evtac_experiments::sampling::{Phase, Sampling};
 use evtac_experiments::training::TrainSpec;
 use evtac_learn::TrainConfig;
-use evtac_repr::{DynamicConfig, ReprConfig, ReprKind, StaticConfig};
+use evtac_repr::{DenseSettings, DynamicConfig, ReprConfig, ReprKind, StaticConfig};
 use std::path::PathBuf;
 
 /// Representation settings shared by `train` and `tune`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReprArgs {
     /// Representation: static, dynamic, combined (the paper's three), stacked or late (learned
-    /// fusions of the static and dynamic frames).
+    /// fusions of the static and dynamic frames), or time-surface, histogram, voxel-grid (the
+    /// real-valued kinds the paper did not choose, as tonic computes them).
     #[arg(long, value_parser = crate::kinds::parser())]
     pub repr: ReprKind,
-    /// Static decay constant tau in ms (the default is the paper's choice).
-    #[arg(long, default_value_t = StaticConfig::default().tau_ms)]
-    pub tau_ms: f64,
-    /// Static binarization threshold in event contributions (the default is the paper's choice).
-    #[arg(long, default_value_t = StaticConfig::default().threshold)]
-    pub threshold: f32,
-    /// Dynamic window length in ms (the default is the paper's choice).
-    #[arg(long, default_value_t = DynamicConfig::default().window_ms)]
-    pub window_ms: f64,
+    /// Decay constant tau in ms: the static part's [default: 1000, the paper's] or a time
+    /// surface's [default: 100].
+    #[arg(long)]
+    pub tau_ms: Option<f64>,
+    /// Binarization threshold: the static part's, in event contributions [default: 2, the
+    /// paper's]; a time surface's, in (0, 1) [default: none, continuous values].
+    #[arg(long)]
+    pub threshold: Option<f64>,
+    /// Window length in ms: the dynamic part's, a histogram's or a voxel grid's [default: 640,
+    /// the paper's dynamic window].
+    #[arg(long)]
+    pub window_ms: Option<f64>,
     /// Dynamic binarization threshold in events per pixel (the default is the paper's choice).
     #[arg(long, default_value_t = DynamicConfig::default().count_threshold)]
     pub count_threshold: u32,
+    /// A voxel grid's temporal bins [default: 5].
+    #[arg(long)]
+    pub bins: Option<u32>,
     /// A full representation config as JSON (`evtac_repr::ReprConfig`), overriding the flags
     /// above (for the static accumulator's other settings).
     #[arg(long)]
@@ -47,13 +54,25 @@ impl ReprArgs {
             config.validate()?;
             return Ok(config);
         }
-        let s = StaticConfig {
+        let settings = DenseSettings {
             tau_ms: self.tau_ms,
             threshold: self.threshold,
-            ..StaticConfig::default()
+            window_ms: self.window_ms,
+            bins: self.bins,
+        };
+        if let Some(config) = crate::kinds::dense_config(self.repr, settings)? {
+            return Ok(config);
+        }
+        let (s, d) = (StaticConfig::default(), DynamicConfig::default());
+        let s = StaticConfig {
+            tau_ms: self.tau_ms.unwrap_or(s.tau_ms),
+            // Static thresholds are float32 contributions; the flag's decimal text is parsed
+            // once, so an f32's shortest text comes back as that f32.
+            threshold: self.threshold.map_or(s.threshold, |t| t as f32),
+            ..s
         };
         let d = DynamicConfig {
-            window_ms: self.window_ms,
+            window_ms: self.window_ms.unwrap_or(d.window_ms),
             count_threshold: self.count_threshold,
         };
         let config = self.repr.config(s, d);

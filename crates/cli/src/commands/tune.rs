@@ -1,5 +1,7 @@
 //! `evtac tune`: Experiment 1's grid search for one representation on a dataset: one training
-//! run per (decay tau x threshold) or (window x threshold), the lowest validation MAE chosen.
+//! run per (decay tau x threshold) or (window x threshold), the lowest validation MAE chosen; or
+//! the grid of a kind the paper did not choose (time surface: tau x threshold; histogram:
+//! window; voxel grid: window x bins; `evtac_experiments::dense_grid`).
 
 use anyhow::Context;
 use evtac_experiments::cache::FeatureCache;
@@ -17,6 +19,12 @@ pub enum TuneKind {
     Static,
     /// Window x threshold.
     Dynamic,
+    /// Tau x threshold (0: the continuous surface).
+    TimeSurface,
+    /// Window.
+    Histogram,
+    /// Window x bins.
+    VoxelGrid,
 }
 
 /// Arguments of `evtac tune`.
@@ -24,7 +32,7 @@ pub enum TuneKind {
 pub struct Args {
     /// Dataset folder (with `trials.csv`).
     pub dataset: PathBuf,
-    /// Representation to tune: static or dynamic.
+    /// Representation to tune (the scale's grid of it: `evtac_experiments::plan`).
     #[arg(long, value_enum)]
     pub repr: TuneKind,
     /// Grid and epochs of this scale: tiny, small or paper (every combination of evtac's grid,
@@ -57,6 +65,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let kind = match args.repr {
         TuneKind::Static => Kind::Static,
         TuneKind::Dynamic => Kind::Dynamic,
+        TuneKind::TimeSurface => Kind::TimeSurface,
+        TuneKind::Histogram => Kind::Histogram,
+        TuneKind::VoxelGrid => Kind::VoxelGrid,
     };
     let out = args
         .out
@@ -80,7 +91,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     crate::outputs::write_text(&json_path, &serde_json::to_string_pretty(&t)?)?;
     println!(
         "{:>10} {:>9} {:>9} {:>7} {:>7}",
-        t.time_name, "threshold", "val MAE", "pitch", "roll"
+        t.time_name,
+        kind.threshold_name(),
+        "val MAE",
+        "pitch",
+        "roll"
     );
     for r in &t.runs {
         println!(
@@ -89,9 +104,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     println!(
-        "chosen: {} {} ms, threshold {} ({})",
+        "chosen: {} {} ms, {} {} ({})",
         t.time_name,
         t.chosen_time_ms,
+        kind.threshold_name(),
         t.chosen_threshold,
         json_path.display()
     );

@@ -44,6 +44,17 @@ pub fn representations() -> [(&'static str, ReprConfig); 5] {
     ]
 }
 
+/// The kinds the paper did not choose, at their default settings (time surface tau 100 ms,
+/// continuous; histogram over 640 ms; voxel grid of 5 bins over 640 ms).
+pub fn beyond_representations() -> [(&'static str, ReprConfig); 3] {
+    evtac_repr::ReprKind::BEYOND.map(|kind| {
+        (
+            kind.name(),
+            kind.config(Default::default(), Default::default()),
+        )
+    })
+}
+
 /// A model bundle with weights initialised from `seed` (untrained: the tests compare online and
 /// offline predictions, which needs varied outputs, not accurate ones), saved in `dir`.
 pub fn seeded_bundle(dir: &Path, seed: u64, repr: &ReprConfig, mask: Option<Mask>) {

@@ -244,8 +244,8 @@ def filter(
 
 
 class Representation:
-    """A static, dynamic, combined, stacked or late representation, as ``evtac represent`` builds
-    it.
+    """A static, dynamic, combined, stacked or late representation, or a time surface, polarity
+    histogram or voxel grid, as ``evtac represent`` builds it.
 
     ``kind`` is ``"static"`` (exponential-decay accumulator, masked and thresholded),
     ``"dynamic"`` (sliding-window event count, thresholded), ``"combined"`` (their pixel-wise
@@ -257,6 +257,17 @@ class Representation:
     ``min_potential`` (0), ``max_potential`` (1), ``neutral_potential`` (0), ``polarity``
     (``"signed"``, ``"ignore"``), ``synchronous_decay`` (False); dynamic ``window_ms`` (640)
     and ``count_threshold`` (0).
+
+    The real-valued kinds the paper did not choose are tonic 1.7's transforms, evaluated at each
+    sample time with the events before it: ``"time-surface"`` (per polarity
+    ``exp(-(t - t_last) / tau)``; ``tau_ms`` (100), ``threshold`` in (0, 1) to binarize
+    (default: continuous)), ``"histogram"`` (event counts per polarity over ``window_ms``
+    (640)) and ``"voxel-grid"`` (``bins`` (5) signed bins over ``window_ms`` (640)). Their
+    features are each channel's 30x30 pooled cells, one channel after the other, e.g.::
+
+        rep = evtac.Representation("voxel-grid", sensor=(640, 480), window_ms=320, bins=3)
+        rep.frames(events, times).shape   # (N, 3, 240, 240), float32
+        rep.features(events, times).shape  # (N, 2700)
 
     Events are in full-sensor coordinates of a ``sensor=(w, h)`` sensor and cropped to its
     centered ``roi`` (default 240x240, the paper's; ``None``: the whole sensor). Without
@@ -310,7 +321,9 @@ class Representation:
 
     def frames(self, events: Any, times_us: Any) -> np.ndarray:
         """Binary frames at each sample time: uint8 ``(N, height, width)``, 0 or 1 (stacked and
-        late: ``(N, 2 * height, width)``, the static frame above the dynamic one)."""
+        late: ``(N, 2 * height, width)``, the static frame above the dynamic one). For a time
+        surface, histogram or voxel grid: float32 ``(N, channels, height, width)``, channels in
+        tonic's order (OFF then ON; voxel bins in time order)."""
         return self._inner.frames(_event_bytes(events), _times(times_us))
 
     def potentials(self, events: Any, times_us: Any) -> np.ndarray:
@@ -326,7 +339,8 @@ class Representation:
         return self._inner.advance_to(int(t_us))
 
     def frame(self) -> np.ndarray:
-        """The incremental state's binary frame: uint8 ``(height, width)``."""
+        """The incremental state's binary frame: uint8 ``(height, width)`` (a real-valued
+        kind's: float32 ``(channels, height, width)``)."""
         return self._inner.frame()
 
     def reset(self) -> None:
@@ -335,7 +349,8 @@ class Representation:
 
     @property
     def kind(self) -> str:
-        """``"static"``, ``"dynamic"``, ``"combined"``, ``"stacked"`` or ``"late"``."""
+        """``"static"``, ``"dynamic"``, ``"combined"``, ``"stacked"``, ``"late"``,
+        ``"time-surface"``, ``"histogram"`` or ``"voxel-grid"``."""
         return self._inner.kind
 
     @property

@@ -47,6 +47,7 @@ fn distinct(runs: &[TuningRun], of: fn(&TuningRun) -> f64) -> Vec<f64> {
 /// The sentence flagging a chosen setting on its grid's edge, with the validation MAE along the
 /// edge's parameter at the chosen other one; `None` when the choice is inside the grid.
 fn edge_sentence(t: &Tuning, unit: &str) -> Option<String> {
+    let second = axes(t.repr).1;
     let times = distinct(&t.runs, |r| r.time_ms);
     let thresholds = distinct(&t.runs, |r| r.threshold);
     // A time of zero is no decay / no window: nothing lies below the smallest positive one in
@@ -63,7 +64,7 @@ fn edge_sentence(t: &Tuning, unit: &str) -> Option<String> {
             .map(|r| format!("{:.3} at {} ms", r.val.overall, r.time_ms))
             .collect();
         parts.push(format!(
-            "the chosen {unit} ({} ms) is {which} tried (validation MAE at threshold {}: {})",
+            "the chosen {unit} ({} ms) is {which} tried (validation MAE at {second} {}: {})",
             t.chosen_time_ms,
             t.chosen_threshold,
             along.join(", ")
@@ -71,7 +72,7 @@ fn edge_sentence(t: &Tuning, unit: &str) -> Option<String> {
     }
     if let Some(which) = threshold_edge {
         parts.push(format!(
-            "the chosen threshold ({}) is {which} tried",
+            "the chosen {second} ({}) is {which} tried",
             t.chosen_threshold
         ));
     }
@@ -87,6 +88,7 @@ fn edge_sentence(t: &Tuning, unit: &str) -> Option<String> {
 /// The sentence on the chosen setting's margin over the next best, judged against the spread
 /// over training seeds Experiment 1 measured for the chosen setting on validation.
 fn margin_sentence(t: &Tuning, r: &Results, unit: &str) -> Option<String> {
+    let second = axes(t.repr).1;
     let mut runs: Vec<&TuningRun> = t.runs.iter().collect();
     runs.sort_by(|a, b| a.val.overall.total_cmp(&b.val.overall));
     let (best, next) = (runs.first()?, runs.get(1)?);
@@ -107,7 +109,7 @@ fn margin_sentence(t: &Tuning, r: &Results, unit: &str) -> Option<String> {
         _ => ("beyond", true),
     };
     Some(format!(
-        "The next best setting ({unit} {} ms, threshold {}) is {:.3} deg higher on validation, \
+        "The next best setting ({unit} {} ms, {second} {}) is {:.3} deg higher on validation, \
          {is} {} (each single tuning run given the spread of the chosen setting's validation \
          MAE over Experiment 1's {} training seeds; the grid's settings were not trained again \
          with more seeds){}.",
@@ -130,10 +132,11 @@ fn recheck(md: &mut String, t: &Tuning, unit: &str) {
     let Some(chosen) = t.recheck.first() else {
         return;
     };
+    let second = axes(t.repr).1;
     let _ = writeln!(
         md,
         "The {} best settings trained again, each with {} seeds (the grid's run the first) and \
-         the grid's epochs:\n\n| {unit} (ms) | threshold | val MAE over seeds |\n| ---: | ---: | \
+         the grid's epochs:\n\n| {unit} (ms) | {second} | val MAE over seeds |\n| ---: | ---: | \
          ---: |",
         t.recheck.len(),
         chosen.seeds.len(),
@@ -153,7 +156,7 @@ fn recheck(md: &mut String, t: &Tuning, unit: &str) {
             &Side::of(&chosen.val.overall),
             &Side::of(&other.val.overall),
         );
-        let name = format!("{unit} {} ms, threshold {}", other.time_ms, other.threshold);
+        let name = format!("{unit} {} ms, {second} {}", other.time_ms, other.threshold);
         match judged.verdict {
             Verdict::FirstLower => beyond.push(name),
             Verdict::Tied => within.push(format!("{name} ({:+.3} deg)", judged.diff)),
@@ -191,23 +194,35 @@ fn recheck(md: &mut String, t: &Tuning, unit: &str) {
     let _ = writeln!(md, "\nBy the report's rule, {verdict}\n");
 }
 
+/// A tuned kind's time axis, its second axis, and what the paper chose: the paper's two, and the
+/// kinds beyond the paper (whose grids are evtac's: `evtac_experiments::dense_grid`).
+fn axes(kind: ReprKind) -> (&'static str, &'static str, &'static str) {
+    match kind {
+        ReprKind::Static => ("tau", "threshold", "paper: 1000 ms, threshold 2"),
+        ReprKind::TimeSurface => (
+            "tau",
+            "threshold",
+            "threshold 0 is the continuous surface; the paper tunes none",
+        ),
+        ReprKind::Histogram => ("window", "threshold", "the paper tunes none"),
+        ReprKind::VoxelGrid => ("window", "bins", "the paper tunes none"),
+        _ => ("window", "threshold", "paper: 640 ms, threshold 0"),
+    }
+}
+
 /// The section.
 pub(super) fn section(md: &mut String, r: &Results) {
     let _ = writeln!(md, "## Experiment 1: hyperparameter search\n");
     for t in &r.tuning {
-        let (unit, paper_choice) = if t.repr == ReprKind::Static {
-            ("tau", "1000 ms, threshold 2")
-        } else {
-            ("window", "640 ms, threshold 0")
-        };
+        let (unit, second, paper_choice) = axes(t.repr);
         let _ = writeln!(
             md,
-            "{}: chosen {unit} {} ms, threshold {} (paper: {paper_choice}).\n",
+            "{}: chosen {unit} {} ms, {second} {} ({paper_choice}).\n",
             t.repr, t.chosen_time_ms, t.chosen_threshold
         );
         let _ = writeln!(
             md,
-            "| {unit} (ms) | threshold | val MAE overall | pitch | roll |\n| ---: | ---: | ---: | \
+            "| {unit} (ms) | {second} | val MAE overall | pitch | roll |\n| ---: | ---: | ---: | \
              ---: | ---: |"
         );
         for run in &t.runs {

@@ -1,12 +1,14 @@
 //! One frame drawn with the report's plotting stack: a row of 240x240 panels (the interval's
-//! events by polarity, each representation's binary frame), with `features` each
+//! events by polarity, each representation's frame: binary ones white on black, the real-valued
+//! kinds' ON red and OFF blue (a voxel grid's bins summed, positive red), scaled to the frame's
+//! largest value where that is above 1), with `features` each
 //! representation's pooled features below its frame, scaled to the same size, and with
 //! `angles` a model's estimates over time below them all.
 
 use super::Panel;
 use super::angles::Angles;
 use super::angles_chart::draw_angles;
-use super::frames::{Frame, Timing};
+use super::frames::{Frame, Pixels, Timing};
 use crate::plots::images::{draw_image, grey, polarity_color};
 use crate::plots::{Error, FAMILY, draw_err};
 use evtac_repr::CROP;
@@ -143,16 +145,22 @@ pub fn draw_frame<DB: DrawingBackend>(
             continue;
         };
         text(format!("{} frame", repr.kind), (x, y - TITLE + 2))?;
-        // A binary frame: white where the representation is set.
-        let set = |px: usize, py: usize| repr.frame.get(py * w + px).is_some_and(|&v| v != 0);
-        draw_image(
-            area,
-            (x, y),
-            (w, h),
-            1,
-            |px, py| if set(px, py) { WHITE } else { BLACK },
-            path,
-        )?;
+        match repr.pixels {
+            // A binary frame: white where the representation is set.
+            Pixels::Binary(bits) => {
+                let set = |px: usize, py: usize| bits.get(py * w + px).is_some_and(|&v| v != 0);
+                let color = |px, py| if set(px, py) { WHITE } else { BLACK };
+                draw_image(area, (x, y), (w, h), 1, color, path)?;
+            }
+            Pixels::Values { channels, values } => {
+                let (on, off) = polarities(channels, values, w * h);
+                let color = |px: usize, py: usize| {
+                    let p = py * w + px;
+                    RGBColor(level(on[p]), 0, level(off[p]))
+                };
+                draw_image(area, (x, y), (w, h), 1, color, path)?;
+            }
+        }
         if layout.features {
             let (fx, fy) = origin(c, 1);
             let (cw, ch) = (w / CELL, h / CELL);
@@ -160,12 +168,21 @@ pub fn draw_frame<DB: DrawingBackend>(
                 format!("{} features ({cw}x{ch})", repr.kind),
                 (fx, fy - TITLE + 2),
             )?;
+            // The real-valued kinds' channels summed per cell, scaled as their frames.
+            let cells = cw * ch;
+            let mut sums = vec![0f32; cells];
+            for channel in repr.features.chunks_exact(cells) {
+                for (s, &v) in sums.iter_mut().zip(channel) {
+                    *s += v.abs();
+                }
+            }
+            let scale = sums.iter().fold(1f32, |m, &v| m.max(v));
             draw_image(
                 area,
                 (fx, fy),
                 (cw, ch),
                 CELL as i32,
-                |cx, cy| grey(repr.features.get(cy * cw + cx).copied().unwrap_or(0.0)),
+                |cx, cy| grey(sums.get(cy * cw + cx).copied().unwrap_or(0.0) / scale),
                 path,
             )?;
         }
@@ -180,4 +197,55 @@ pub fn draw_frame<DB: DrawingBackend>(
         draw_angles(&panel, angles, frame.t_us, timing, path)?;
     }
     Ok(())
+}
+
+/// Per pixel, the ON and OFF intensities of a real-valued frame of `channels` channels of
+/// `pixels` values, in 0..=1: a polarity pair's two channels (OFF first, tonic's order), or a
+/// voxel grid's bins summed (positive ON, negative OFF), divided by the frame's largest value
+/// where it is above 1 (a histogram's counts; a time surface's values are already in 0..=1).
+fn polarities(channels: usize, values: &[f32], pixels: usize) -> (Vec<f32>, Vec<f32>) {
+    let (mut on, mut off) = (vec![0f32; pixels], vec![0f32; pixels]);
+    if channels == 2 {
+        off.copy_from_slice(&values[..pixels]);
+        on.copy_from_slice(&values[pixels..2 * pixels]);
+    } else {
+        for bin in values.chunks_exact(pixels) {
+            for (o, &v) in on.iter_mut().zip(bin) {
+                *o += v;
+            }
+        }
+        for (o, f) in on.iter_mut().zip(&mut off) {
+            *f = (-*o).max(0.0);
+            *o = o.max(0.0);
+        }
+    }
+    let scale = on.iter().chain(&off).fold(1f32, |m, &v| m.max(v));
+    for v in on.iter_mut().chain(&mut off) {
+        *v /= scale;
+    }
+    (on, off)
+}
+
+/// A colour channel's level for an intensity in 0..=1.
+fn level(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn real_valued_frames_split_into_on_and_off_scaled_to_their_largest() {
+        // Two polarity channels of two pixels: OFF [0.5, 0], ON [0.25, 1].
+        let (on, off) = polarities(2, &[0.5, 0.0, 0.25, 1.0], 2);
+        assert_eq!((on, off), (vec![0.25, 1.0], vec![0.5, 0.0]));
+        // Counts above 1 are scaled to the largest.
+        let (on, off) = polarities(2, &[4.0, 0.0, 2.0, 8.0], 2);
+        assert_eq!((on, off), (vec![0.25, 1.0], vec![0.5, 0.0]));
+        // Three signed bins summed: +3 and -1.5.
+        let (on, off) = polarities(3, &[1.0, -0.5, 1.0, -0.5, 1.0, -0.5], 2);
+        assert_eq!((on, off), (vec![1.0, 0.0], vec![0.0, 0.5]));
+        assert_eq!((level(1.5), level(0.5), level(-1.0)), (255, 128, 0));
+    }
 }

@@ -1,5 +1,5 @@
 //! The frame sequence: when each frame is taken, and what it holds (the events of its interval,
-//! each representation's binary frame and pooled features at its end).
+//! each representation's frame, binary or real-valued, and pooled features at its end).
 
 use super::Error;
 use evtac_events::Event;
@@ -92,14 +92,28 @@ fn range(events: &[Event], from_us: Option<i64>, to_us: Option<i64>) -> Result<(
     Ok((start_us, end_us))
 }
 
+/// A representation's frame.
+#[derive(Debug, Clone, Copy)]
+pub enum Pixels<'a> {
+    /// A binary frame, row-major, 0 or 1.
+    Binary(&'a [u8]),
+    /// A real-valued kind's channels (`channels x height x width`, tonic's layout).
+    Values {
+        /// Channels: two polarities (OFF, ON) or a voxel grid's bins.
+        channels: usize,
+        /// The values.
+        values: &'a [f32],
+    },
+}
+
 /// One representation in a frame.
 #[derive(Debug, Clone, Copy)]
 pub struct ReprFrame<'a> {
     /// The representation.
     pub kind: ReprKind,
-    /// The binary frame, row-major, 0 or 1.
-    pub frame: &'a [u8],
-    /// The pooled features, row-major.
+    /// Its frame.
+    pub pixels: Pixels<'a>,
+    /// The pooled features, row-major (channel after channel for the real-valued kinds).
     pub features: &'a [f32],
 }
 
@@ -135,6 +149,8 @@ pub fn for_each_frame(
 ) -> Result<(), Error> {
     let mut fx = FeatureExtractor::new_with_masks(reprs, CROP, masks)?;
     let samples: Vec<i64> = (0..timing.count).map(|k| timing.end_us(k)).collect();
+    // The real-valued kinds' frames are built on request, into these.
+    let mut values: Vec<Vec<f32>> = vec![Vec::new(); reprs.len()];
     // Events before the range still build up the representations' state (the static
     // accumulator and the dynamic window), as they would live.
     let mut failed = None;
@@ -145,6 +161,11 @@ pub fn for_each_frame(
         let t_us = samples[k];
         let first = events.partition_point(|e| e.t <= t_us - timing.step_us);
         let last = events.partition_point(|e| e.t <= t_us);
+        for (i, config) in reprs.iter().enumerate() {
+            if config.dense_part().is_some() {
+                fx.frame_values_into(i, &mut values[i]);
+            }
+        }
         let frame = Frame {
             index: k,
             t_us,
@@ -154,7 +175,13 @@ pub fn for_each_frame(
                 .enumerate()
                 .map(|(i, config)| ReprFrame {
                     kind: config.kind(),
-                    frame: fx.frame(i),
+                    pixels: match config.dense_part() {
+                        Some(_) => Pixels::Values {
+                            channels: config.frames(),
+                            values: &values[i],
+                        },
+                        None => Pixels::Binary(fx.frame(i)),
+                    },
                     features: fx.features(i),
                 })
                 .collect(),

@@ -19,6 +19,13 @@ pub struct HistogramConfig {
     pub window_ms: f64,
 }
 
+impl Default for HistogramConfig {
+    /// The paper's dynamic window, 640 ms, as the starting point (`tune` searches around it).
+    fn default() -> Self {
+        Self { window_ms: 640.0 }
+    }
+}
+
 impl HistogramConfig {
     /// Checks the window.
     pub fn validate(&self) -> Result<(), ReprError> {

@@ -42,6 +42,18 @@ pub struct TimeSurfaceConfig {
     pub threshold: Option<f64>,
 }
 
+impl Default for TimeSurfaceConfig {
+    /// evtac's starting point, where the paper states none: tau 100 ms (a pin's events fade
+    /// over about the time a contact phase changes), continuous values. `tune` searches
+    /// around it.
+    fn default() -> Self {
+        Self {
+            tau_ms: 100.0,
+            threshold: None,
+        }
+    }
+}
+
 impl TimeSurfaceConfig {
     /// Checks tau (finite, > 0) and the threshold (in (0, 1)).
     pub fn validate(&self) -> Result<(), ReprError> {

@@ -43,6 +43,17 @@ pub struct VoxelGridConfig {
     pub bins: u32,
 }
 
+impl Default for VoxelGridConfig {
+    /// The paper's dynamic window, 640 ms, in 5 bins (evtac's choice: 4500 features, within
+    /// what the networks read), as the starting point (`tune` searches around it).
+    fn default() -> Self {
+        Self {
+            window_ms: 640.0,
+            bins: 5,
+        }
+    }
+}
+
 impl VoxelGridConfig {
     /// Checks the window and the bins.
     pub fn validate(&self) -> Result<(), ReprError> {
