@@ -65,7 +65,14 @@ pub fn run(
     let mut all = Vec::new();
     for level in run.plan.unique_noise_levels() {
         if level == 1.0 {
-            all.extend(points(level, background_rate(ds1, seconds)?, e1));
+            // Experiment 1 itself, for the representations this study trains (not the kinds
+            // beyond the paper Experiment 1 may also compare).
+            let e1: Vec<Exp1Repr> = e1
+                .iter()
+                .filter(|e| reprs.iter().any(|c| c.kind() == e.name))
+                .cloned()
+                .collect();
+            all.extend(points(level, background_rate(ds1, seconds)?, &e1));
             continue;
         }
         // Same protocol, scale and seed as Experiment 1's dataset: only the noise differs.
