@@ -111,13 +111,11 @@ fn frames_of(extractor: &FeatureExtractor, config: &ReprConfig, mask: Option<&Ma
         height: (pixels.len() / usize::from(size.width.max(1))) as u32,
         pixels,
     };
-    if config.dense_part().is_some() {
-        return Vec::new();
-    }
-    let whole = extractor.frame(0);
+    // Read only for the binary kinds (a real-valued kind has no binary frame).
+    let whole = || extractor.frame(0);
     match config {
-        ReprConfig::Static(_) => vec![frame(Part::Static, whole.to_vec())],
-        ReprConfig::Dynamic(_) => vec![frame(Part::Dynamic, whole.to_vec())],
+        ReprConfig::Static(_) => vec![frame(Part::Static, whole().to_vec())],
+        ReprConfig::Dynamic(_) => vec![frame(Part::Dynamic, whole().to_vec())],
         ReprConfig::Combined {
             static_part,
             dynamic_part,
@@ -135,7 +133,7 @@ fn frames_of(extractor: &FeatureExtractor, config: &ReprConfig, mask: Option<&Ma
                     combine::dynamic_frame(dynamic_part, counts),
                 ));
             }
-            frames.push(frame(Part::Combined, whole.to_vec()));
+            frames.push(frame(Part::Combined, whole().to_vec()));
             frames
         }
         // Refused when frames are asked for (`Estimator::capture_frames`): not binary.
@@ -144,6 +142,7 @@ fn frames_of(extractor: &FeatureExtractor, config: &ReprConfig, mask: Option<&Ma
         }
         // The static part's frame above the dynamic part's.
         ReprConfig::Stacked { .. } | ReprConfig::Late { .. } => {
+            let whole = whole();
             let (top, bottom) = whole.split_at(whole.len() / 2);
             vec![
                 frame(Part::Static, top.to_vec()),

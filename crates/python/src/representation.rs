@@ -231,7 +231,7 @@ impl Representation {
         fx.run(&cropped, times, visit).map_err(error::value)
     }
 
-    /// What `read` gives at each of `times` (`per_sample` values each), concatenated, with the
+    /// What `read` appends at each of `times` (`per_sample` values each), concatenated, with the
     /// interpreter released while the representation runs: the shared body of `features`,
     /// `frames` and `potentials`. Returns the number of samples with the values.
     fn sampled<T: Copy + Send + Sync>(
@@ -240,7 +240,7 @@ impl Representation {
         events: &PyReadonlyArray1<'_, u8>,
         times: &PyReadonlyArray1<'_, i64>,
         per_sample: usize,
-        read: impl Fn(&FeatureExtractor) -> &[T] + Sync,
+        read: impl Fn(&FeatureExtractor, &mut Vec<T>) + Sync,
     ) -> PyResult<(usize, Vec<T>)> {
         let (events, times) = (
             events.as_slice().map_err(error::value)?,
@@ -248,7 +248,7 @@ impl Representation {
         );
         py.detach(|| {
             let mut out = Vec::with_capacity(times.len() * per_sample);
-            self.run(events, times, |_, fx| out.extend_from_slice(read(fx)))?;
+            self.run(events, times, |_, fx| read(fx, &mut out))?;
             Ok((times.len(), out))
         })
     }
@@ -323,7 +323,9 @@ impl Representation {
         times: PyReadonlyArray1<'py, i64>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let len = self.state()?.feature_len(0);
-        let (n, out) = self.sampled(py, &events, &times, len, |fx| fx.features(0))?;
+        let (n, out) = self.sampled(py, &events, &times, len, |fx, out| {
+            out.extend_from_slice(fx.features(0));
+        })?;
         let out = Array2::from_shape_vec((n, len), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))
     }
@@ -340,23 +342,17 @@ impl Representation {
         let (h, w) = self.frame_dims();
         if self.config.dense_part().is_some() {
             let c = self.config.frames();
-            let (events, times) = (
-                events.as_slice().map_err(error::value)?,
-                times.as_slice().map_err(error::value)?,
-            );
-            let out = py.detach(|| -> PyResult<Vec<f32>> {
-                let mut out = Vec::with_capacity(times.len() * c * h * w);
+            let (n, out) = self.sampled(py, &events, &times, c * h * w, |fx, out| {
                 let mut values = Vec::new();
-                self.run(events, times, |_, fx| {
-                    fx.frame_values_into(0, &mut values);
-                    out.extend_from_slice(&values);
-                })?;
-                Ok(out)
+                fx.frame_values_into(0, &mut values);
+                out.extend_from_slice(&values);
             })?;
-            let out = Array4::from_shape_vec((times.len(), c, h, w), out).map_err(error::value)?;
+            let out = Array4::from_shape_vec((n, c, h, w), out).map_err(error::value)?;
             return Ok(out.into_pyarray(py).into_any());
         }
-        let (n, out) = self.sampled(py, &events, &times, h * w, |fx| fx.frame(0))?;
+        let (n, out) = self.sampled(py, &events, &times, h * w, |fx, out| {
+            out.extend_from_slice(fx.frame(0));
+        })?;
         let out = Array3::from_shape_vec((n, h, w), out).map_err(error::value)?;
         Ok(out.into_pyarray(py).into_any())
     }
@@ -377,8 +373,8 @@ impl Representation {
             usize::from(self.roi.size.height),
             usize::from(self.roi.size.width),
         );
-        let (n, out) = self.sampled(py, &events, &times, h * w, |fx| {
-            fx.potentials(0).unwrap_or_default()
+        let (n, out) = self.sampled(py, &events, &times, h * w, |fx, out| {
+            out.extend_from_slice(fx.potentials(0).unwrap_or_default());
         })?;
         let out = Array3::from_shape_vec((n, h, w), out).map_err(error::value)?;
         Ok(out.into_pyarray(py))

@@ -388,16 +388,29 @@ impl FeatureExtractor {
         self.sample_time
     }
 
-    /// Number of pushed events not yet applied (later than the latest sample time).
+    /// Number of pushed events not yet applied (later than the latest sample time; at or after
+    /// it for an extractor of real-valued kinds only, whose samples see the events before them).
     pub fn pending(&self) -> usize {
-        self.pending.len()
+        match (self.binary(), self.denses.first()) {
+            (false, Some(dense)) => dense.pending(),
+            _ => self.pending.len(),
+        }
+    }
+
+    /// Whether any output is binary. Without one, events go to the real-valued kinds'
+    /// extractors alone, which check and queue them themselves: the binary queue would only be
+    /// a copy of every event, drained unread.
+    fn binary(&self) -> bool {
+        !self.outputs.is_empty()
     }
 
     /// Queues events in crop coordinates, in time order (also after earlier pushes). The whole
     /// chunk is checked first: on error nothing is queued.
     pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
-        let (pending, last) = (&mut self.pending, &mut self.last_pushed);
-        crate::check::queue_events(pending, last, self.resolution, events, None)?;
+        if self.binary() {
+            let (pending, last) = (&mut self.pending, &mut self.last_pushed);
+            crate::check::queue_events(pending, last, self.resolution, events, None)?;
+        }
         for dense in &mut self.denses {
             dense.push(events)?;
         }
@@ -407,8 +420,10 @@ impl FeatureExtractor {
     /// Queues events in full-sensor coordinates, cropping them with `roi` on the way (events
     /// outside it are dropped). `roi.size` must be the frame size.
     pub fn push_with_roi(&mut self, events: &[Event], roi: &Roi) -> Result<(), ReprError> {
-        let (pending, last) = (&mut self.pending, &mut self.last_pushed);
-        crate::check::queue_events(pending, last, self.resolution, events, Some(roi))?;
+        if self.binary() {
+            let (pending, last) = (&mut self.pending, &mut self.last_pushed);
+            crate::check::queue_events(pending, last, self.resolution, events, Some(roi))?;
+        }
         for dense in &mut self.denses {
             dense.push_with_roi(events, roi)?;
         }
@@ -482,6 +497,10 @@ impl FeatureExtractor {
     /// # Ok::<(), evtac_repr::ReprError>(())
     /// ```
     pub fn push_and_prepare(&mut self, events: &[Event], t_next: i64) -> Result<(), ReprError> {
+        if !self.binary() {
+            self.push(events)?;
+            return self.prepare(t_next);
+        }
         self.last_pushed =
             crate::check::check_events(events, Some(self.resolution), self.last_pushed)?;
         for dense in &mut self.denses {

@@ -206,6 +206,11 @@ impl DenseExtractor {
         self.sample_time
     }
 
+    /// Number of pushed events not yet applied (at or after the latest sample time).
+    pub fn pending(&self) -> usize {
+        self.pending.len()
+    }
+
     /// Queues events in crop coordinates, in time order (also after earlier pushes). The whole
     /// chunk is checked first: on error nothing is queued.
     pub fn push(&mut self, events: &[Event]) -> Result<(), ReprError> {
