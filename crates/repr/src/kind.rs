@@ -168,63 +168,65 @@ impl ReprKind {
     /// time surface tau 100 ms, continuous; windows 640 ms; 5 bins), checked. A setting the
     /// kind does not take is an error naming it, as is a binary kind.
     pub fn dense_config(self, settings: DenseSettings) -> Result<ReprConfig, ReprError> {
-        let refuse = |field: &'static str, value: String| {
-            Err(ReprError::InvalidConfig {
-                field,
-                value,
-                reason: match self {
-                    Self::TimeSurface => "a time surface takes tau_ms and threshold",
-                    Self::Histogram => "a histogram takes window_ms",
-                    Self::VoxelGrid => "a voxel grid takes window_ms and bins",
-                    _ => "only time-surface, histogram and voxel-grid take these settings",
-                },
-            })
+        let (takes, reason): (&[&str], _) = match self {
+            Self::TimeSurface => (
+                &["tau_ms", "threshold"],
+                "a time surface takes tau_ms and threshold",
+            ),
+            Self::Histogram => (&["window_ms"], "a histogram takes window_ms"),
+            Self::VoxelGrid => (
+                &["window_ms", "bins"],
+                "a voxel grid takes window_ms and bins",
+            ),
+            Self::Static | Self::Dynamic | Self::Combined | Self::Stacked | Self::Late => (
+                &[],
+                "only time-surface, histogram and voxel-grid take these settings",
+            ),
         };
+        let refuse = |field: &'static str, value: String| ReprError::InvalidConfig {
+            field,
+            value,
+            reason,
+        };
+        if !self.is_dense() {
+            return Err(refuse("kind", self.name().to_string()));
+        }
         let DenseSettings {
             tau_ms,
             threshold,
             window_ms,
             bins,
         } = settings;
+        let given = [
+            ("tau_ms", tau_ms.map(|v| v.to_string())),
+            ("threshold", threshold.map(|v| v.to_string())),
+            ("window_ms", window_ms.map(|v| v.to_string())),
+            ("bins", bins.map(|v| v.to_string())),
+        ];
+        if let Some((field, Some(value))) = given
+            .into_iter()
+            .find(|(field, value)| value.is_some() && !takes.contains(field))
+        {
+            return Err(refuse(field, value));
+        }
         let config = match self {
             Self::TimeSurface => {
-                if let Some(w) = window_ms {
-                    return refuse("window_ms", w.to_string());
-                }
-                if let Some(b) = bins {
-                    return refuse("bins", b.to_string());
-                }
                 let d = TimeSurfaceConfig::default();
                 ReprConfig::TimeSurface(TimeSurfaceConfig {
                     tau_ms: tau_ms.unwrap_or(d.tau_ms),
                     threshold: threshold.or(d.threshold),
                 })
             }
-            Self::Histogram | Self::VoxelGrid => {
-                if let Some(t) = tau_ms {
-                    return refuse("tau_ms", t.to_string());
-                }
-                if let Some(t) = threshold {
-                    return refuse("threshold", t.to_string());
-                }
-                if self == Self::Histogram {
-                    if let Some(b) = bins {
-                        return refuse("bins", b.to_string());
-                    }
-                    let d = HistogramConfig::default();
-                    ReprConfig::Histogram(HistogramConfig {
-                        window_ms: window_ms.unwrap_or(d.window_ms),
-                    })
-                } else {
-                    let d = VoxelGridConfig::default();
-                    ReprConfig::VoxelGrid(VoxelGridConfig {
-                        window_ms: window_ms.unwrap_or(d.window_ms),
-                        bins: bins.unwrap_or(d.bins),
-                    })
-                }
-            }
-            Self::Static | Self::Dynamic | Self::Combined | Self::Stacked | Self::Late => {
-                return refuse("kind", self.name().to_string());
+            Self::Histogram => ReprConfig::Histogram(HistogramConfig {
+                window_ms: window_ms.unwrap_or(HistogramConfig::default().window_ms),
+            }),
+            // The binary kinds were refused above.
+            _ => {
+                let d = VoxelGridConfig::default();
+                ReprConfig::VoxelGrid(VoxelGridConfig {
+                    window_ms: window_ms.unwrap_or(d.window_ms),
+                    bins: bins.unwrap_or(d.bins),
+                })
             }
         };
         config.validate()?;
